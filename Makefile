@@ -1,0 +1,36 @@
+# Two commands for a fresh machine:
+#   make run   - create .venv, install thermodem, run the default example, print where results are
+#   make test  - create .venv, install thermodem with test extras, run the whole test suite
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+OUT ?= results/default
+
+.PHONY: run test venv lint bench clean-cache
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(VENV)/.installed: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $@
+
+venv: $(VENV)/.installed
+
+run: venv
+	$(BIN)/thermodem run examples/default.yaml --output $(OUT) --overwrite
+	@echo "Results written to $(OUT) (open $(OUT)/particles.pvd in ParaView)"
+
+test: venv
+	$(BIN)/python -m pytest -q
+
+lint: venv
+	$(BIN)/ruff check src tests bench
+	$(BIN)/ruff format --check src tests bench
+
+bench: venv
+	$(BIN)/python bench/bench_packed_bed.py --n 50000
+
+clean-cache:
+	find src -name '__pycache__' -type d -prune -exec rm -rf {} +

@@ -1,0 +1,184 @@
+"""The case file: pydantic models of every section (unknown keys are errors).
+
+A case is YAML; :func:`thermodem.config.load.load_case` reads it into :class:`Case`. Model
+choices are ``{model: NAME, <parameters of that model>}``: the name is checked against the
+registry (with a "did you mean") and the remaining keys against that model's own schema.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, Field, field_validator, model_validator
+
+from thermodem.config.base import StrictModel
+from thermodem.config.insertion import InsertionEntry
+from thermodem.geometry.walls import Wall
+from thermodem.models import registry
+from thermodem.state.materials import InteractionOverride, Material
+
+Vec3 = tuple[float, float, float]
+
+
+class ModelChoice(StrictModel):
+    """A model of one family and its validated parameters."""
+
+    family: str
+    model: str
+    params: BaseModel
+
+    @property
+    def spec(self) -> registry.ModelSpec:
+        return registry.get(self.family, self.model)
+
+
+def parse_model_choice(family: str, value: Any, default: str) -> ModelChoice:
+    """``"hertz"`` or ``{model: hertz, ...params}`` -> ModelChoice (raises ValueError)."""
+    if isinstance(value, ModelChoice):
+        return value
+    if value is None:
+        value = {"model": default}
+    if isinstance(value, str):
+        value = {"model": value}
+    if not isinstance(value, dict):
+        raise ValueError(f"expected a model name or a mapping with 'model', got {value!r}")
+    data = dict(value)
+    name = data.pop("model", default)
+    try:
+        spec = registry.get(family, str(name))
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+    return ModelChoice(family=family, model=spec.name, params=spec.params(**data))
+
+
+class ContactModels(StrictModel):
+    """Mechanical contact laws: ``normal``, ``tangential``, ``rolling``."""
+
+    normal: ModelChoice = Field(default_factory=lambda: parse_model_choice("normal", None,
+                                                                           "hertz"))
+    tangential: ModelChoice = Field(
+        default_factory=lambda: parse_model_choice("tangential", None, "mindlin")
+    )
+    rolling: ModelChoice = Field(default_factory=lambda: parse_model_choice("rolling", None,
+                                                                            "none"))
+
+    @field_validator("normal", mode="before")
+    @classmethod
+    def _normal(cls, v: Any) -> ModelChoice:
+        return parse_model_choice("normal", v, "hertz")
+
+    @field_validator("tangential", mode="before")
+    @classmethod
+    def _tangential(cls, v: Any) -> ModelChoice:
+        return parse_model_choice("tangential", v, "mindlin")
+
+    @field_validator("rolling", mode="before")
+    @classmethod
+    def _rolling(cls, v: Any) -> ModelChoice:
+        return parse_model_choice("rolling", v, "none")
+
+
+class Domain(StrictModel):
+    """Simulation box: the cell grid spans it; particles leaving a non-periodic side are an
+    error."""
+
+    lower: Vec3
+    upper: Vec3
+    periodic: tuple[bool, bool, bool] = (False, False, False)
+
+    @model_validator(mode="after")
+    def _check(self) -> Domain:
+        for axis, lo, hi in zip("xyz", self.lower, self.upper, strict=True):
+            if not lo < hi:
+                raise ValueError(f"lower must be < upper on every axis; on {axis}: lower={lo}, "
+                                 f"upper={hi}")
+        return self
+
+
+class Neighbors(StrictModel):
+    """Neighbour list settings."""
+
+    skin: float | None = Field(
+        default=None, ge=0,
+        description="Verlet skin [m]; default 0.1 × the largest particle diameter",
+    )
+    extra_distance: float = Field(
+        default=0.0, ge=0, description="interaction distance beyond contact (near pairs) [m]"
+    )
+    rebuild_every_step: bool = Field(default=False, description="ignore the skin criterion")
+
+
+class TimeStepCheck(StrictModel):
+    """Time step criteria checked before the run (docs/time-step.md).
+
+    Rayleigh time (Li et al. 2005): warn above ``rayleigh_warn_fraction``, refuse above 1.
+    Hertz collision time t_c at ``impact_velocity`` (spec appendix A): warn when a collision
+    lasts fewer than ``collision_warn_steps`` steps, refuse below ``collision_min_steps``.
+    ``allow_unstable: true`` turns refusals into warnings.
+    """
+
+    rayleigh_warn_fraction: float = Field(default=0.3, gt=0, le=1)
+    collision_warn_steps: float = Field(default=30.0, gt=0)
+    collision_min_steps: float = Field(default=10.0, gt=0)
+    impact_velocity: float | None = Field(
+        default=None, gt=0,
+        description="characteristic impact speed [m/s]; default: max(1, sqrt(2 g H), "
+        "initial and wall speeds)",
+    )
+    allow_unstable: bool = False
+
+
+class SimulationSettings(StrictModel):
+    time_step: float = Field(gt=0, description="[s]")
+    end_time: float = Field(gt=0, description="[s]")
+    gravity: Vec3 = (0.0, 0.0, -9.81)
+    seed: int = Field(default=12345, ge=0)
+    initial_temperature: float = Field(default=293.15, gt=0, description="[K]")
+    time_step_check: TimeStepCheck = Field(default_factory=TimeStepCheck)
+    max_overlap_ratio: float = Field(
+        default=0.2, gt=0, le=1,
+        description="stop when an overlap exceeds this fraction of the smaller radius",
+    )
+
+
+class Output(StrictModel):
+    interval: float | None = Field(default=None, gt=0, description="VTU interval [s]")
+    vtu: bool = True
+    wall_extent: float | None = Field(
+        default=None, gt=0, description="half size drawn for infinite walls [m]"
+    )
+
+
+class Case(StrictModel):
+    """A whole case file."""
+
+    simulation: SimulationSettings
+    domain: Domain
+    materials: dict[str, Material]
+    interactions: list[InteractionOverride] = Field(default_factory=list)
+    contact: ContactModels = Field(default_factory=ContactModels)
+    neighbors: Neighbors = Field(default_factory=Neighbors)
+    walls: list[Wall] = Field(default_factory=list)
+    insertion: list[InsertionEntry] = Field(default_factory=list)
+    output: Output = Field(default_factory=Output)
+
+    @model_validator(mode="after")
+    def _names(self) -> Case:
+        if not self.materials:
+            raise ValueError("materials: at least one material is needed")
+        known = set(self.materials)
+        allowed = ", ".join(sorted(known))
+        for k, w in enumerate(self.walls):
+            if w.material not in known:
+                raise ValueError(f"walls.{k}.material: unknown material {w.material!r}; "
+                                 f"allowed: {allowed}")
+        for k, e in enumerate(self.insertion):
+            if e.material not in known:
+                raise ValueError(f"insertion.{k}.material: unknown material {e.material!r}; "
+                                 f"allowed: {allowed}")
+        for k, o in enumerate(self.interactions):
+            for m in o.materials:
+                if m not in known:
+                    raise ValueError(f"interactions.{k}.materials: unknown material {m!r}; "
+                                     f"allowed: {allowed}")
+        return self

@@ -1,0 +1,112 @@
+"""Physics sanity before a run: the mechanical time step criteria.
+
+- Rayleigh time (Li et al. 2005, spec section 1.4): Δt_R = π R sqrt(ρ/G) / (0.8766 + 0.163 ν),
+  per material with its smallest radius. Warn above ``rayleigh_warn_fraction`` × Δt_R, refuse
+  above Δt_R.
+- Hertz collision time (spec appendix A): t_c = 2.87 (m*² / (R* E*² v))^{1/5} for two of the
+  smallest particles of each material pair (and particle–wall, m* = m, R* = R) at the
+  characteristic impact speed v. Warn when a collision would last fewer than
+  ``collision_warn_steps`` steps, refuse below ``collision_min_steps``.
+  For the linear spring the collision time is π sqrt(m*/k) / sqrt(1 - ζ²) instead.
+
+``allow_unstable: true`` turns refusals into warnings.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from thermodem.config.schema import Case
+from thermodem.errors import ConfigError
+from thermodem.models.mechanics.normal import hertz_collision_time, linear_damping_ratio
+from thermodem.state.materials import effective_youngs_modulus, resolve_pair
+
+
+def rayleigh_time(radius: float, density: float, shear_modulus: float, poisson: float) -> float:
+    """Δt_R = π R sqrt(ρ/G) / (0.8766 + 0.163 ν) (Li et al. 2005)."""
+    return math.pi * radius * math.sqrt(density / shear_modulus) / (0.8766 + 0.163 * poisson)
+
+
+def characteristic_speed(case: Case, velocities: np.ndarray | None = None) -> float:
+    chk = case.simulation.time_step_check
+    if chk.impact_velocity is not None:
+        return chk.impact_velocity
+    g = float(np.linalg.norm(case.simulation.gravity))
+    height = float(np.max(np.subtract(case.domain.upper, case.domain.lower)))
+    speeds = [1.0, math.sqrt(2.0 * g * height)]
+    if velocities is not None and velocities.size:
+        speeds.append(float(np.sqrt((velocities**2).sum(axis=1)).max()))
+    for w in case.walls:
+        speeds.append(float(np.linalg.norm(w.velocity)))
+        if getattr(w, "angular_velocity", 0.0):
+            speeds.append(abs(w.angular_velocity) * w.radius)
+    return max(speeds)
+
+
+def critical_times(case: Case, radius: np.ndarray, type_id: np.ndarray,
+                   names: list[str], velocities: np.ndarray | None = None) -> dict[str, float]:
+    """Smallest Rayleigh time and collision time over materials present [s]."""
+    v = characteristic_speed(case, velocities)
+    r_min = {}
+    for t, name in enumerate(names):
+        sel = radius[type_id == t]
+        if sel.size:
+            r_min[name] = float(sel.min())
+    out = {"rayleigh": math.inf, "collision": math.inf, "impact_speed": v}
+    normal = case.contact.normal
+    wall_mats = {w.material for w in case.walls}
+    for a, ra in r_min.items():
+        ma = case.materials[a]
+        out["rayleigh"] = min(out["rayleigh"], rayleigh_time(ra, ma.density, ma.shear_modulus,
+                                                             ma.poisson_ratio))
+        partners = [(b, r_min[b], False) for b in r_min] + [(b, math.inf, True)
+                                                               for b in wall_mats]
+        for b, rb, is_wall in partners:
+            mb = case.materials[b]
+            m_a = ma.density * 4.0 / 3.0 * math.pi * ra**3
+            if is_wall:
+                m_eff, r_eff = m_a, ra
+            else:
+                m_b = mb.density * 4.0 / 3.0 * math.pi * rb**3
+                m_eff, r_eff = m_a * m_b / (m_a + m_b), ra * rb / (ra + rb)
+            if normal.model == "linear":
+                k = normal.params.stiffness
+                zeta = linear_damping_ratio(resolve_pair(ma, mb).restitution)
+                tc = math.pi * math.sqrt(m_eff / k) / math.sqrt(max(1.0 - zeta**2, 1e-12))
+            else:
+                tc = hertz_collision_time(m_eff, r_eff, effective_youngs_modulus(ma, mb), v)
+            out["collision"] = min(out["collision"], tc)
+    return out
+
+
+def check_time_step(case: Case, radius: np.ndarray, type_id: np.ndarray, names: list[str],
+                    velocities: np.ndarray | None = None) -> list[str]:
+    """Warnings about the time step; raises ConfigError when it is refused."""
+    dt = case.simulation.time_step
+    chk = case.simulation.time_step_check
+    t = critical_times(case, radius, type_id, names, velocities)
+    warnings: list[str] = []
+    refusals: list[str] = []
+    if math.isfinite(t["rayleigh"]):
+        frac = dt / t["rayleigh"]
+        msg = (f"simulation.time_step = {dt:.4g} s is {frac:.3g} × the Rayleigh time "
+               f"{t['rayleigh']:.4g} s (Li et al. 2005)")
+        if frac > 1.0:
+            refusals.append(msg + "; the limit is 1")
+        elif frac > chk.rayleigh_warn_fraction:
+            warnings.append(msg + f"; above the warning fraction {chk.rayleigh_warn_fraction}")
+    if math.isfinite(t["collision"]):
+        steps = t["collision"] / dt
+        msg = (f"simulation.time_step = {dt:.4g} s resolves the collision time "
+               f"{t['collision']:.4g} s (at {t['impact_speed']:.3g} m/s) with {steps:.3g} steps")
+        if steps < chk.collision_min_steps:
+            refusals.append(msg + f"; at least {chk.collision_min_steps:g} are required")
+        elif steps < chk.collision_warn_steps:
+            warnings.append(msg + f"; fewer than {chk.collision_warn_steps:g} recommended")
+    if refusals and not chk.allow_unstable:
+        raise ConfigError("time step refused:\n" + "\n".join(refusals)
+                          + "\n(set simulation.time_step_check.allow_unstable: true to run "
+                          "anyway)")
+    return refusals + warnings

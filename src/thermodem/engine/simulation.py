@@ -1,0 +1,454 @@
+"""The simulation: orchestration in plain Python around the Numba kernels.
+
+Order inside one step (``Simulation.step``), held by the tests:
+
+1. first half kick and drift (velocity Verlet), walls move, pouring inserts particles;
+2. rebuild the pair lists if a particle moved more than half the skin (history carried by key);
+3. pair pass: geometry and contact forces of every particle and wall pair, dissipation per
+   mechanism, history, ledger rows per chunk;
+4. particle pass: gravity (thermal sources come with the thermal engine);
+5. reduce to per-particle force and torque in a fixed order, second half kick;
+6. check flags (non-finite values, particles outside the domain, excessive overlap);
+7. writers on their triggers (owned by the caller, see ``thermodem.engine.runner``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numba
+import numpy as np
+
+from thermodem.config.schema import Case, ModelChoice
+from thermodem.errors import SimulationError
+from thermodem.geometry import wall_layout as WL
+from thermodem.geometry.insertion import InsertedParticles, Pourer, insert
+from thermodem.geometry.walls import wall_rows
+from thermodem.kernels import contact as C
+from thermodem.kernels import neighbors as NB
+from thermodem.kernels.integrate import (
+    check_particles,
+    kick_drift,
+    max_column,
+    reduce_and_kick,
+    sum_rows,
+)
+from thermodem.models import registry
+from thermodem.state.materials import resolve_pair
+from thermodem.state.particles import Particles
+
+LEDGER_DISSIPATION = (
+    "normal_damping",
+    "tangential_damping",
+    "sliding_friction",
+    "rolling_friction",
+)
+
+
+def pair_table(choice: ModelChoice, case: Case, names: list[str]) -> np.ndarray:
+    """[nmat, nmat, PARAM_WIDTH] parameter rows of one model for every material pair."""
+    spec = choice.spec
+    n = len(names)
+    table = np.zeros((n, n, registry.PARAM_WIDTH))
+    overrides = {frozenset(o.materials): o for o in case.interactions}
+    for a in range(n):
+        for b in range(n):
+            ma = case.materials[names[a]]
+            mb = case.materials[names[b]]
+            pair = resolve_pair(ma, mb, overrides.get(frozenset((names[a], names[b]))))
+            table[a, b] = spec.pack(choice.params, pair)
+    return table
+
+
+class _PairBuffers:
+    """Pair-list arrays with a capacity; grown (never shrunk) when a rebuild needs more."""
+
+    def __init__(self, capacity: int, history_width: int, with_roll: bool) -> None:
+        self.count = 0
+        self.history_width = history_width
+        self.with_roll = with_roll
+        self.allocate(capacity)
+
+    def allocate(self, capacity: int) -> None:
+        capacity = max(int(capacity), 16)
+        self.capacity = capacity
+        self.i = np.zeros(capacity, np.int32)
+        self.j = np.zeros(capacity, np.int32)
+        self.history = np.zeros((capacity, self.history_width))
+        self.spare_history = np.zeros((capacity, self.history_width))
+        self.force = np.zeros((capacity, 3))
+        self.lever = np.zeros((capacity, 3))
+        self.roll = np.zeros((capacity if self.with_roll else 0, 3))
+        self.dissipation = np.zeros((capacity, 4))
+        self.normal_force = np.zeros(capacity)
+        self.state = np.zeros(capacity, np.int8)
+        self.key_a = np.zeros(capacity, np.int64)
+        self.key_b = np.zeros(capacity, np.int64)
+        self.lookup_order = np.zeros(capacity, np.int64)
+        self.chunk_ledger = np.zeros((capacity // C.CHUNK + 2, C.LEDGER_WIDTH))
+
+    def grow_keep_history(self, capacity: int) -> None:
+        """Grow while keeping the current keys and history (for lookups after the rebuild)."""
+        old = (self.history, self.key_a, self.key_b, self.lookup_order, self.count)
+        self.allocate(capacity)
+        history, key_a, key_b, order, count = old
+        self.history[:count] = history[:count]
+        self.key_a[:count] = key_a[:count]
+        self.key_b[:count] = key_b[:count]
+        self.lookup_order[:count] = order[:count]
+        self.count = count
+
+
+class Simulation:
+    """A thermal DEM simulation built from a validated :class:`~thermodem.config.schema.Case`."""
+
+    def __init__(self, case: Case, threads: int | None = None) -> None:
+        if threads is not None:
+            numba.set_num_threads(int(threads))
+        self.case = case
+        sim = case.simulation
+        self.dt = float(sim.time_step)
+        self.time = 0.0
+        self.step_count = 0
+        self.gravity = np.asarray(sim.gravity, np.float64)
+        self.rng = np.random.default_rng(sim.seed)
+        # materials and model tables
+        self.material_names = list(case.materials)
+        self.material_index = {n: k for k, n in enumerate(self.material_names)}
+        self.density = np.array([case.materials[n].density for n in self.material_names])
+        models = case.contact
+        self.model_ids = (
+            models.normal.spec.model_id,
+            models.tangential.spec.model_id,
+            models.rolling.spec.model_id,
+        )
+        self.normal_table = pair_table(models.normal, case, self.material_names)
+        self.tangential_table = pair_table(models.tangential, case, self.material_names)
+        self.rolling_table = pair_table(models.rolling, case, self.material_names)
+        rolling_history = models.rolling.spec.history_width > 0
+        history_width = C.HISTORY_WIDTH_ROLLING if rolling_history else C.HISTORY_WIDTH_BASE
+        with_roll = models.rolling.model != "none"
+        # domain and walls
+        dom = case.domain
+        self.lower = np.asarray(dom.lower, np.float64)
+        self.upper = np.asarray(dom.upper, np.float64)
+        self.periodic = np.asarray(dom.periodic, np.bool_)
+        self.wall_kind, self.wall_rows, self.wall_labels = wall_rows(case.walls,
+                                                                     self.material_index)
+        self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
+        self.wall_reference = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3].copy()
+        # particles
+        self.particles = Particles.empty()
+        self.next_global_id = 0
+        self.pourers: list[Pourer] = []
+        for entry in case.insertion:
+            if entry.kind == "pour":
+                self.pourers.append(Pourer(entry, self.rng))
+            else:
+                self.add_particles(insert(entry, self.rng, self.particles.position,
+                                          self.particles.radius))
+        # neighbour list
+        nb = case.neighbors
+        self.extra = float(nb.extra_distance)
+        self.skin = nb.skin
+        self.rebuild_every_step = nb.rebuild_every_step
+        self.pairs = _PairBuffers(1024, history_width, with_roll)
+        self.walls = _PairBuffers(64, history_width, with_roll)
+        self.row_start = np.zeros(1, np.int64)
+        self.entries = np.zeros(16, np.int64)
+        self.wall_row_start = np.zeros(1, np.int64)
+        self.lookup_start = np.zeros(1, np.int64)
+        self.wall_lookup_start = np.zeros(1, np.int64)
+        self.reference = np.zeros((0, 3))
+        self.rebuild_count = 0
+        self._needs_rebuild = True
+        # ledger
+        self.ledger_cumulative = dict.fromkeys(
+            (*LEDGER_DISSIPATION, "stiffness_work", "wall_work", "inserted_energy"), 0.0
+        )
+        self.elastic = np.zeros(3)
+        self.max_overlap_ratio = 0.0
+        self.contact_count = 0
+        self.callbacks: list[tuple[int, Callable[[Simulation], None]]] = []
+        self._compute_forces(kick=False)
+        self.initial_energy = self.total_energy()
+
+    # ------------------------------------------------------------------ particles in and out
+    def add_particles(self, new: InsertedParticles) -> None:
+        """Append particles of one material; they get fresh global ids."""
+        n = len(new)
+        if n == 0:
+            return
+        t = self.material_index[new.material]
+        temperature = new.temperature
+        if temperature is None:
+            temperature = np.full(n, self.case.simulation.initial_temperature)
+        gids = np.arange(self.next_global_id, self.next_global_id + n, dtype=np.int64)
+        self.next_global_id += n
+        extra = Particles.create(new.position, new.radius, np.full(n, self.density[t]),
+                                 np.full(n, t, np.int32), gids, new.velocity, temperature)
+        if hasattr(self, "ledger_cumulative"):
+            self.ledger_cumulative["inserted_energy"] += float(
+                0.5 * np.sum(extra.mass * np.sum(extra.velocity**2, axis=1))
+                - np.sum(extra.mass * (extra.position @ self.gravity))
+            )
+        self.particles.append(extra)
+        self._needs_rebuild = True
+
+    # ------------------------------------------------------------------------- neighbours
+    def _cell_size(self) -> float:
+        r_max = float(self.particles.radius.max()) if self.particles.count else 0.0
+        if self.skin is None and r_max > 0:
+            self.skin = 0.2 * r_max
+        return 2.0 * r_max + self.extra + (self.skin or 0.0)
+
+    def rebuild(self) -> None:
+        """Sort particles by cell, list pairs and wall pairs, carry history by key."""
+        p = self.particles
+        n = p.count
+        cell = self._cell_size()
+        if n == 0:
+            self.pairs.count = 0
+            self.walls.count = 0
+            self.row_start = np.zeros(1, np.int64)
+            self.wall_row_start = np.zeros(1, np.int64)
+            self.reference = p.position.copy()
+            return
+        length = self.upper - self.lower
+        for a in range(3):
+            if self.periodic[a] and length[a] < 2.0 * cell:
+                raise SimulationError(
+                    f"periodic axis {'xyz'[a]}: domain length {length[a]:.6g} m is shorter than "
+                    f"twice the interaction cut-off {cell:.6g} m (minimum image needs >= "
+                    f"{2 * cell:.6g} m)", self.step_count, self.time)
+        # old keys (global ids) before particles move in memory
+        pb, wb = self.pairs, self.walls
+        dims, edge = NB.cell_grid(self.lower, self.upper, cell, self.periodic)
+        ncell = int(dims[0] * dims[1] * dims[2])
+        order = np.empty(n, np.int64)
+        cell_start = np.zeros(ncell + 1, np.int64)
+        NB.sort_by_cell(p.position, self.lower, edge, dims, order, cell_start)
+        p.permute(order)
+        # particle pairs
+        while True:
+            count = NB.build_pairs(p.position, p.radius, p.global_id, self.lower, self.upper,
+                                   self.periodic, dims, edge, cell_start, self.extra,
+                                   self.skin, pb.i, pb.j)
+            if count <= pb.capacity:
+                break
+            pb.grow_keep_history(int(count * 1.25) + 16)
+        self._carry(pb, count, p.global_id[pb.i[:count]], p.global_id[pb.j[:count]],
+                    "lookup_start")
+        if self.row_start.shape[0] != n + 1:
+            self.row_start = np.zeros(n + 1, np.int64)
+        if self.entries.shape[0] < 2 * pb.capacity:
+            self.entries = np.zeros(2 * pb.capacity, np.int64)
+        NB.particle_pair_csr(pb.i, pb.j, count, p.global_id, n, self.row_start, self.entries)
+        # wall pairs
+        if self.wall_row_start.shape[0] != n + 1:
+            self.wall_row_start = np.zeros(n + 1, np.int64)
+        while True:
+            wcount = NB.build_wall_pairs(p.position, p.radius, self.wall_kind, self.wall_rows,
+                                         self.extra, self.skin, wb.i, wb.j, self.wall_row_start)
+            if wcount <= wb.capacity:
+                break
+            wb.grow_keep_history(int(wcount * 1.25) + 16)
+        self._carry(wb, wcount, p.global_id[wb.i[:wcount]], wb.j[:wcount].astype(np.int64),
+                    "wall_lookup_start")
+        self.reference = p.position.copy()
+        self.wall_reference = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3].copy()
+        self.rebuild_count += 1
+        self._needs_rebuild = False
+
+    def _carry(self, buf: _PairBuffers, count: int, new_a: np.ndarray, new_b: np.ndarray,
+               lookup_attr: str) -> None:
+        old_start = getattr(self, lookup_attr)
+        NB.carry_history(new_a, new_b, count, buf.key_a, buf.key_b, old_start,
+                         buf.lookup_order, buf.history, buf.spare_history)
+        buf.history, buf.spare_history = buf.spare_history, buf.history
+        buf.key_a[:count] = new_a
+        buf.key_b[:count] = new_b
+        buf.count = count
+        nkeys = self.next_global_id
+        new_start = np.zeros(nkeys + 1, np.int64)
+        NB.index_by_first_key(buf.key_a, count, nkeys, new_start, buf.lookup_order)
+        setattr(self, lookup_attr, new_start)
+
+    def _rebuild_due(self) -> bool:
+        if self._needs_rebuild or self.rebuild_every_step:
+            return True
+        moved = NB.max_displacement(self.particles.position, self.reference, self.lower,
+                                    self.upper, self.periodic)
+        wall_moved = 0.0
+        if self.wall_rows.shape[0]:
+            shift = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3] - self.wall_reference
+            wall_moved = float(np.sqrt((shift**2).sum(axis=1)).max())
+        return 2.0 * moved > self.skin or moved + wall_moved > self.skin
+
+    # ------------------------------------------------------------------------------ forces
+    def _compute_forces(self, kick: bool) -> None:
+        if self._rebuild_due():
+            self.rebuild()
+        p = self.particles
+        pb, wb = self.pairs, self.walls
+        nid, tid, rid = self.model_ids
+        C.particle_pair_pass(
+            p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
+            p.type_id, pb.i, pb.j, pb.count, pb.history, self.lower, self.upper, self.periodic,
+            self.extra, self.dt, nid, self.normal_table, tid, self.tangential_table, rid,
+            self.rolling_table, pb.force, pb.lever, pb.roll, pb.dissipation, pb.normal_force,
+            pb.state, pb.chunk_ledger,
+        )
+        C.wall_pair_pass(
+            p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
+            p.type_id, wb.i, wb.j, wb.count, wb.history, self.wall_kind, self.wall_rows,
+            self.wall_material, self.extra, self.dt, nid, self.normal_table, tid,
+            self.tangential_table, rid, self.rolling_table, wb.force, wb.lever, wb.roll,
+            wb.dissipation, wb.normal_force, wb.state, wb.chunk_ledger,
+        )
+        reduce_and_kick(
+            p.radius, p.mass, p.moment_of_inertia, p.velocity, p.angular_velocity, p.force,
+            p.torque, self.gravity, self.dt, self.row_start, self.entries, pb.force, pb.lever,
+            pb.roll, self.wall_row_start, wb.force, wb.lever, wb.roll, kick,
+        )
+        self._accumulate_ledger(kick)
+
+    def _accumulate_ledger(self, count_dissipation: bool) -> None:
+        pb, wb = self.pairs, self.walls
+        npc = (pb.count + C.CHUNK - 1) // C.CHUNK
+        nwc = (wb.count + C.CHUNK - 1) // C.CHUNK
+        sums = sum_rows(pb.chunk_ledger, npc) + sum_rows(wb.chunk_ledger, nwc)
+        self.elastic = sums[C.L_ELASTIC_NORMAL:C.L_ELASTIC_ROLLING + 1].copy()
+        self.contact_count = int(sums[C.L_TOUCHING])
+        self.max_overlap_ratio = max(max_column(pb.chunk_ledger, npc, C.L_MAX_OVERLAP_RATIO),
+                                     max_column(wb.chunk_ledger, nwc, C.L_MAX_OVERLAP_RATIO))
+        if count_dissipation:
+            cum = self.ledger_cumulative
+            cum["normal_damping"] += sums[C.L_NORMAL_DAMPING]
+            cum["tangential_damping"] += sums[C.L_TANGENTIAL_DAMPING]
+            cum["sliding_friction"] += sums[C.L_SLIDING_FRICTION]
+            cum["rolling_friction"] += sums[C.L_ROLLING_FRICTION]
+            cum["stiffness_work"] += sums[C.L_STIFFNESS_WORK]
+            cum["wall_work"] += sums[C.L_WALL_WORK]
+
+    # -------------------------------------------------------------------------------- step
+    def step(self) -> None:
+        """Advance one time step (see the module docstring for the order)."""
+        p = self.particles
+        kick_drift(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
+                   p.moment_of_inertia, self.dt, self.lower, self.upper, self.periodic)
+        self.time = (self.step_count + 1) * self.dt
+        self.step_count += 1
+        if self.wall_rows.shape[0]:
+            self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3] += (
+                self.wall_rows[:, WL.COL_VELOCITY:WL.COL_VELOCITY + 3] * self.dt
+            )
+        for pourer in self.pourers:
+            if pourer.due(self.time, self.dt):
+                self.add_particles(pourer.emit(self.time, self.particles.position,
+                                               self.particles.radius))
+        self._compute_forces(kick=True)
+        self._check()
+
+    def run(self, steps: int | None = None, until: float | None = None,
+            callback: Callable[[Simulation], None] | None = None, every: int = 1) -> None:
+        """Advance ``steps`` steps, or until simulated time ``until`` [s]."""
+        if (steps is None) == (until is None):
+            raise ValueError("give exactly one of steps= or until=")
+        if until is not None:
+            steps = max(0, int(round((until - self.time) / self.dt)))
+        for _ in range(int(steps)):
+            self.step()
+            if callback is not None and self.step_count % every == 0:
+                callback(self)
+
+    def _check(self) -> None:
+        p = self.particles
+        index, code = check_particles(p.position, p.velocity, self.lower, self.upper,
+                                      self.periodic)
+        where = f"at step {self.step_count} (t = {self.time:.6g} s)"
+        if code:
+            gid = int(p.global_id[index])
+            x = p.position[index]
+            v = p.velocity[index]
+            if code == 1:
+                raise SimulationError(
+                    f"non-finite position or velocity of particle {gid} {where}: x = {x}, "
+                    f"v = {v}; likely cause: time step {self.dt:g} s too large for the "
+                    f"contact stiffness (see the Rayleigh and Hertz checks of 'validate')",
+                    self.step_count, self.time, gid)
+            raise SimulationError(
+                f"particle {gid} left the domain {where}: position {x.tolist()} outside "
+                f"[{self.lower.tolist()}, {self.upper.tolist()}], velocity {v.tolist()} m/s",
+                self.step_count, self.time, gid)
+        limit = self.case.simulation.max_overlap_ratio
+        if self.max_overlap_ratio > limit:
+            raise SimulationError(
+                f"overlap of {self.max_overlap_ratio:.3g} × the smaller radius {where} exceeds "
+                f"simulation.max_overlap_ratio = {limit}; likely cause: contact stiffness too "
+                f"low for the loads, or time step {self.dt:g} s too large",
+                self.step_count, self.time)
+
+    # ------------------------------------------------------------------------------ ledger
+    def energies(self) -> dict[str, float]:
+        """Current mechanical energies [J] and cumulative dissipation by mechanism [J]."""
+        p = self.particles
+        ke_t = 0.5 * float(np.sum(p.mass * np.sum(p.velocity**2, axis=1)))
+        ke_r = 0.5 * float(np.sum(p.moment_of_inertia * np.sum(p.angular_velocity**2, axis=1)))
+        grav = -float(np.sum(p.mass * (p.position @ self.gravity)))
+        out = {
+            "kinetic_translational": ke_t,
+            "kinetic_rotational": ke_r,
+            "gravitational": grav,
+            "elastic_normal": float(self.elastic[0]),
+            "elastic_tangential": float(self.elastic[1]),
+            "elastic_rolling": float(self.elastic[2]),
+        }
+        out.update({f"dissipated_{k}": v for k, v in self.ledger_cumulative.items()
+                    if k in LEDGER_DISSIPATION})
+        out["stiffness_work"] = self.ledger_cumulative["stiffness_work"]
+        out["wall_work"] = self.ledger_cumulative["wall_work"]
+        out["inserted_energy"] = self.ledger_cumulative["inserted_energy"]
+        return out
+
+    def total_energy(self) -> float:
+        """Mechanical energy now: kinetic + gravitational + elastic [J]."""
+        e = self.energies()
+        return (e["kinetic_translational"] + e["kinetic_rotational"] + e["gravitational"]
+                + e["elastic_normal"] + e["elastic_tangential"] + e["elastic_rolling"])
+
+    def energy_balance_error(self) -> float:
+        """E(t) + dissipated - stiffness work - wall work - inserted - E(0) [J]; ~0."""
+        e = self.energies()
+        dissipated = sum(e[f"dissipated_{k}"] for k in LEDGER_DISSIPATION)
+        return (self.total_energy() + dissipated - e["stiffness_work"] - e["wall_work"]
+                - e["inserted_energy"] - self.initial_energy)
+
+    # ------------------------------------------------------------------------ pair access
+    def touching_pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global ids (a, b), a < b, of the touching particle pairs."""
+        pb = self.pairs
+        mask = pb.state[: pb.count] == C.STATE_TOUCHING
+        gid = self.particles.global_id
+        return gid[pb.i[: pb.count][mask]], gid[pb.j[: pb.count][mask]]
+
+    def coordination_number(self) -> np.ndarray:
+        """Touching contacts per particle (particle and wall contacts)."""
+        n = self.particles.count
+        pb, wb = self.pairs, self.walls
+        mask = pb.state[: pb.count] == C.STATE_TOUCHING
+        z = np.bincount(pb.i[: pb.count][mask], minlength=n)
+        z += np.bincount(pb.j[: pb.count][mask], minlength=n)
+        wmask = wb.state[: wb.count] == C.STATE_TOUCHING
+        z += np.bincount(wb.i[: wb.count][wmask], minlength=n)
+        return z
+
+    def stable_time_steps(self) -> dict[str, float]:
+        """Rayleigh and Hertz collision times of the current particles (see engine.checks)."""
+        from thermodem.engine.checks import critical_times
+
+        return critical_times(self.case, self.particles.radius, self.particles.type_id,
+                              self.material_names)
+
+

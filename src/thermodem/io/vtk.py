@@ -1,0 +1,448 @@
+"""ParaView output: particles and walls as VTU files, indexed in time by PVD collections.
+
+Recommended layout of an output directory (for whoever writes the run output)::
+
+    out/particles.pvd             # time index of the particle frames (part 0)
+    out/walls.pvd                 # time index of the wall frames (part 0)
+    out/vtk/particles_000042.vtu  # one VTU per output frame
+    out/vtk/walls_000042.vtu
+
+Particles and walls go to *separate* PVD files. A single PVD with two parts would make
+ParaView read every frame as a multiblock dataset, so that filters (Glyph on the particles,
+colouring by a particle field) act on both blocks at once. With two collections the user gets
+two independent pipeline sources. :class:`PVDWriter` nevertheless supports the ``part``
+attribute, so both kinds of frame can share one PVD (particles part 0, walls part 1) if wanted.
+
+The VTU files are written with meshio as uncompressed base64 "binary" XML (``header_type``
+UInt64, so a single array may exceed 4 GiB); they read back with meshio and with VTK's
+``vtkXMLUnstructuredGridReader`` (checked with VTK 9.7: vertex cells, all arrays and dtypes
+intact). Measured on the development machine (2 cores): 200 000 particles with 10 fields
+(6 float64 scalars, 2 float64 vectors, an int64 and an int32 field) take 0.11-0.15 s to write
+(41.6 MB). A hand-written raw-appended VTU took about 0.06 s (29.8 MB) for the same data; not
+worth a second XML writer for now. zlib compression cuts the size by a quarter but takes about
+1 s, which is why it is off by default.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+from thermodem.geometry.wall_layout import (
+    COL_AXIS,
+    COL_HALF_LENGTH,
+    COL_HALF_U,
+    COL_HALF_V,
+    COL_NORMAL,
+    COL_POINT,
+    COL_RADIUS,
+    COL_SIDE,
+    COL_U,
+    CYLINDER,
+    PLANE,
+    RECTANGLE,
+    WALL_WIDTH,
+)
+
+__all__ = [
+    "PART_PARTICLES",
+    "PART_WALLS",
+    "PVDWriter",
+    "wall_surface_mesh",
+    "write_particles_vtu",
+    "write_walls_vtu",
+]
+
+#: ``part`` index of particle frames when particles and walls share one PVD.
+PART_PARTICLES = 0
+#: ``part`` index of wall frames when particles and walls share one PVD.
+PART_WALLS = 1
+
+_VTU_OPTIONS = {"binary": True, "header_type": "UInt64"}
+
+
+# --------------------------------------------------------------------------------------------
+# Arrays
+# --------------------------------------------------------------------------------------------
+
+
+def _as_vtk_array(name: str, value: np.ndarray, n: int, what: str) -> np.ndarray:
+    """Return ``value`` as a contiguous array of ``n`` tuples that VTU can store.
+
+    Booleans become uint8; arrays of more than two dimensions (e.g. (n, 3, 3) tensors) are
+    flattened to (n, k) components; a trailing dimension of 1 is dropped.
+    """
+    a = np.asarray(value)
+    if a.ndim == 0 or a.shape[0] != n:
+        raise ValueError(f"{what} field {name!r} has shape {a.shape}, expected ({n}, ...)")
+    if a.dtype == np.bool_:
+        a = a.astype(np.uint8)
+    elif a.dtype.kind not in "iuf":
+        raise TypeError(f"{what} field {name!r} has unsupported dtype {a.dtype}")
+    if a.ndim > 2:
+        a = a.reshape(n, -1)
+    if a.ndim == 2 and a.shape[1] == 1:
+        a = a[:, 0]
+    # Native byte order and C order: meshio writes ``tobytes()`` of the array.
+    a = a.astype(a.dtype.newbyteorder("="), copy=False)
+    return np.ascontiguousarray(a)
+
+
+def _prepare_path(path: str | os.PathLike[str]) -> Path:
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    return p
+
+
+# --------------------------------------------------------------------------------------------
+# Particles
+# --------------------------------------------------------------------------------------------
+
+
+def write_particles_vtu(
+    path: str | os.PathLike[str],
+    positions: np.ndarray,
+    fields: Mapping[str, np.ndarray] | None = None,
+    *,
+    compression: str | None = None,
+) -> None:
+    """Write particles as a VTU unstructured grid with one vertex cell per particle.
+
+    Parameters
+    ----------
+    path:
+        Output ``.vtu`` file (its directory is created if needed).
+    positions:
+        (N, 3) particle centres.
+    fields:
+        Point data, each of shape (N,) (scalars) or (N, k) (vectors: k = 3); float or integer
+        dtypes are written as they are (float32 stays float32, int32 stays Int32, ...),
+        booleans as uint8, (N, 3, 3) tensors as 9 components.
+    compression:
+        ``None`` (default, fastest) or ``"zlib"`` / ``"lzma"``.
+
+    In ParaView, apply a *Glyph* filter (glyph type Sphere, scale array ``radius``, scale
+    factor 2) or the *Point Gaussian* representation to draw the spheres.
+    """
+    pos = np.ascontiguousarray(positions, dtype=np.float64)
+    if pos.ndim != 2 or pos.shape[1] != 3:
+        raise ValueError(f"positions must have shape (N, 3), got {pos.shape}")
+    n = pos.shape[0]
+    point_data = {
+        name: _as_vtk_array(name, value, n, "particle") for name, value in (fields or {}).items()
+    }
+    cells = [("vertex", np.arange(n, dtype=np.int64).reshape(n, 1))]
+    mesh = meshio.Mesh(pos, cells, point_data=point_data)
+    meshio.write(
+        _prepare_path(path), mesh, file_format="vtu", compression=compression, **_VTU_OPTIONS
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Walls
+# --------------------------------------------------------------------------------------------
+
+
+def _unit(v: np.ndarray, what: str) -> np.ndarray:
+    norm = float(np.linalg.norm(v))
+    if not math.isfinite(norm) or norm == 0.0:
+        raise ValueError(f"wall {what} must be a finite non-zero vector, got {v}")
+    return v / norm
+
+
+def _perpendicular_unit(n: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to the unit vector ``n``."""
+    # Cross with the Cartesian axis least aligned with n: well conditioned.
+    e = np.zeros(3)
+    e[int(np.argmin(np.abs(n)))] = 1.0
+    return _unit(np.cross(n, e), "normal")
+
+
+def _quad_mesh(
+    centre: np.ndarray, u: np.ndarray, v: np.ndarray, hu: float, hv: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Two triangles covering centre + [-hu, hu] u + [-hv, hv] v, oriented along u x v."""
+    points = np.array(
+        [
+            centre - hu * u - hv * v,
+            centre + hu * u - hv * v,
+            centre + hu * u + hv * v,
+            centre - hu * u + hv * v,
+        ]
+    )
+    triangles = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int64)
+    return points, triangles
+
+
+def wall_surface_mesh(
+    kind: int, row: np.ndarray, resolution: int = 48, infinite_extent: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Triangulated surface of one wall, for display.
+
+    Parameters
+    ----------
+    kind:
+        ``PLANE``, ``RECTANGLE`` or ``CYLINDER`` (see :mod:`thermodem.geometry.wall_layout`).
+    row:
+        The wall's parameter row (``WALL_WIDTH`` float64 values).
+    resolution:
+        Number of segments around a cylinder (at least 3).
+    infinite_extent:
+        Half size used for what is unbounded: a plane is drawn as a square of side
+        ``2 * infinite_extent`` centred at its point, a cylinder with infinite half length as a
+        tube of length ``2 * infinite_extent`` centred at its axis point.
+
+    Returns
+    -------
+    points, triangles:
+        (P, 3) float64 vertices and (T, 3) int64 vertex indices. Triangles are oriented
+        (right-hand rule) so that their normal points towards the particles: along the normal
+        for planes and rectangles, towards the axis for a cylinder holding the particles inside
+        (side +1) and away from it otherwise. A cylinder is an open tube (no end caps) whose
+        vertices lie on the circle of the given radius, so its area is that of the inscribed
+        polygonal prism, ``resolution * 2 R sin(pi / resolution) * 2 L``. A rotating cylinder is
+        axisymmetric: its mesh does not change with time.
+    """
+    r = np.asarray(row, dtype=np.float64)
+    if r.shape != (WALL_WIDTH,):
+        raise ValueError(f"wall row must have shape ({WALL_WIDTH},), got {r.shape}")
+    if not (infinite_extent > 0.0 and math.isfinite(infinite_extent)):
+        raise ValueError(f"infinite_extent must be positive and finite, got {infinite_extent}")
+    point = r[COL_POINT : COL_POINT + 3].copy()
+
+    if kind == PLANE:
+        n = _unit(r[COL_NORMAL : COL_NORMAL + 3], "normal")
+        u = _perpendicular_unit(n)
+        v = np.cross(n, u)
+        return _quad_mesh(point, u, v, infinite_extent, infinite_extent)
+
+    if kind == RECTANGLE:
+        n = _unit(r[COL_NORMAL : COL_NORMAL + 3], "normal")
+        u = _unit(r[COL_U : COL_U + 3], "u axis")
+        # Keep u exactly in the plane (it should already be perpendicular to n).
+        u = _unit(u - np.dot(u, n) * n, "u axis (parallel to the normal)")
+        v = np.cross(n, u)
+        hu, hv = float(r[COL_HALF_U]), float(r[COL_HALF_V])
+        if not (hu > 0.0 and hv > 0.0 and math.isfinite(hu) and math.isfinite(hv)):
+            raise ValueError(f"rectangle half extents must be positive and finite: {hu}, {hv}")
+        return _quad_mesh(point, u, v, hu, hv)
+
+    if kind == CYLINDER:
+        if resolution < 3:
+            raise ValueError(f"resolution must be at least 3, got {resolution}")
+        a = _unit(r[COL_AXIS : COL_AXIS + 3], "axis")
+        radius = float(r[COL_RADIUS])
+        if not (radius > 0.0 and math.isfinite(radius)):
+            raise ValueError(f"cylinder radius must be positive and finite, got {radius}")
+        half_length = float(r[COL_HALF_LENGTH])
+        if math.isinf(half_length):
+            half_length = infinite_extent
+        if not half_length > 0.0:
+            raise ValueError(f"cylinder half length must be positive, got {half_length}")
+        e1 = _perpendicular_unit(a)
+        e2 = np.cross(a, e1)  # (e1, e2, a) right-handed
+        theta = 2.0 * np.pi * np.arange(resolution) / resolution
+        ring = radius * (np.cos(theta)[:, None] * e1 + np.sin(theta)[:, None] * e2)
+        bottom = point + ring - half_length * a
+        top = point + ring + half_length * a
+        points = np.concatenate([bottom, top])  # bottom k -> k, top k -> resolution + k
+        k = np.arange(resolution, dtype=np.int64)
+        k1 = (k + 1) % resolution
+        # (bottom k, bottom k+1, top k+1) turns along e_theta then along a: the normal is
+        # e_theta x a = e_r, outwards.
+        outward = np.concatenate(
+            [
+                np.stack([k, k1, resolution + k1], axis=1),
+                np.stack([k, resolution + k1, resolution + k], axis=1),
+            ]
+        )
+        # Interleave so the two triangles of each quad are neighbours.
+        triangles = outward.reshape(2, resolution, 3).transpose(1, 0, 2).reshape(-1, 3)
+        if r[COL_SIDE] > 0.0:  # particles inside: normals towards the axis
+            triangles = triangles[:, ::-1]
+        return points, np.ascontiguousarray(triangles)
+
+    raise ValueError(f"unknown wall kind {kind}")
+
+
+def write_walls_vtu(
+    path: str | os.PathLike[str],
+    kinds: np.ndarray,
+    rows: np.ndarray,
+    fields: Mapping[str, np.ndarray] | None = None,
+    infinite_extent: float = 1.0,
+    *,
+    resolution: int = 48,
+) -> None:
+    """Write all walls as one VTU of triangles.
+
+    Each triangle carries the cell data ``wall_id`` (int32, the wall's row index) and, for
+    every entry of ``fields`` (arrays of shape (W,) or (W, k), e.g. temperature or force
+    magnitude), the value of its wall. With no walls an empty (but valid) grid is written.
+    """
+    kinds = np.asarray(kinds).reshape(-1)
+    rows = np.asarray(rows, dtype=np.float64).reshape(-1, WALL_WIDTH)
+    w = kinds.shape[0]
+    if rows.shape[0] != w:
+        raise ValueError(f"{w} wall kinds but {rows.shape[0]} wall rows")
+    fields = dict(fields or {})
+    if "wall_id" in fields:
+        raise ValueError("'wall_id' is reserved for the wall index")
+    per_wall = {name: _as_vtk_array(name, value, w, "wall") for name, value in fields.items()}
+
+    all_points: list[np.ndarray] = []
+    all_triangles: list[np.ndarray] = []
+    counts = np.zeros(w, dtype=np.int64)
+    offset = 0
+    for i in range(w):
+        pts, tri = wall_surface_mesh(int(kinds[i]), rows[i], resolution, infinite_extent)
+        all_points.append(pts)
+        all_triangles.append(tri + offset)
+        counts[i] = tri.shape[0]
+        offset += pts.shape[0]
+    points = np.concatenate(all_points) if w else np.zeros((0, 3))
+    triangles = np.concatenate(all_triangles) if w else np.zeros((0, 3), dtype=np.int64)
+
+    cell_data = {"wall_id": [np.repeat(np.arange(w, dtype=np.int32), counts)]}
+    for name, value in per_wall.items():
+        cell_data[name] = [np.ascontiguousarray(np.repeat(value, counts, axis=0))]
+    mesh = meshio.Mesh(points, [("triangle", triangles)], cell_data=cell_data)
+    meshio.write(_prepare_path(path), mesh, file_format="vtu", compression=None, **_VTU_OPTIONS)
+
+
+# --------------------------------------------------------------------------------------------
+# PVD time index
+# --------------------------------------------------------------------------------------------
+
+
+class PVDWriter:
+    """Time index (ParaView ``.pvd`` collection) of VTU frames, always valid on disk.
+
+    Every :meth:`add` rewrites the whole file to a temporary file in the same directory and
+    moves it over the old one with :func:`os.replace`, so a run killed at any moment leaves
+    either the previous or the new index, never a truncated one. Write the VTU first, then
+    :meth:`add` it.
+
+    The writer creates (or truncates) the file on construction. To continue a collection after
+    a restart, use :meth:`resume`.
+
+    Entries are kept in the order they are added. Within one ``part`` times must not decrease;
+    adding a time already present for the same part replaces that entry (a restarted run that
+    writes its first frame at the restart time again).
+
+    Recommended: particles and walls in separate collections (both part 0); to put both in one
+    file use ``part=PART_PARTICLES`` and ``part=PART_WALLS``.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        *,
+        fsync: bool = False,
+        _entries: list[tuple[float, int, str]] | None = None,
+    ) -> None:
+        self.path = Path(path)
+        self.fsync = fsync
+        self._entries: list[tuple[float, int, str]] = list(_entries or [])
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._write()
+
+    @classmethod
+    def resume(cls, path: str | os.PathLike[str], time: float, *, fsync: bool = False) -> PVDWriter:
+        """Re-open ``path``, keeping the entries with ``timestep <= time`` (all parts).
+
+        The pruned index is written back at once. A missing file gives an empty collection.
+        The VTU files of dropped entries are left on disk (the restarted run overwrites them).
+        """
+        p = Path(path)
+        entries: list[tuple[float, int, str]] = []
+        if p.exists():
+            for t, part, file in cls.read(p):
+                if t <= time:
+                    entries.append((t, part, file))
+        return cls(p, fsync=fsync, _entries=entries)
+
+    @staticmethod
+    def read(path: str | os.PathLike[str]) -> list[tuple[float, int, str]]:
+        """Entries ``(time, part, file)`` of an existing PVD file, in file order."""
+        root = ET.parse(path).getroot()
+        collection = root.find("Collection")
+        if root.tag != "VTKFile" or root.get("type") != "Collection" or collection is None:
+            raise ValueError(f"{path} is not a VTK collection (.pvd) file")
+        return [
+            (float(ds.get("timestep", "0")), int(ds.get("part", "0")), ds.get("file", ""))
+            for ds in collection.iter("DataSet")
+        ]
+
+    @property
+    def entries(self) -> list[tuple[float, int, str]]:
+        """A copy of the entries ``(time, part, file)``."""
+        return list(self._entries)
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    def add(self, time: float, relative_vtu_path: str | os.PathLike[str], part: int = 0) -> None:
+        """Append a frame and rewrite the index atomically.
+
+        ``relative_vtu_path`` is relative to the PVD's directory (stored with ``/``); an
+        absolute path is converted to a relative one.
+        """
+        time = float(time)
+        if not math.isfinite(time):
+            raise ValueError(f"time must be finite, got {time}")
+        part = int(part)
+        if part < 0:
+            raise ValueError(f"part must be non-negative, got {part}")
+        file = os.fspath(relative_vtu_path)
+        if os.path.isabs(file):
+            file = os.path.relpath(file, os.path.abspath(self.path.parent))
+        file = Path(file).as_posix()
+
+        entries = list(self._entries)
+        same_part = [i for i, (_, q, _) in enumerate(entries) if q == part]
+        if same_part and time <= entries[same_part[-1]][0]:
+            last = entries[same_part[-1]][0]
+            if time < last:
+                raise ValueError(f"time {time!r} precedes the last time {last!r} of part {part}")
+            entries[same_part[-1]] = (time, part, file)
+        else:
+            entries.append((time, part, file))
+        # Only keep the new entry if the file was written (memory and disk stay in step).
+        self._write(entries)
+        self._entries = entries
+
+    def _text(self, entries: list[tuple[float, int, str]]) -> str:
+        lines = [
+            '<?xml version="1.0"?>',
+            '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+            "  <Collection>",
+        ]
+        lines += [
+            f'    <DataSet timestep="{t!r}" group="" part="{part}" file={quoteattr(file)}/>'
+            for t, part, file in entries
+        ]
+        lines += ["  </Collection>", "</VTKFile>", ""]
+        return "\n".join(lines)
+
+    def _write(self, entries: list[tuple[float, int, str]] | None = None) -> None:
+        data = self._text(self._entries if entries is None else entries).encode("utf-8")
+        # A plain open() (not mkstemp) so the file gets the usual umask permissions.
+        tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+        try:
+            with open(tmp, "wb") as f:
+                f.write(data)
+                if self.fsync:
+                    f.flush()
+                    os.fsync(f.fileno())
+            os.replace(tmp, self.path)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise

@@ -1,0 +1,1 @@
+"""Physical models, grouped by family; see :mod:`thermodem.models.registry`."""

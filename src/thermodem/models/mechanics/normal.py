@@ -1,0 +1,176 @@
+"""Normal contact laws (family ``normal``), with damping from the coefficient of restitution.
+
+Kernel signature (all float64)::
+
+    kernel(p, overlap, overlap_rate, eff_radius, eff_mass)
+        -> (force_elastic, force_damping, ref_stiffness, damping_coeff, elastic_energy)
+
+``overlap`` δ > 0 in contact; ``overlap_rate`` dδ/dt > 0 while approaching. Forces are
+positive when repulsive; the damping force is ``damping_coeff * overlap_rate`` so the power it
+dissipates is ``damping_coeff * overlap_rate**2 >= 0``. ``ref_stiffness`` is the stiffness the
+damping coefficient is scaled with (the tangential laws reuse the same damping ratio).
+The normal force is not clipped at zero: a damped contact may pull briefly before it opens,
+which is what makes the restitution coefficient exact (see the docs page).
+
+The damping family of the architecture is folded into this one: the map from the coefficient of
+restitution to a damping coefficient depends on the elastic law, so each law owns it.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+from numba import njit
+from pydantic import Field
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from thermodem.config.base import StrictModel
+from thermodem.models.registry import pad_row, register
+from thermodem.state.materials import PairContext
+
+HERTZ = 1
+LINEAR = 2
+
+
+# ----------------------------------------------------------------------------------- Hertz
+class HertzParams(StrictModel):
+    """Hertz (1882) elastic normal force with the viscous damping of Tsuji, Tanaka & Ishida (1992).
+
+    F = (4/3) E* sqrt(R*) δ^{3/2} + α sqrt(m* (4/3) E* sqrt(R*)) δ^{1/4} dδ/dt
+
+    Tsuji, Y., Tanaka, T., Ishida, T. (1992) Lagrangian numerical simulation of plug flow of
+    cohesionless particles in a horizontal pipe, Powder Technol. 71, 239-250. With damping
+    proportional to δ^{1/4} the restitution coefficient does not depend on the impact velocity
+    (Antypov & Elliott 2011, EPL 94, 50004); α is found here for the requested restitution by
+    integrating the dimensionless contact equation x'' + α x^{1/4} x' + x^{3/2} = 0 and solving
+    e(α) = e_target (so e is reproduced exactly, not through a fitted approximation).
+    No parameters: E*, R*, m* and e come from the materials and the pair.
+    """
+
+
+@lru_cache(maxsize=256)
+def hertz_restitution_of_alpha(alpha: float) -> float:
+    """Restitution of the dimensionless Hertz–Tsuji contact for damping factor α."""
+
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        x = max(y[0], 0.0)
+        return [y[1], -alpha * x**0.25 * y[1] - x**1.5]
+
+    def opened(_t: float, y: np.ndarray) -> float:
+        return y[0]
+
+    opened.terminal = True  # type: ignore[attr-defined]
+    opened.direction = -1  # type: ignore[attr-defined]
+    sol = solve_ivp(rhs, (0.0, 60.0), [0.0, 1.0], events=opened, rtol=1e-11, atol=1e-14,
+                    max_step=0.01)
+    if sol.t_events[0].size == 0:
+        return 0.0
+    return float(-sol.y_events[0][0][1])
+
+
+@lru_cache(maxsize=256)
+def hertz_alpha_of_restitution(restitution: float) -> float:
+    """Damping factor α of the Hertz–Tsuji law that gives the coefficient of restitution e."""
+    if restitution >= 1.0:
+        return 0.0
+    if restitution <= 0.0:
+        restitution = 0.0
+        # smallest α with no rebound: bisect on e(α) > 0
+        lo, hi = 1.0, 4.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            if hertz_restitution_of_alpha(mid) > 0.0:
+                lo = mid
+            else:
+                hi = mid
+        return hi
+    return float(brentq(lambda a: hertz_restitution_of_alpha(a) - restitution, 0.0, 4.0,
+                        xtol=1e-13, rtol=1e-13))
+
+
+def pack_hertz(params: HertzParams, pair: PairContext) -> np.ndarray:
+    return pad_row([pair.effective_youngs_modulus, hertz_alpha_of_restitution(pair.restitution)])
+
+
+@njit(cache=True)
+def hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+    e_star = p[0]
+    alpha = p[1]
+    k_hz = 4.0 / 3.0 * e_star * math.sqrt(eff_radius)
+    root = math.sqrt(overlap)
+    secant = k_hz * root  # F_el / δ
+    f_el = secant * overlap
+    gamma = alpha * math.sqrt(eff_mass * secant)
+    energy = 0.4 * f_el * overlap  # ∫ k δ^{3/2} dδ = (2/5) k δ^{5/2}
+    return f_el, gamma * overlap_rate, secant, gamma, energy
+
+
+# ---------------------------------------------------------------------------------- linear
+class LinearParams(StrictModel):
+    """Linear spring–dashpot: F = k δ + γ dδ/dt (Cundall & Strack 1979).
+
+    γ = 2 ζ sqrt(m* k) with ζ = -ln e / sqrt(π² + ln² e): the exact relation of the damped
+    linear oscillator, so the restitution coefficient equals the input for every impact
+    velocity (contact ends when δ returns to zero). e = 0 gives critical damping (ζ = 1).
+    """
+
+    stiffness: float = Field(gt=0, description="normal spring stiffness k [N/m]")
+
+
+def linear_damping_ratio(restitution: float) -> float:
+    """ζ(e) of the linear spring–dashpot (exact)."""
+    if restitution <= 0.0:
+        return 1.0
+    if restitution >= 1.0:
+        return 0.0
+    log_e = math.log(restitution)
+    return -log_e / math.sqrt(math.pi**2 + log_e**2)
+
+
+def pack_linear(params: LinearParams, pair: PairContext) -> np.ndarray:
+    return pad_row([params.stiffness, linear_damping_ratio(pair.restitution)])
+
+
+@njit(cache=True)
+def linear_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+    k = p[0]
+    gamma = 2.0 * p[1] * math.sqrt(eff_mass * k)
+    return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
+
+
+register(
+    family="normal",
+    name="hertz",
+    model_id=HERTZ,
+    kernel=hertz_force,
+    params=HertzParams,
+    pack=pack_hertz,
+    summary="Hertz elastic force with Tsuji (1992) δ^1/4 damping calibrated to the restitution",
+    reference="Hertz (1882); Tsuji, Tanaka & Ishida (1992) Powder Technol. 71, 239-250",
+    requires=("youngs_modulus", "poisson_ratio", "restitution"),
+)
+register(
+    family="normal",
+    name="linear",
+    model_id=LINEAR,
+    kernel=linear_force,
+    params=LinearParams,
+    pack=pack_linear,
+    summary="linear spring-dashpot with the exact restitution-damping relation",
+    reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
+    requires=("restitution",),
+)
+
+
+# ------------------------------------------------------------------- closed forms (tests, docs)
+def hertz_collision_time(eff_mass: float, eff_radius: float, e_star: float, speed: float) -> float:
+    """Total elastic Hertz collision time, t_c = 2.87 (m*²/(R* E*² v))^{1/5} (spec, appendix A)."""
+    return 2.87 * (eff_mass**2 / (eff_radius * e_star**2 * speed)) ** 0.2
+
+
+def hertz_max_overlap(eff_mass: float, eff_radius: float, e_star: float, speed: float) -> float:
+    """δ_max = (15/16 m* v² / (sqrt(R*) E*))^{2/5} (spec, appendix A)."""
+    return (15.0 / 16.0 * eff_mass * speed**2 / (math.sqrt(eff_radius) * e_star)) ** 0.4

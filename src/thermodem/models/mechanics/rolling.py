@@ -1,0 +1,129 @@
+"""Rolling resistance (family ``rolling``).
+
+Kernel signature (all float64)::
+
+    kernel(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
+           wx, wy, wz, mx, my, mz, dt)
+        -> (tx, ty, tz, mx, my, mz, stiffness, dissipated_energy)
+
+``w`` is the relative angular velocity ω_i - ω_j projected on the tangent plane (rolling, not
+twisting); ``m`` the elastic rolling torque carried as history (rotated into the current plane
+by the caller). Returned: the rolling torque on i (j receives the opposite), the updated history,
+the rolling spring stiffness k_r (stored energy |m|²/(2 k_r); 0 when there is no spring) and the
+energy dissipated this step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from pydantic import Field
+
+from thermodem.config.base import StrictModel
+from thermodem.models.registry import pad_row, register
+from thermodem.state.materials import PairContext
+
+NONE = 0
+CONSTANT_TORQUE = 1
+EPSD = 2
+
+
+class NoneParams(StrictModel):
+    """No rolling resistance."""
+
+
+def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
+    return pad_row([])
+
+
+@njit(cache=True)
+def no_rolling(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
+               wx, wy, wz, mx, my, mz, dt):
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+class ConstantTorqueParams(StrictModel):
+    """Constant directional torque, M = -μ_r R* F_n ω_rel/|ω_rel| (model A of Ai et al. 2011).
+
+    Ai, J., Chen, J.-F., Rotter, J.M., Ooi, J.Y. (2011) Assessment of rolling resistance models
+    in discrete element simulations, Powder Technol. 206, 269-282; after Zhou et al. (1999)
+    Physica A 269, 536-553. μ_r is the pair's rolling friction coefficient. Below
+    ``angular_velocity_threshold`` the torque is zero, which avoids the sign chatter of the
+    model at rest (a known limitation of model A, documented there).
+    """
+
+    angular_velocity_threshold: float = Field(default=1e-9, ge=0, description="[rad/s]")
+
+
+def pack_constant(params: ConstantTorqueParams, pair: PairContext) -> np.ndarray:
+    return pad_row([pair.rolling_friction, params.angular_velocity_threshold])
+
+
+@njit(cache=True)
+def constant_torque(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
+                    wx, wy, wz, mx, my, mz, dt):
+    w = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if w <= p[1] or normal_force <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    mag = p[0] * eff_radius * normal_force
+    return -mag * wx / w, -mag * wy / w, -mag * wz / w, 0.0, 0.0, 0.0, 0.0, mag * w * dt
+
+
+class EPSDParams(StrictModel):
+    """Elastic–plastic spring–dashpot rolling resistance (model C of Ai et al. 2011).
+
+    k_r = 2.25 k_n μ_r² R*², limit |M| ≤ μ_r R* F_n, viscous torque -η_r 2 sqrt(I_r k_r) ω
+    while below the limit (and f η_r of it at the limit, f = ``plastic_damping_factor``).
+    I_r is the pair's rolling inertia [(I_i + m_i R_i²)^-1 + (I_j + m_j R_j²)^-1]^-1.
+    Ai, Chen, Rotter & Ooi (2011) Powder Technol. 206, 269-282; Iwashita & Oda (1998)
+    J. Eng. Mech. 124, 285-292.
+    """
+
+    damping_ratio: float = Field(default=0.3, ge=0, description="η_r [-]")
+    plastic_damping_factor: float = Field(default=0.0, ge=0, le=1, description="f [-]")
+
+
+def pack_epsd(params: EPSDParams, pair: PairContext) -> np.ndarray:
+    return pad_row([pair.rolling_friction, params.damping_ratio, params.plastic_damping_factor])
+
+
+@njit(cache=True)
+def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
+         wx, wy, wz, mx, my, mz, dt):
+    mu_r = p[0]
+    k_r = 2.25 * ref_stiffness * mu_r * mu_r * eff_radius * eff_radius
+    c_r = p[1] * 2.0 * math.sqrt(rolling_inertia * k_r)
+    m_lim = mu_r * eff_radius * max(normal_force, 0.0)
+    # elastic part: incremental rotation of the spring
+    mx -= k_r * wx * dt
+    my -= k_r * wy * dt
+    mz -= k_r * wz * dt
+    trial_energy = 0.5 * (mx * mx + my * my + mz * mz) / k_r if k_r > 0.0 else 0.0
+    m_mag = math.sqrt(mx * mx + my * my + mz * mz)
+    damp = c_r
+    if m_mag > m_lim:
+        scale = m_lim / m_mag if m_mag > 0.0 else 0.0
+        mx *= scale
+        my *= scale
+        mz *= scale
+        damp = p[2] * c_r
+    energy = 0.5 * (mx * mx + my * my + mz * mz) / k_r if k_r > 0.0 else 0.0
+    w2 = wx * wx + wy * wy + wz * wz
+    dissipated = (trial_energy - energy) + damp * w2 * dt
+    return mx - damp * wx, my - damp * wy, mz - damp * wz, mx, my, mz, k_r, dissipated
+
+
+register(family="rolling", name="none", model_id=NONE, kernel=no_rolling, params=NoneParams,
+         pack=pack_none, summary="no rolling resistance", reference="-")
+register(family="rolling", name="constant_torque", model_id=CONSTANT_TORQUE,
+         kernel=constant_torque, params=ConstantTorqueParams, pack=pack_constant,
+         summary="constant directional torque μ_r R* F_n opposing relative rolling",
+         reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model A); Zhou et al. (1999)",
+         requires=("rolling_friction",))
+register(family="rolling", name="epsd", model_id=EPSD, kernel=epsd, params=EPSDParams,
+         pack=pack_epsd,
+         summary="elastic-plastic spring-dashpot rolling torque (model C)",
+         reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model C); Iwashita & Oda (1998)",
+         requires=("rolling_friction",), history_width=3, history_flip=(True, True, True))

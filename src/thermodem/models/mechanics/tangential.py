@@ -1,0 +1,144 @@
+"""Tangential contact laws (family ``tangential``): spring with history and a Coulomb cap.
+
+Kernel signature (all float64)::
+
+    kernel(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
+           vtx, vty, vtz, sx, sy, sz, dt)
+        -> (ftx, fty, ftz, sx, sy, sz, stiffness, damping_power, slip_energy)
+
+``v_t`` is the tangential velocity of i relative to j at the contact point; ``s`` the
+accumulated tangential spring displacement (history), already rotated into the current tangent
+plane by the caller. Returned: the tangential force on i, the updated displacement, the spring
+stiffness k_t (the stored elastic energy is ½ k_t |s|²), the power dissipated by the tangential dashpot and the energy
+released by sliding this step (the spring energy given up when the trial force exceeds the
+Coulomb limit μ max(F_n, 0)). When the cap is reached the displacement is rescaled so that the
+spring plus dashpot force equals the limit (the history is "rescaled when the cap is reached").
+
+The tangential dashpot uses the damping ratio of the normal law: γ_t = γ_n sqrt(k_t / k_n),
+where k_n is the normal law's reference stiffness (Tsuji et al. 1992 use the same α for both
+directions, which is this rule for Hertz–Mindlin).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from pydantic import Field
+
+from thermodem.config.base import StrictModel
+from thermodem.models.registry import pad_row, register
+from thermodem.state.materials import PairContext
+
+NONE = 0
+MINDLIN = 1
+LINEAR = 2
+
+
+@njit(cache=True)
+def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy, sz, dt):
+    """Shared algorithm: incremental spring + dashpot, Coulomb cap with history rescale."""
+    sx += vtx * dt
+    sy += vty * dt
+    sz += vtz * dt
+    fx = -k_t * sx - gamma_t * vtx
+    fy = -k_t * sy - gamma_t * vty
+    fz = -k_t * sz - gamma_t * vtz
+    trial_energy = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
+    f_mag = math.sqrt(fx * fx + fy * fy + fz * fz)
+    f_cap = mu * max(normal_force, 0.0)
+    damping_power = gamma_t * (vtx * vtx + vty * vty + vtz * vtz)
+    if f_mag > f_cap:
+        scale = f_cap / f_mag if f_mag > 0.0 else 0.0
+        fx *= scale
+        fy *= scale
+        fz *= scale
+        damping_power *= scale
+        if k_t > 0.0:
+            sx = -(fx + gamma_t * scale * vtx) / k_t
+            sy = -(fy + gamma_t * scale * vty) / k_t
+            sz = -(fz + gamma_t * scale * vtz) / k_t
+        else:
+            sx = 0.0
+            sy = 0.0
+            sz = 0.0
+    slip_energy = trial_energy - 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
+    return fx, fy, fz, sx, sy, sz, k_t, damping_power, slip_energy
+
+
+# ------------------------------------------------------------------------------------ none
+class NoneParams(StrictModel):
+    """No tangential force (frictionless spheres)."""
+
+
+def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
+    return pad_row([])
+
+
+@njit(cache=True)
+def no_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
+                  vtx, vty, vtz, sx, sy, sz, dt):
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+# --------------------------------------------------------------------------------- Mindlin
+class MindlinParams(StrictModel):
+    """Mindlin (1949) no-slip tangential stiffness k_t = 8 G* sqrt(R* δ) with a Coulomb cap.
+
+    Mindlin, R.D. (1949) Compliance of elastic bodies in contact, J. Appl. Mech. 16, 259-268;
+    the simplified no-slip form as in Di Renzo & Di Maio (2004) Chem. Eng. Sci. 59, 525-541.
+    G* = [(2-ν_i)/G_i + (2-ν_j)/G_j]^-1. Friction μ is the pair's sliding friction.
+    """
+
+
+def pack_mindlin(params: MindlinParams, pair: PairContext) -> np.ndarray:
+    return pad_row([pair.effective_shear_modulus, pair.sliding_friction])
+
+
+@njit(cache=True)
+def mindlin(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
+            vtx, vty, vtz, sx, sy, sz, dt):
+    k_t = 8.0 * p[0] * math.sqrt(eff_radius * overlap)
+    gamma_t = normal_damping * math.sqrt(k_t / ref_stiffness) if ref_stiffness > 0.0 else 0.0
+    return _spring_dashpot_capped(k_t, gamma_t, p[1], normal_force, vtx, vty, vtz, sx, sy, sz, dt)
+
+
+# ---------------------------------------------------------------------------------- linear
+class LinearTangentialParams(StrictModel):
+    """Linear tangential spring k_t = r k_n with a Coulomb cap (Cundall & Strack 1979).
+
+    k_n is the normal law's reference stiffness (the spring constant of the linear law, the
+    secant stiffness of Hertz). The default r = 2/7 makes the tangential and normal oscillation
+    periods of a sphere equal (Schäfer, Dippel & Wolf 1996, J. Phys. I France 6, 5-20).
+    """
+
+    stiffness_ratio: float = Field(default=2.0 / 7.0, gt=0, description="k_t / k_n [-]")
+
+
+def pack_linear(params: LinearTangentialParams, pair: PairContext) -> np.ndarray:
+    return pad_row([params.stiffness_ratio, pair.sliding_friction])
+
+
+@njit(cache=True)
+def linear_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
+                      vtx, vty, vtz, sx, sy, sz, dt):
+    k_t = p[0] * ref_stiffness
+    gamma_t = normal_damping * math.sqrt(p[0])
+    return _spring_dashpot_capped(k_t, gamma_t, p[1], normal_force, vtx, vty, vtz, sx, sy, sz, dt)
+
+
+_COMMON = dict(history_width=3, history_flip=(True, True, True))
+register(family="tangential", name="none", model_id=NONE, kernel=no_tangential,
+         params=NoneParams, pack=pack_none, summary="no tangential force",
+         reference="-", history_width=0, history_flip=())
+register(family="tangential", name="mindlin", model_id=MINDLIN, kernel=mindlin,
+         params=MindlinParams, pack=pack_mindlin,
+         summary="Mindlin no-slip stiffness 8G*sqrt(R*δ), Coulomb cap, history rescaled",
+         reference="Mindlin (1949) J. Appl. Mech. 16, 259-268; Di Renzo & Di Maio (2004)",
+         requires=("youngs_modulus", "poisson_ratio", "sliding_friction"), **_COMMON)
+register(family="tangential", name="linear", model_id=LINEAR, kernel=linear_tangential,
+         params=LinearTangentialParams, pack=pack_linear,
+         summary="linear tangential spring k_t = r k_n, Coulomb cap, history rescaled",
+         reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
+         requires=("sliding_friction",), **_COMMON)

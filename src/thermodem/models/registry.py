@@ -1,0 +1,163 @@
+"""The model registry: the only list of model names in thermodem.
+
+Every physical model is registered once, with :func:`register`, by the module that defines it.
+A model is a small Numba-compiled scalar function (its *kernel*) plus:
+
+- a pydantic parameter schema (SI names, bounds, defaults; the paper cited in its docstring),
+- a ``pack`` function turning the parameters and the two materials that meet into a float64
+  row for that type pair (mixing rules are written there, explicitly),
+- metadata: its integer id inside the family (the fused loops switch on it), history width and
+  which history entries flip sign when i and j swap, the interaction range beyond contact it
+  needs, the material properties it requires, and the reference.
+
+The integer ids are written as constants in the model modules (not assigned at import time) so
+that the compiled dispatchers, which are cached on disk by Numba, never disagree with the
+registry; ``tests/unit/test_registry_conformance.py`` walks the registry and checks that each
+family's dispatcher and each model's own kernel give the same answer.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel
+
+FAMILIES: tuple[str, ...] = (
+    "normal",
+    "tangential",
+    "rolling",
+    "contact_radius",
+    "direct_conduction",
+    "indirect_conduction",
+    "convection",
+    "radiation",
+    "heat_generation",
+    "heat_source",
+)
+
+#: Width of every family's packed parameter row (rows are padded with zeros to this width).
+PARAM_WIDTH = 16
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """Everything thermodem knows about one registered model."""
+
+    family: str
+    name: str
+    model_id: int
+    kernel: Callable[..., Any]
+    params: type[BaseModel]
+    pack: Callable[..., np.ndarray]
+    summary: str
+    reference: str
+    history_width: int = 0
+    history_flip: tuple[bool, ...] = ()
+    requires: tuple[str, ...] = ()
+    interaction_range: Callable[..., float] | None = None
+    antisymmetric: bool = True
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+_REGISTRY: dict[str, dict[str, ModelSpec]] = {f: {} for f in FAMILIES}
+
+
+def register(
+    *,
+    family: str,
+    name: str,
+    model_id: int,
+    kernel: Callable[..., Any],
+    params: type[BaseModel],
+    pack: Callable[..., np.ndarray],
+    summary: str,
+    reference: str,
+    history_width: int = 0,
+    history_flip: tuple[bool, ...] = (),
+    requires: tuple[str, ...] = (),
+    interaction_range: Callable[..., float] | None = None,
+    antisymmetric: bool = True,
+    **extra: Any,
+) -> ModelSpec:
+    """Register a model; the (family, name) and (family, model_id) pairs must be unique."""
+    if family not in _REGISTRY:
+        raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
+    models = _REGISTRY[family]
+    if name in models:
+        raise ValueError(f"model {family}.{name} is registered twice")
+    for other in models.values():
+        if other.model_id == model_id:
+            raise ValueError(
+                f"model id {model_id} of {family}.{name} is already used by {family}.{other.name}"
+            )
+    if len(history_flip) != history_width:
+        raise ValueError(f"{family}.{name}: history_flip must have history_width entries")
+    spec = ModelSpec(
+        family=family,
+        name=name,
+        model_id=model_id,
+        kernel=kernel,
+        params=params,
+        pack=pack,
+        summary=summary,
+        reference=reference,
+        history_width=history_width,
+        history_flip=tuple(history_flip),
+        requires=tuple(requires),
+        interaction_range=interaction_range,
+        antisymmetric=antisymmetric,
+        extra=dict(extra),
+    )
+    models[name] = spec
+    return spec
+
+
+def _ensure_loaded() -> None:
+    # Importing the model packages runs their register() calls.
+    from thermodem.models import mechanics, thermal  # noqa: F401
+
+
+def get(family: str, name: str) -> ModelSpec:
+    """Look up a model, raising a ``KeyError`` whose message suggests close names."""
+    _ensure_loaded()
+    if family not in _REGISTRY:
+        raise KeyError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
+    models = _REGISTRY[family]
+    if name not in models:
+        raise KeyError(unknown_name_message(family, name))
+    return models[name]
+
+
+def names(family: str) -> list[str]:
+    """Registered model names of a family, sorted."""
+    _ensure_loaded()
+    return sorted(_REGISTRY[family])
+
+
+def all_models() -> list[ModelSpec]:
+    """Every registered model, by family then name."""
+    _ensure_loaded()
+    return [_REGISTRY[f][n] for f in FAMILIES for n in sorted(_REGISTRY[f])]
+
+
+def unknown_name_message(family: str, name: str) -> str:
+    """'unknown ... model 'x'; did you mean 'y'? allowed: ...' for error messages."""
+    _ensure_loaded()
+    choices = sorted(_REGISTRY[family])
+    close = difflib.get_close_matches(name, choices, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return f"unknown {family} model {name!r}{hint} allowed: {', '.join(choices)}"
+
+
+def pad_row(values: list[float] | tuple[float, ...] | np.ndarray) -> np.ndarray:
+    """A float64 parameter row of width PARAM_WIDTH from the first values."""
+    row = np.zeros(PARAM_WIDTH, dtype=np.float64)
+    values = np.asarray(values, dtype=np.float64)
+    if values.size > PARAM_WIDTH:
+        raise ValueError(f"parameter row of {values.size} values exceeds {PARAM_WIDTH}")
+    row[: values.size] = values
+    return row

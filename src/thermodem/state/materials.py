@@ -1,0 +1,120 @@
+"""Materials (per type) and the resolved properties of a pair of materials that meet.
+
+A material is a row of properties indexed by ``type_id``; walls have materials too. Every model's
+``pack`` receives a :class:`PairContext`, which holds both materials and the pair-resolved
+mechanical coefficients, and turns them into a float64 parameter row for that type pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pydantic import Field
+
+from thermodem.config.base import StrictModel
+
+
+class Material(StrictModel):
+    """Bulk and surface properties of one particle or wall material (SI units)."""
+
+    density: float = Field(gt=0, description="density [kg/m^3]")
+    youngs_modulus: float = Field(gt=0, description="Young's modulus used by the contact law [Pa]")
+    poisson_ratio: float = Field(gt=-1.0, lt=0.5, description="Poisson ratio [-]")
+    restitution: float = Field(
+        default=0.5, ge=0.0, le=1.0, description="normal coefficient of restitution [-]"
+    )
+    sliding_friction: float = Field(default=0.5, ge=0.0, description="Coulomb coefficient [-]")
+    rolling_friction: float = Field(
+        default=0.0, ge=0.0, description="rolling resistance coefficient [-]"
+    )
+    # Thermal bulk properties (required only when a model that uses them is selected).
+    thermal_conductivity: float | None = Field(default=None, gt=0, description="[W/(m K)]")
+    specific_heat: float | None = Field(default=None, gt=0, description="[J/(kg K)]")
+    emissivity: float | None = Field(default=None, ge=0.0, le=1.0, description="[-]")
+    # Surface properties for the stagnant-gas resistance network (Beaulieu 2020).
+    microhardness: float | None = Field(default=None, gt=0, description="[Pa]")
+    surface_roughness: float | None = Field(default=None, gt=0, description="RMS roughness [m]")
+    surface_slope: float | None = Field(default=None, gt=0, description="RMS asperity slope [-]")
+    thermal_accommodation: float | None = Field(default=None, gt=0, le=1.0, description="[-]")
+    # Real (physical) Young's modulus for low-stiffness corrections of the contact radius.
+    youngs_modulus_real: float | None = Field(default=None, gt=0, description="[Pa]")
+
+    @property
+    def shear_modulus(self) -> float:
+        """G = E / (2 (1 + nu)) [Pa]."""
+        return self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+
+
+class InteractionOverride(StrictModel):
+    """Pair-specific mechanical coefficients that replace the mixing rule for one pair."""
+
+    materials: tuple[str, str]
+    restitution: float | None = Field(default=None, ge=0.0, le=1.0)
+    sliding_friction: float | None = Field(default=None, ge=0.0)
+    rolling_friction: float | None = Field(default=None, ge=0.0)
+
+
+def effective_youngs_modulus(mi: Material, mj: Material, real: bool = False) -> float:
+    """E* = [(1 - nu_i^2)/E_i + (1 - nu_j^2)/E_j]^-1 (spec, appendix A)."""
+    ei = (mi.youngs_modulus_real or mi.youngs_modulus) if real else mi.youngs_modulus
+    ej = (mj.youngs_modulus_real or mj.youngs_modulus) if real else mj.youngs_modulus
+    return 1.0 / ((1.0 - mi.poisson_ratio**2) / ei + (1.0 - mj.poisson_ratio**2) / ej)
+
+
+def effective_shear_modulus(mi: Material, mj: Material) -> float:
+    """G* = [(2 - nu_i)/G_i + (2 - nu_j)/G_j]^-1 (Mindlin; Di Renzo & Di Maio 2004)."""
+    return 1.0 / (
+        (2.0 - mi.poisson_ratio) / mi.shear_modulus + (2.0 - mj.poisson_ratio) / mj.shear_modulus
+    )
+
+
+@dataclass(frozen=True)
+class PairContext:
+    """The two materials that meet and their pair-resolved coefficients.
+
+    Mixing rule (when no ``interactions`` override names the pair): the arithmetic mean of the
+    two materials' restitution, sliding and rolling friction coefficients. For a particle-wall
+    pair ``mat_j`` is the wall material and ``is_wall`` is true (the wall is a body of infinite
+    radius and mass).
+    """
+
+    mat_i: Material
+    mat_j: Material
+    restitution: float
+    sliding_friction: float
+    rolling_friction: float
+    is_wall: bool = False
+    gas: object | None = None
+
+    @property
+    def effective_youngs_modulus(self) -> float:
+        return effective_youngs_modulus(self.mat_i, self.mat_j)
+
+    @property
+    def effective_shear_modulus(self) -> float:
+        return effective_shear_modulus(self.mat_i, self.mat_j)
+
+
+def resolve_pair(
+    mi: Material,
+    mj: Material,
+    override: InteractionOverride | None = None,
+    is_wall: bool = False,
+    gas: object | None = None,
+) -> PairContext:
+    """Pair coefficients from the mixing rule, replaced where an override gives them."""
+
+    def pick(attr: str) -> float:
+        if override is not None and getattr(override, attr) is not None:
+            return float(getattr(override, attr))
+        return 0.5 * (getattr(mi, attr) + getattr(mj, attr))
+
+    return PairContext(
+        mat_i=mi,
+        mat_j=mj,
+        restitution=pick("restitution"),
+        sliding_friction=pick("sliding_friction"),
+        rolling_friction=pick("rolling_friction"),
+        is_wall=is_wall,
+        gas=gas,
+    )

@@ -1,0 +1,99 @@
+"""Particle state as a structure of arrays.
+
+Every per-particle quantity is a contiguous NumPy array with the particle as first index.
+``global_id`` is the stable identity of a particle (history keys, restarts, output); the array
+order changes when the neighbour list sorts particles by cell. ``heat_rate_by_mechanism`` has
+one column per heat transfer mechanism (:data:`HEAT_MECHANISMS`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+#: Columns of ``heat_rate_by_mechanism`` [W].
+HEAT_MECHANISMS: tuple[str, ...] = (
+    "direct_conduction",
+    "indirect_conduction",
+    "convection",
+    "radiation",
+    "generation",
+    "source",
+    "wall",
+)
+
+
+@dataclass
+class Particles:
+    """Per-particle arrays (SI units)."""
+
+    position: np.ndarray  # (n, 3) [m]
+    velocity: np.ndarray  # (n, 3) [m/s]
+    angular_velocity: np.ndarray  # (n, 3) [rad/s]
+    force: np.ndarray  # (n, 3) [N]
+    torque: np.ndarray  # (n, 3) [N m]
+    radius: np.ndarray  # (n,) [m]
+    mass: np.ndarray  # (n,) [kg]
+    moment_of_inertia: np.ndarray  # (n,) [kg m^2]
+    temperature: np.ndarray  # (n,) [K]
+    heat_rate: np.ndarray  # (n,) [W]
+    heat_rate_by_mechanism: np.ndarray  # (n, len(HEAT_MECHANISMS)) [W]
+    type_id: np.ndarray  # (n,) int32, index into the material table
+    global_id: np.ndarray  # (n,) int64, stable identity
+
+    @property
+    def count(self) -> int:
+        return int(self.radius.shape[0])
+
+    @classmethod
+    def empty(cls) -> Particles:
+        return cls.create(np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0, np.int32),
+                          np.zeros(0, np.int64))
+
+    @classmethod
+    def create(
+        cls,
+        position: np.ndarray,
+        radius: np.ndarray,
+        density: np.ndarray,
+        type_id: np.ndarray,
+        global_id: np.ndarray,
+        velocity: np.ndarray | None = None,
+        temperature: np.ndarray | None = None,
+    ) -> Particles:
+        """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R²."""
+        n = radius.shape[0]
+        radius = np.ascontiguousarray(radius, dtype=np.float64)
+        mass = np.asarray(density, dtype=np.float64) * (4.0 / 3.0) * np.pi * radius**3
+        return cls(
+            position=np.ascontiguousarray(position, dtype=np.float64).reshape(n, 3),
+            velocity=np.zeros((n, 3))
+            if velocity is None
+            else np.ascontiguousarray(velocity, dtype=np.float64).reshape(n, 3),
+            angular_velocity=np.zeros((n, 3)),
+            force=np.zeros((n, 3)),
+            torque=np.zeros((n, 3)),
+            radius=radius,
+            mass=mass,
+            moment_of_inertia=0.4 * mass * radius**2,
+            temperature=np.zeros(n)
+            if temperature is None
+            else np.ascontiguousarray(temperature, dtype=np.float64),
+            heat_rate=np.zeros(n),
+            heat_rate_by_mechanism=np.zeros((n, len(HEAT_MECHANISMS))),
+            type_id=np.ascontiguousarray(type_id, dtype=np.int32),
+            global_id=np.ascontiguousarray(global_id, dtype=np.int64),
+        )
+
+    def permute(self, order: np.ndarray) -> None:
+        """Reorder every array so that new index k holds old particle order[k]."""
+        for f in fields(self):
+            setattr(self, f.name, np.ascontiguousarray(getattr(self, f.name)[order]))
+
+    def append(self, other: Particles) -> None:
+        for f in fields(self):
+            setattr(self, f.name, np.concatenate([getattr(self, f.name), getattr(other, f.name)]))
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
