@@ -1,0 +1,552 @@
+"""Case-file section ``insertion``: where particles come from (SI units throughout).
+
+The section is a list of entries, each selected by its ``kind``:
+
+``lattice``
+    A regular grid of sites filling an axis-aligned box, given by a spacing or a count per axis,
+    optionally jittered.
+``random_box`` / ``random_cylinder``
+    Random sequential addition of non-overlapping spheres inside a box or a cylinder.
+``pour``
+    A continuous feed: batches of particles are inserted into a box or cylinder region at a fixed
+    interval, at a given rate [particles/s], between a start and an end time.
+``file``
+    Positions and radii (optionally velocities and temperatures) read from a text/CSV file.
+
+Every entry names a ``material`` (a key of the case's ``materials`` section) and, except ``file``,
+a radius ``distribution`` (selected by its own ``kind``: ``mono``, ``uniform``,
+``truncated_normal``, ``lognormal`` or ``discrete``). Entries may also set an initial
+``velocity`` [m/s] and ``temperature`` [K]; when ``temperature`` is omitted the engine applies
+its default initial temperature.
+
+The algorithms live in :mod:`thermodem.geometry.insertion`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import (
+    Field,
+    FiniteFloat,
+    PositiveInt,
+    TypeAdapter,
+    field_validator,
+    model_validator,
+)
+from scipy.special import ndtr
+
+from thermodem.config.base import StrictModel
+
+Vec3 = tuple[FiniteFloat, FiniteFloat, FiniteFloat]
+"""Three finite floats (a point or a vector) [m] or [m/s]."""
+
+PositiveLength = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+"""A strictly positive, finite length [m]."""
+
+_AXES = ("x", "y", "z")
+
+FRACTION_SUM_TOLERANCE = 1e-9
+"""Allowed deviation of the sum of discrete fractions from 1."""
+
+
+def _check_box(lower: Vec3, upper: Vec3, what: str = "region") -> None:
+    """Raise ValueError unless ``lower < upper`` on every axis."""
+    for axis, lo, hi in zip(_AXES, lower, upper, strict=True):
+        if not lo < hi:
+            raise ValueError(
+                f"{what}: lower corner must be < upper corner on every axis, but on the "
+                f"{axis} axis lower={lo!r} and upper={hi!r}"
+            )
+
+
+def _normalise_axis(value: Vec3) -> Vec3:
+    """Return ``value`` scaled to unit length; a zero vector is an error."""
+    norm = math.sqrt(sum(c * c for c in value))
+    if not norm > 1e-300:
+        raise ValueError(f"axis must be a non-zero vector, got {tuple(value)!r}")
+    return (value[0] / norm, value[1] / norm, value[2] / norm)
+
+
+# --------------------------------------------------------------------------------------------
+# Radius distributions
+# --------------------------------------------------------------------------------------------
+
+
+class MonoRadius(StrictModel):
+    """Every particle has the same radius."""
+
+    kind: Literal["mono"] = "mono"
+    radius: PositiveLength = Field(description="particle radius [m]")
+
+    @property
+    def max_radius_bound(self) -> float:
+        """Largest radius the distribution can produce [m]."""
+        return self.radius
+
+
+class UniformRadius(StrictModel):
+    """Radius uniformly distributed (by number) on ``[min_radius, max_radius]``."""
+
+    kind: Literal["uniform"] = "uniform"
+    min_radius: PositiveLength = Field(description="smallest radius [m]")
+    max_radius: PositiveLength = Field(description="largest radius [m]")
+
+    @model_validator(mode="after")
+    def _check_bounds(self) -> UniformRadius:
+        if not self.min_radius <= self.max_radius:
+            raise ValueError(
+                f"uniform radius distribution: min_radius={self.min_radius!r} must be <= "
+                f"max_radius={self.max_radius!r}"
+            )
+        return self
+
+    @property
+    def max_radius_bound(self) -> float:
+        """Largest radius the distribution can produce [m]."""
+        return self.max_radius
+
+
+def _normal_interval_mass(alpha: float, beta: float) -> float:
+    """Probability of a standard normal variable in ``[alpha, beta]``, accurate in the tails."""
+    if alpha > 0.0:
+        alpha, beta = -beta, -alpha
+    return float(ndtr(beta) - ndtr(alpha))
+
+
+class TruncatedNormalRadius(StrictModel):
+    """Normal distribution (by number) truncated to ``[min_radius, max_radius]``.
+
+    ``mean`` and ``std`` are the parameters of the parent (untruncated) normal distribution; the
+    mean and standard deviation of the truncated distribution differ unless the truncation is far
+    in the tails.
+    """
+
+    kind: Literal["truncated_normal"] = "truncated_normal"
+    mean: PositiveLength = Field(description="mean of the parent normal distribution [m]")
+    std: PositiveLength = Field(description="standard deviation of the parent normal [m]")
+    min_radius: PositiveLength = Field(description="lower truncation radius [m]")
+    max_radius: PositiveLength = Field(description="upper truncation radius [m]")
+
+    @model_validator(mode="after")
+    def _check_bounds(self) -> TruncatedNormalRadius:
+        if not self.min_radius < self.max_radius:
+            raise ValueError(
+                f"truncated_normal radius distribution: min_radius={self.min_radius!r} must be "
+                f"< max_radius={self.max_radius!r}"
+            )
+        alpha = (self.min_radius - self.mean) / self.std
+        beta = (self.max_radius - self.mean) / self.std
+        if not _normal_interval_mass(alpha, beta) > 0.0:
+            raise ValueError(
+                f"truncated_normal radius distribution: the interval [{self.min_radius!r}, "
+                f"{self.max_radius!r}] lies so far in the tail of N(mean={self.mean!r}, "
+                f"std={self.std!r}) that it has zero probability; move the bounds towards the "
+                "mean or increase std"
+            )
+        return self
+
+    @property
+    def max_radius_bound(self) -> float:
+        """Largest radius the distribution can produce [m]."""
+        return self.max_radius
+
+
+class LognormalRadius(StrictModel):
+    """Log-normal distribution (by number): ``ln r`` is normal with standard deviation ``sigma``.
+
+    Give exactly one of ``median`` (= exp(mu)) or ``mean`` (= exp(mu + sigma^2/2)) of the
+    untruncated distribution. ``min_radius``/``max_radius`` optionally truncate it.
+    """
+
+    kind: Literal["lognormal"] = "lognormal"
+    median: PositiveLength | None = Field(default=None, description="median radius [m]")
+    mean: PositiveLength | None = Field(
+        default=None, description="mean radius of the untruncated distribution [m]"
+    )
+    sigma: float = Field(gt=0, allow_inf_nan=False, description="standard deviation of ln r [-]")
+    min_radius: PositiveLength | None = Field(default=None, description="lower truncation [m]")
+    max_radius: PositiveLength | None = Field(default=None, description="upper truncation [m]")
+
+    @model_validator(mode="after")
+    def _check(self) -> LognormalRadius:
+        if (self.median is None) == (self.mean is None):
+            raise ValueError(
+                "lognormal radius distribution: give exactly one of 'median' or 'mean', got "
+                f"median={self.median!r} and mean={self.mean!r}"
+            )
+        if (
+            self.min_radius is not None
+            and self.max_radius is not None
+            and not self.min_radius < self.max_radius
+        ):
+            raise ValueError(
+                f"lognormal radius distribution: min_radius={self.min_radius!r} must be < "
+                f"max_radius={self.max_radius!r}"
+            )
+        alpha = -math.inf if self.min_radius is None else (math.log(self.min_radius) - self.mu)
+        beta = math.inf if self.max_radius is None else (math.log(self.max_radius) - self.mu)
+        if not _normal_interval_mass(alpha / self.sigma, beta / self.sigma) > 0.0:
+            raise ValueError(
+                f"lognormal radius distribution: the truncation interval [{self.min_radius!r}, "
+                f"{self.max_radius!r}] has zero probability for median={math.exp(self.mu)!r} "
+                f"and sigma={self.sigma!r}; move the bounds towards the median"
+            )
+        return self
+
+    @property
+    def mu(self) -> float:
+        """Mean of ``ln r`` of the untruncated distribution."""
+        if self.median is not None:
+            return math.log(self.median)
+        assert self.mean is not None
+        return math.log(self.mean) - 0.5 * self.sigma**2
+
+    @property
+    def max_radius_bound(self) -> float | None:
+        """Largest radius the distribution can produce [m] (None: unbounded)."""
+        return self.max_radius
+
+
+class DiscreteRadius(StrictModel):
+    """A finite set of radii with the fraction of each, by number or by mass.
+
+    With ``fraction_basis: mass`` the fractions are mass fractions; since every particle of an
+    entry has the same material, a particle's mass is proportional to r^3 and the number
+    fractions are ``n_i = (w_i / r_i^3) / sum_j (w_j / r_j^3)``.
+    """
+
+    kind: Literal["discrete"] = "discrete"
+    radii: list[PositiveLength] = Field(min_length=1, description="the radii [m]")
+    fractions: list[Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]] = Field(
+        min_length=1, description="fraction of each radius [-], summing to 1"
+    )
+    fraction_basis: Literal["number", "mass"] = Field(
+        default="number", description="whether fractions are by particle number or by mass"
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> DiscreteRadius:
+        if len(self.radii) != len(self.fractions):
+            raise ValueError(
+                f"discrete radius distribution: radii has {len(self.radii)} entries but "
+                f"fractions has {len(self.fractions)}; give one fraction per radius"
+            )
+        total = math.fsum(self.fractions)
+        if abs(total - 1.0) > FRACTION_SUM_TOLERANCE:
+            raise ValueError(
+                f"discrete radius distribution: fractions {self.fractions!r} sum to {total!r}; "
+                f"they must sum to 1 (within {FRACTION_SUM_TOLERANCE:g})"
+            )
+        return self
+
+    def number_fractions(self) -> np.ndarray:
+        """Fraction by number of each radius (converted from mass fractions if needed)."""
+        w = np.asarray(self.fractions, dtype=np.float64)
+        if self.fraction_basis == "mass":
+            w = w / np.asarray(self.radii, dtype=np.float64) ** 3
+        return w / w.sum()
+
+    @property
+    def max_radius_bound(self) -> float:
+        """Largest radius the distribution can produce [m] (only radii with nonzero fraction)."""
+        return max(r for r, f in zip(self.radii, self.fractions, strict=True) if f > 0)
+
+
+RadiusDistribution = Annotated[
+    MonoRadius | UniformRadius | TruncatedNormalRadius | LognormalRadius | DiscreteRadius,
+    Field(discriminator="kind"),
+]
+"""One radius distribution, selected by ``kind``."""
+
+
+# --------------------------------------------------------------------------------------------
+# Regions (used by ``pour``)
+# --------------------------------------------------------------------------------------------
+
+
+class BoxRegion(StrictModel):
+    """Axis-aligned box between ``lower`` and ``upper`` corners [m]."""
+
+    kind: Literal["box"] = "box"
+    lower: Vec3 = Field(description="lower corner (x, y, z) [m]")
+    upper: Vec3 = Field(description="upper corner (x, y, z) [m]")
+
+    @model_validator(mode="after")
+    def _check(self) -> BoxRegion:
+        _check_box(self.lower, self.upper, "box region")
+        return self
+
+
+class CylinderRegion(StrictModel):
+    """Solid cylinder from ``base_centre`` along the unit ``axis`` over ``length`` [m].
+
+    ``axis`` is normalised on validation (it must be non-zero).
+    """
+
+    kind: Literal["cylinder"] = "cylinder"
+    base_centre: Vec3 = Field(description="centre of the base disc [m]")
+    axis: Vec3 = Field(description="direction from the base to the top (normalised) [-]")
+    radius: PositiveLength = Field(description="cylinder radius [m]")
+    length: PositiveLength = Field(description="cylinder length along the axis [m]")
+
+    @field_validator("axis")
+    @classmethod
+    def _unit_axis(cls, value: Vec3) -> Vec3:
+        return _normalise_axis(value)
+
+
+Region = Annotated[BoxRegion | CylinderRegion, Field(discriminator="kind")]
+"""A box or cylinder region, selected by ``kind``."""
+
+
+# --------------------------------------------------------------------------------------------
+# Insertion entries
+# --------------------------------------------------------------------------------------------
+
+
+class _EntryBase(StrictModel):
+    """Fields shared by every insertion entry."""
+
+    material: str = Field(min_length=1, description="name of a material in 'materials'")
+    velocity: Vec3 = Field(default=(0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    temperature: float | None = Field(
+        default=None,
+        gt=0,
+        allow_inf_nan=False,
+        description="initial temperature [K]; None: the engine's default initial temperature",
+    )
+
+
+class LatticeInsertion(_EntryBase):
+    """A regular lattice of sites filling the box ``[lower, upper]``.
+
+    Give exactly one of ``spacing`` (centre-to-centre distance, one value or one per axis) or
+    ``count`` (number of sites per axis). Sites keep a margin of ``r_max + jitter`` from every
+    face, where ``r_max`` is the distribution's largest radius, so every particle lies fully in
+    the box; with ``spacing`` the lattice is centred in the box. ``jitter`` displaces each site
+    by a uniform random amount in ``[-jitter, jitter]`` per axis; the spacing must be at least
+    ``2 (r_max + jitter)`` so that no two particles overlap. Sites that would overlap an
+    existing particle are skipped.
+    """
+
+    kind: Literal["lattice"] = "lattice"
+    distribution: RadiusDistribution
+    lower: Vec3 = Field(description="lower corner of the box (x, y, z) [m]")
+    upper: Vec3 = Field(description="upper corner of the box (x, y, z) [m]")
+    spacing: PositiveLength | tuple[PositiveLength, PositiveLength, PositiveLength] | None = Field(
+        default=None, description="site spacing, one value or one per axis [m]"
+    )
+    count: tuple[PositiveInt, PositiveInt, PositiveInt] | None = Field(
+        default=None, description="number of sites along x, y and z"
+    )
+    jitter: float = Field(
+        default=0.0, ge=0, allow_inf_nan=False, description="maximum random displacement [m]"
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> LatticeInsertion:
+        _check_box(self.lower, self.upper, "lattice insertion")
+        if (self.spacing is None) == (self.count is None):
+            raise ValueError(
+                "lattice insertion: give exactly one of 'spacing' or 'count', got "
+                f"spacing={self.spacing!r} and count={self.count!r}"
+            )
+        r_max = self.distribution.max_radius_bound
+        if r_max is None:
+            raise ValueError(
+                "lattice insertion needs a bounded radius distribution: set max_radius on the "
+                f"{self.distribution.kind} distribution"
+            )
+        margin = r_max + self.jitter
+        for a, axis in enumerate(_AXES):
+            extent = self.upper[a] - self.lower[a]
+            if extent < 2.0 * margin:
+                raise ValueError(
+                    f"lattice insertion: the box is {extent!r} m wide along {axis}, smaller than "
+                    f"2 (r_max + jitter) = {2.0 * margin!r} m; enlarge the box or reduce the "
+                    "radius or jitter"
+                )
+            spacing = self.axis_spacing(a)
+            if spacing is not None and spacing < 2.0 * margin * (1.0 - 1e-12):
+                raise ValueError(
+                    f"lattice insertion: spacing along {axis} is {spacing!r} m but must be at "
+                    f"least 2 (r_max + jitter) = {2.0 * margin!r} m so particles do not overlap; "
+                    "increase the spacing, reduce count, or reduce the radius or jitter"
+                )
+        return self
+
+    @property
+    def region(self) -> BoxRegion:
+        """The lattice box as a :class:`BoxRegion`."""
+        return BoxRegion(lower=self.lower, upper=self.upper)
+
+    def axis_spacing(self, axis: int) -> float | None:
+        """Site spacing along ``axis`` (0, 1, 2) [m]; None if there is a single site on it."""
+        if self.spacing is not None:
+            return float(self.spacing if isinstance(self.spacing, float) else self.spacing[axis])
+        assert self.count is not None
+        n = self.count[axis]
+        if n == 1:
+            return None
+        r_max = self.distribution.max_radius_bound
+        assert r_max is not None
+        span = self.upper[axis] - self.lower[axis] - 2.0 * (r_max + self.jitter)
+        return span / (n - 1)
+
+
+class RandomBoxInsertion(_EntryBase):
+    """Random sequential addition of non-overlapping spheres inside the box ``[lower, upper]``.
+
+    Give exactly one of ``count`` or ``volume_fraction`` (radii are drawn until the summed sphere
+    volume reaches ``volume_fraction`` times the box volume). Random sequential addition of
+    equal spheres jams near a volume fraction of 0.38 (less near walls); denser packings need a
+    compaction stage. ``max_attempts`` is the number of candidate positions tried for one
+    particle before the insertion fails.
+    """
+
+    kind: Literal["random_box"] = "random_box"
+    distribution: RadiusDistribution
+    lower: Vec3 = Field(description="lower corner of the box (x, y, z) [m]")
+    upper: Vec3 = Field(description="upper corner of the box (x, y, z) [m]")
+    count: PositiveInt | None = Field(default=None, description="number of particles")
+    volume_fraction: float | None = Field(
+        default=None, gt=0, lt=0.74, description="solid volume fraction of the box [-]"
+    )
+    max_attempts: PositiveInt = Field(
+        default=1000, description="candidate positions tried per particle before giving up"
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> RandomBoxInsertion:
+        _check_box(self.lower, self.upper, "random_box insertion")
+        if (self.count is None) == (self.volume_fraction is None):
+            raise ValueError(
+                "random_box insertion: give exactly one of 'count' or 'volume_fraction', got "
+                f"count={self.count!r} and volume_fraction={self.volume_fraction!r}"
+            )
+        return self
+
+    @property
+    def region(self) -> BoxRegion:
+        """The box as a :class:`BoxRegion`."""
+        return BoxRegion(lower=self.lower, upper=self.upper)
+
+
+class RandomCylinderInsertion(_EntryBase):
+    """Random sequential addition of ``count`` non-overlapping spheres inside a cylinder.
+
+    The cylinder starts at ``base_centre`` and extends ``length`` along the unit ``axis``
+    (normalised on validation).
+    """
+
+    kind: Literal["random_cylinder"] = "random_cylinder"
+    distribution: RadiusDistribution
+    base_centre: Vec3 = Field(description="centre of the base disc [m]")
+    axis: Vec3 = Field(description="direction from the base to the top (normalised) [-]")
+    radius: PositiveLength = Field(description="cylinder radius [m]")
+    length: PositiveLength = Field(description="cylinder length along the axis [m]")
+    count: PositiveInt = Field(description="number of particles")
+    max_attempts: PositiveInt = Field(
+        default=1000, description="candidate positions tried per particle before giving up"
+    )
+
+    @field_validator("axis")
+    @classmethod
+    def _unit_axis(cls, value: Vec3) -> Vec3:
+        return _normalise_axis(value)
+
+    @property
+    def region(self) -> CylinderRegion:
+        """The cylinder as a :class:`CylinderRegion`."""
+        return CylinderRegion(
+            base_centre=self.base_centre, axis=self.axis, radius=self.radius, length=self.length
+        )
+
+
+class PourInsertion(_EntryBase):
+    """A continuous feed of particles into a box or cylinder ``region``.
+
+    From ``start_time`` to ``end_time`` (None: until the run ends), every ``interval`` seconds a
+    batch is inserted containing the particles due since the previous batch, so that after time
+    ``t`` a total of ``floor(rate (t - start_time))`` particles has been requested. Each batch is
+    placed by random sequential addition without overlapping particles already in the region or
+    each other; particles that cannot be placed in ``max_attempts`` tries are skipped with a
+    warning (they are not carried over to the next batch).
+    """
+
+    kind: Literal["pour"] = "pour"
+    distribution: RadiusDistribution
+    region: Region
+    rate: float = Field(gt=0, allow_inf_nan=False, description="particles per second [1/s]")
+    start_time: float = Field(default=0.0, ge=0, allow_inf_nan=False, description="[s]")
+    end_time: float | None = Field(default=None, allow_inf_nan=False, description="[s]")
+    interval: float = Field(gt=0, allow_inf_nan=False, description="time between batches [s]")
+    max_attempts: PositiveInt = Field(
+        default=200, description="candidate positions tried per particle before skipping it"
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> PourInsertion:
+        if self.end_time is not None and not self.end_time > self.start_time:
+            raise ValueError(
+                f"pour insertion: end_time={self.end_time!r} must be > "
+                f"start_time={self.start_time!r} (or omitted to pour until the end of the run)"
+            )
+        return self
+
+
+class FileInsertion(_EntryBase):
+    """Particles read from a whitespace- or comma-separated text file.
+
+    The first non-blank line is a header naming the columns (a leading ``#`` is allowed):
+    ``x y z radius`` are required; ``vx vy vz`` (all three) and ``temperature`` are optional
+    and override the entry's ``velocity``/``temperature``. Later lines starting with ``#`` are
+    comments. A relative ``path`` is resolved by the caller (normally against the case file's
+    directory). Positions are taken as given: overlaps are not checked.
+    """
+
+    kind: Literal["file"] = "file"
+    path: Path = Field(description="path of the particle file")
+
+
+InsertionEntry = Annotated[
+    LatticeInsertion | RandomBoxInsertion | RandomCylinderInsertion | PourInsertion | FileInsertion,
+    Field(discriminator="kind"),
+]
+"""One entry of the ``insertion`` section, selected by ``kind``."""
+
+InsertionSection = list[InsertionEntry]
+"""The ``insertion`` section: a list of entries."""
+
+_SECTION_ADAPTER: TypeAdapter[list[Any]] = TypeAdapter(InsertionSection)
+
+
+def parse_insertion_section(data: Any) -> list[Any]:
+    """Validate the raw ``insertion`` section (a list of mappings) into entry models."""
+    return _SECTION_ADAPTER.validate_python(data)
+
+
+__all__ = [
+    "BoxRegion",
+    "CylinderRegion",
+    "DiscreteRadius",
+    "FileInsertion",
+    "InsertionEntry",
+    "InsertionSection",
+    "LatticeInsertion",
+    "LognormalRadius",
+    "MonoRadius",
+    "PourInsertion",
+    "RadiusDistribution",
+    "RandomBoxInsertion",
+    "RandomCylinderInsertion",
+    "Region",
+    "TruncatedNormalRadius",
+    "UniformRadius",
+    "parse_insertion_section",
+    "Vec3",
+]
