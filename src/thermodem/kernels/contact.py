@@ -64,7 +64,7 @@ STATE_NEAR = 1
 STATE_TOUCHING = 2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rotate_into_plane(h, k, c0, nx, ny, nz):
     """Project the 3-vector h[k, c0:c0+3] onto the plane normal to n, keeping its length."""
     ax = h[k, c0]
@@ -84,7 +84,7 @@ def _rotate_into_plane(h, k, c0, nx, ny, nz):
     return 0.0, 0.0, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def contact_response(
     k, history, nx, ny, nz, overlap, eff_radius, eff_mass, rolling_inertia,
     vrx, vry, vrz, wrx, wry, wrz, dt,
@@ -179,7 +179,7 @@ def contact_response(
     return f_n, ftx, fty, ftz, tx, ty, tz
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _clear_contact(k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
                    ledger_row):
     # energy left in springs when a contact opens is released as friction (documented)
@@ -199,7 +199,7 @@ def _clear_contact(k, history, out_force, out_lever, out_roll, out_diss, out_nor
     out_normal_force[k] = 0.0
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def particle_pair_pass(
     position, velocity, angular_velocity, radius, mass, inertia, type_id,
     pair_i, pair_j, npairs, history, lower, upper, periodic, extra, dt,
@@ -275,7 +275,7 @@ def particle_pair_pass(
                 row[L_MAX_OVERLAP_RATIO] = ratio
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def wall_pair_pass(
     position, velocity, angular_velocity, radius, mass, inertia, type_id,
     wall_pair_i, wall_pair_w, nwpairs, history, wall_kind, wall_rows, wall_material, extra, dt,

@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit, prange
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def kick_drift(position, velocity, angular_velocity, force, torque, mass, inertia, dt,
                lower, upper, periodic):
     """First half kick and drift; wraps positions on periodic axes."""
@@ -34,7 +34,7 @@ def kick_drift(position, velocity, angular_velocity, force, torque, mass, inerti
             position[i, a] = x
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def reduce_and_kick(
     radius, mass, inertia, velocity, angular_velocity, force, torque, gravity, dt,
     row_start, entries, pair_force, pair_lever, pair_roll,
@@ -107,7 +107,7 @@ def reduce_and_kick(
             angular_velocity[i, 2] += tz * inv_i
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def check_particles(position, velocity, lower, upper, periodic):
     """First particle (array index) with a non-finite value or outside the domain.
 
@@ -125,7 +125,7 @@ def check_particles(position, velocity, lower, upper, periodic):
     return -1, 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sum_rows(table, count):
     """Column sums of the first ``count`` rows (fixed order), and the max of the column
     ``max_col`` is not special-cased here: callers take maxima separately."""
@@ -136,7 +136,7 @@ def sum_rows(table, count):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def max_column(table, count, col):
     best = 0.0
     for r in range(count):

@@ -34,7 +34,7 @@ from thermodem.geometry.wall_layout import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def minimum_image(dx, length, periodic):
     """dx folded into [-L/2, L/2] on a periodic axis."""
     if periodic:
@@ -42,7 +42,7 @@ def minimum_image(dx, length, periodic):
     return dx
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cell_grid(lower, upper, cell_size, periodic):
     """Number of cells per axis (at least 1) and the actual cell edge per axis."""
     dims = np.empty(3, dtype=np.int64)
@@ -57,7 +57,7 @@ def cell_grid(lower, upper, cell_size, periodic):
     return dims, edge
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cell_of(x, lower, edge, dims):
     """Cell coordinates (cx, cy, cz) of a position, clamped into the grid on every axis."""
     return (
@@ -67,7 +67,7 @@ def cell_of(x, lower, edge, dims):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _axis_cell(x, lower, edge, n):
     k = int(math.floor((x - lower) / edge))
     if k < 0:
@@ -77,7 +77,7 @@ def _axis_cell(x, lower, edge, n):
     return k
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sort_by_cell(position, lower, edge, dims, order, cell_start):
     """Counting sort of particles by linear cell index.
 
@@ -101,7 +101,7 @@ def sort_by_cell(position, lower, edge, dims, order, cell_start):
         fill[cid] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _stencil_axis(k, n, periodic, out):
     """Unique neighbour cell coordinates along one axis; returns their count."""
     m = 0
@@ -121,7 +121,7 @@ def _stencil_axis(k, n, periodic, out):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def build_pairs(position, radius, global_id, lower, upper, periodic, dims, edge, cell_start,
                 extra, skin, pair_i, pair_j):
     """List every pair (i, j) with distance < R_i + R_j + extra + skin, each pair once.
@@ -170,7 +170,7 @@ def build_pairs(position, radius, global_id, lower, upper, periodic, dims, edge,
     return count
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def wall_distance(kind, row, x):
     """Distance from a sphere centre to a wall surface and the unit normal wall -> centre.
 
@@ -247,7 +247,7 @@ def wall_distance(kind, row, x):
     return np.inf, 0.0, 0.0, 1.0, x[0], x[1], x[2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def build_wall_pairs(position, radius, wall_kind, wall_rows, extra, skin, wall_pair_i,
                      wall_pair_w, wall_row_start):
     """List (particle, wall) pairs within R + extra + skin, grouped by particle.
@@ -271,7 +271,7 @@ def build_wall_pairs(position, radius, wall_kind, wall_rows, extra, skin, wall_p
     return count
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def index_by_first_key(key_a, count, nkeys, start, order):
     """Group entries by ``key_a`` (a counting sort): ``start`` has nkeys + 1 offsets."""
     start[:] = 0
@@ -286,7 +286,7 @@ def index_by_first_key(key_a, count, nkeys, start, order):
         fill[g] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def carry_history(new_a, new_b, new_count, old_a, old_b, old_start, old_order, old_history,
                   new_history):
     """Copy each new pair's history row from the old pair with the same key (a, b), or zero.
@@ -314,7 +314,7 @@ def carry_history(new_a, new_b, new_count, old_a, old_b, old_start, old_order, o
                 new_history[k, c] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def particle_pair_csr(pair_i, pair_j, npairs, global_id, n, row_start, entries):
     """Per-particle list of its pairs, each row ordered by the neighbour's global id.
 
@@ -355,7 +355,7 @@ def particle_pair_csr(pair_i, pair_j, npairs, global_id, n, row_start, entries):
             entries[b + 1] = e
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def max_displacement(position, reference, lower, upper, periodic):
     """Largest displacement since the reference positions (minimum image on periodic axes)."""
     length = upper - lower

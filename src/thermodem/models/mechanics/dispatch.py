@@ -13,14 +13,14 @@ from numba import njit
 from thermodem.models.mechanics import normal, rolling, tangential
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass):
     if model_id == normal.HERTZ:
         return normal.hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass)
     return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def tangential_dispatch(model_id, p, ref_stiffness, normal_damping, eff_radius, overlap,
                         normal_force, vtx, vty, vtz, sx, sy, sz, dt):
     if model_id == tangential.MINDLIN:
@@ -33,7 +33,7 @@ def tangential_dispatch(model_id, p, ref_stiffness, normal_damping, eff_radius, 
                                     normal_force, vtx, vty, vtz, sx, sy, sz, dt)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def rolling_dispatch(model_id, p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
                      wx, wy, wz, mx, my, mz, dt):
     if model_id == rolling.CONSTANT_TORQUE:

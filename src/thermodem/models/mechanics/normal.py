@@ -95,7 +95,7 @@ def pack_hertz(params: HertzParams, pair: PairContext) -> np.ndarray:
     return pad_row([pair.effective_youngs_modulus, hertz_alpha_of_restitution(pair.restitution)])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass):
     e_star = p[0]
     alpha = p[1]
@@ -134,7 +134,7 @@ def pack_linear(params: LinearParams, pair: PairContext) -> np.ndarray:
     return pad_row([params.stiffness, linear_damping_ratio(pair.restitution)])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def linear_force(p, overlap, overlap_rate, eff_radius, eff_mass):
     k = p[0]
     gamma = 2.0 * p[1] * math.sqrt(eff_mass * k)

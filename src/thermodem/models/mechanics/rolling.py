@@ -38,7 +38,7 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
     return pad_row([])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def no_rolling(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
                wx, wy, wz, mx, my, mz, dt):
     return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -61,7 +61,7 @@ def pack_constant(params: ConstantTorqueParams, pair: PairContext) -> np.ndarray
     return pad_row([pair.rolling_friction, params.angular_velocity_threshold])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def constant_torque(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
                     wx, wy, wz, mx, my, mz, dt):
     w = math.sqrt(wx * wx + wy * wy + wz * wz)
@@ -89,7 +89,7 @@ def pack_epsd(params: EPSDParams, pair: PairContext) -> np.ndarray:
     return pad_row([pair.rolling_friction, params.damping_ratio, params.plastic_damping_factor])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
          wx, wy, wz, mx, my, mz, dt):
     mu_r = p[0]

@@ -36,7 +36,7 @@ MINDLIN = 1
 LINEAR = 2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy, sz, dt):
     """Shared algorithm: incremental spring + dashpot, Coulomb cap with history rescale."""
     sx += vtx * dt
@@ -76,7 +76,7 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
     return pad_row([])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def no_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
                   vtx, vty, vtz, sx, sy, sz, dt):
     return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -96,7 +96,7 @@ def pack_mindlin(params: MindlinParams, pair: PairContext) -> np.ndarray:
     return pad_row([pair.effective_shear_modulus, pair.sliding_friction])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def mindlin(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
             vtx, vty, vtz, sx, sy, sz, dt):
     k_t = 8.0 * p[0] * math.sqrt(eff_radius * overlap)
@@ -120,7 +120,7 @@ def pack_linear(params: LinearTangentialParams, pair: PairContext) -> np.ndarray
     return pad_row([params.stiffness_ratio, pair.sliding_friction])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def linear_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
                       vtx, vty, vtz, sx, sy, sz, dt):
     k_t = p[0] * ref_stiffness

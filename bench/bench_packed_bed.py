@@ -1,0 +1,164 @@
+"""Packed-bed benchmark: particle-steps per second and peak memory on a settled bed.
+
+N spheres (R = 1 mm, ρ = 2500 kg/m³, E = 1e7 Pa, ν = 0.3, e = 0.5, μ = 0.5, Hertz–Mindlin,
+gravity, dt = 5e-6 s) are poured into an open box and settled; the settled bed is cached in
+``bench/.cache``. Then, in a fresh process, S steps are timed on the settled bed.
+
+    python bench/bench_packed_bed.py --n 50000 --steps 500 --threads 1 [--json]
+
+Settling uses the same materials with a softer damping (e = 0.1) and dt = 1e-5 s to get to rest
+faster; the timed run uses exactly the parameters above.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+CACHE = Path(__file__).parent / ".cache"
+RADIUS = 1e-3
+
+
+def case_dict(n: int, positions_file: str | None, dt: float, restitution: float,
+              end_time: float, threads_note: str = "") -> dict:
+    # footprint: square box sized so the bed is about as high as it is wide / 2
+    side = (n * (2 * RADIUS) ** 3 / 0.6 / 0.5) ** (1 / 3)
+    side = max(side, 20 * RADIUS)
+    height_bed = n * (4 / 3 * np.pi * RADIUS**3) / 0.6 / side**2
+    fill_height = 1.9 * height_bed + 4 * RADIUS  # random insertion at ~0.32 solid fraction
+    height = fill_height + 4 * RADIUS
+    material = {
+        "density": 2500.0,
+        "youngs_modulus": 1e7,
+        "poisson_ratio": 0.3,
+        "restitution": restitution,
+        "sliding_friction": 0.5,
+    }
+    case = {
+        "simulation": {"time_step": dt, "end_time": end_time, "seed": 7},
+        "domain": {"lower": [0, 0, 0], "upper": [side, side, height]},
+        "materials": {"glass": material},
+        "contact": {"normal": "hertz", "tangential": "mindlin", "rolling": "none"},
+        "walls": [{"kind": "box", "lower": [0, 0, 0], "upper": [side, side, height],
+                   "open_top": True, "material": "glass"}],
+        "output": {"vtu": False},
+    }
+    if positions_file is None:
+        case["insertion"] = [{
+            "kind": "random_box", "material": "glass", "count": n,
+            "distribution": {"kind": "mono", "radius": RADIUS},
+            "lower": [0, 0, 0], "upper": [side, side, fill_height],
+        }]
+    else:
+        case["insertion"] = [{"kind": "file", "material": "glass", "path": positions_file}]
+    return case
+
+
+def settle(n: int) -> Path:
+    """Settle N spheres under gravity (cached)."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+    from thermodem.geometry.insertion import InsertedParticles, save_particle_file
+
+    path = CACHE / f"bed_{n}.txt"
+    if path.exists():
+        return path
+    CACHE.mkdir(parents=True, exist_ok=True)
+    case = case_from_dict(case_dict(n, None, 1e-5, 0.1, 1.0))
+    sim = Simulation(case)
+    t0 = time.perf_counter()
+    while True:
+        sim.run(steps=2000)
+        v = np.sqrt((sim.particles.velocity**2).sum(axis=1))
+        print(f"settling: t = {sim.time:.3f} s, max speed {v.max():.3g} m/s, mean "
+              f"{v.mean():.3g} m/s, {sim.contact_count} contacts "
+              f"({time.perf_counter() - t0:.0f} s)", flush=True)
+        if (v.max() < 0.02 and sim.time > 0.1) or sim.time > 1.0:
+            break
+    p = sim.particles
+    save_particle_file(path, InsertedParticles(p.position.copy(), p.radius.copy(),
+                                               np.zeros_like(p.velocity), None, "glass"))
+    return path
+
+
+def rss_bytes() -> int:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def timed(n: int, steps: int, threads: int, heat: str | None) -> dict:
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+
+    bed = settle(n)
+    # baseline: interpreter + libraries + compiled kernels on a tiny case
+    tiny = Simulation(case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0)), threads=threads)
+    tiny.run(steps=5)
+    baseline = rss_bytes()
+    sim = Simulation(case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0)), threads=threads)
+    sim.run(steps=20)  # warm-up
+    r0 = sim.rebuild_count
+    t0 = time.perf_counter()
+    sim.run(steps=steps)
+    elapsed = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    return {
+        "n": n,
+        "steps": steps,
+        "threads": threads,
+        "heat": heat,
+        "particle_steps_per_s": n * steps / elapsed,
+        "seconds": elapsed,
+        "rebuilds": sim.rebuild_count - r0,
+        "contacts_per_particle": 2 * sim.contact_count / n,
+        "pairs_per_particle": sim.pairs.count / n,
+        "peak_rss_mb": peak / 2**20,
+        "baseline_rss_mb": baseline / 2**20,
+        "bytes_per_particle_above_baseline": (peak - baseline) / n,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=50000)
+    ap.add_argument("--steps", type=int, default=500)
+    ap.add_argument("--threads", type=int, nargs="*", default=[1, 2])
+    ap.add_argument("--heat", default=None, help="direct conduction model (thermal issue)")
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        print(json.dumps(timed(args.n, args.steps, args.threads[0], args.heat)))
+        return
+    settle(args.n)  # in this process, so the timed child starts from the cached bed
+    results = []
+    for th in args.threads:
+        env = dict(os.environ, NUMBA_NUM_THREADS=str(th))
+        cmd = [sys.executable, __file__, "--child", "--n", str(args.n), "--steps",
+               str(args.steps), "--threads", str(th)]
+        if args.heat:
+            cmd += ["--heat", args.heat]
+        out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
+        res = json.loads(out.strip().splitlines()[-1])
+        results.append(res)
+        if not args.json:
+            print(f"N = {res['n']}, threads = {th}: {res['particle_steps_per_s'] / 1e6:.2f} M "
+                  f"particle-steps/s ({res['steps']} steps, {res['rebuilds']} rebuilds, "
+                  f"{res['contacts_per_particle']:.2f} contacts/particle, "
+                  f"{res['pairs_per_particle']:.2f} listed pairs/particle); peak RSS "
+                  f"{res['peak_rss_mb']:.0f} MB, {res['bytes_per_particle_above_baseline']:.0f}"
+                  f" B/particle above baseline {res['baseline_rss_mb']:.0f} MB", flush=True)
+    if args.json:
+        print(json.dumps(results, indent=2))
+
+
+if __name__ == "__main__":
+    main()

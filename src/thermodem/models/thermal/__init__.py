@@ -1,0 +1,7 @@
+"""Thermal models (imported to register them)."""
+
+from thermodem.models.thermal import (  # noqa: F401
+    contact_radius,
+    direct_conduction,
+    resistance_network,
+)
