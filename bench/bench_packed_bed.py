@@ -27,14 +27,28 @@ CACHE = Path(__file__).parent / ".cache"
 RADIUS = 1e-3
 
 
+TILE_BASE = 50000
+
+
+def bed_geometry(n: int) -> tuple[float, float, float, int]:
+    """(box side, box height, fill height, tiles per axis) of the bed of n spheres.
+
+    Beds of k² × 50,000 spheres are the settled 50,000-sphere bed tiled k × k side by side
+    (settling 200,000 spheres from scratch would take most of an hour on 2 cores).
+    """
+    tiles = int(round(np.sqrt(n / TILE_BASE))) if n > TILE_BASE else 1
+    if tiles > 1 and tiles * tiles * TILE_BASE != n:
+        tiles = 1
+    base = n // (tiles * tiles)
+    side = max((base * (2 * RADIUS) ** 3 / 0.6 / 0.5) ** (1 / 3), 20 * RADIUS)
+    height_bed = base * (4 / 3 * np.pi * RADIUS**3) / 0.6 / side**2
+    fill_height = 2.2 * height_bed + 4 * RADIUS  # random insertion at ~0.27 solid fraction
+    return tiles * side, fill_height + 4 * RADIUS, fill_height, tiles
+
+
 def case_dict(n: int, positions_file: str | None, dt: float, restitution: float,
-              end_time: float, threads_note: str = "") -> dict:
-    # footprint: square box sized so the bed is about as high as it is wide / 2
-    side = (n * (2 * RADIUS) ** 3 / 0.6 / 0.5) ** (1 / 3)
-    side = max(side, 20 * RADIUS)
-    height_bed = n * (4 / 3 * np.pi * RADIUS**3) / 0.6 / side**2
-    fill_height = 1.9 * height_bed + 4 * RADIUS  # random insertion at ~0.32 solid fraction
-    height = fill_height + 4 * RADIUS
+              end_time: float) -> dict:
+    side, height, fill_height, _ = bed_geometry(n)
     material = {
         "density": 2500.0,
         "youngs_modulus": 1e7,
@@ -72,6 +86,17 @@ def settle(n: int) -> Path:
     if path.exists():
         return path
     CACHE.mkdir(parents=True, exist_ok=True)
+    side, _, _, tiles = bed_geometry(n)
+    if tiles > 1:
+        from thermodem.geometry.insertion import load_particle_file
+
+        base = load_particle_file(settle(n // (tiles * tiles)), "glass")
+        step = side / tiles
+        pos = np.concatenate([base.position + [a * step, b * step, 0.0]
+                              for a in range(tiles) for b in range(tiles)])
+        rad = np.tile(base.radius, tiles * tiles)
+        save_particle_file(path, InsertedParticles(pos, rad, np.zeros_like(pos), None, "glass"))
+        return path
     case = case_from_dict(case_dict(n, None, 1e-5, 0.1, 1.0))
     sim = Simulation(case)
     t0 = time.perf_counter()
