@@ -28,10 +28,11 @@ from thermodem.geometry.walls import wall_rows
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
 from thermodem.kernels.integrate import (
-    check_particles,
+    CHECK_CHUNK,
     kick_drift,
     max_column,
     reduce_and_kick,
+    reduce_checks,
     sum_rows,
 )
 from thermodem.models import registry
@@ -161,6 +162,8 @@ class Simulation:
         self.lookup_start = np.zeros(1, np.int64)
         self.wall_lookup_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
+        self.chunk_check = np.zeros((1, 3))
+        self.moved = 0.0
         self.rebuild_count = 0
         self._needs_rebuild = True
         # ledger
@@ -194,6 +197,8 @@ class Simulation:
                 - np.sum(extra.mass * (extra.position @ self.gravity))
             )
         self.particles.append(extra)
+        if hasattr(self, "reference"):
+            self.reference = np.concatenate([self.reference, extra.position])
         self._needs_rebuild = True
 
     # ------------------------------------------------------------------------- neighbours
@@ -278,8 +283,7 @@ class Simulation:
     def _rebuild_due(self) -> bool:
         if self._needs_rebuild or self.rebuild_every_step:
             return True
-        moved = NB.max_displacement(self.particles.position, self.reference, self.lower,
-                                    self.upper, self.periodic)
+        moved = self.moved
         wall_moved = 0.0
         if self.wall_rows.shape[0]:
             shift = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3] - self.wall_reference
@@ -336,8 +340,15 @@ class Simulation:
     def step(self) -> None:
         """Advance one time step (see the module docstring for the order)."""
         p = self.particles
+        nchunks = p.count // CHECK_CHUNK + 1
+        if self.chunk_check.shape[0] < nchunks:
+            self.chunk_check = np.zeros((nchunks, 3))
         kick_drift(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
-                   p.moment_of_inertia, self.dt, self.lower, self.upper, self.periodic)
+                   p.moment_of_inertia, self.dt, self.lower, self.upper, self.periodic,
+                   self.reference, self.chunk_check)
+        self.moved, bad, code = reduce_checks(self.chunk_check, p.count)
+        if bad >= 0:
+            self._particle_failure(bad, code)
         self.time = (self.step_count + 1) * self.dt
         self.step_count += 1
         if self.wall_rows.shape[0]:
@@ -349,7 +360,7 @@ class Simulation:
                 self.add_particles(pourer.emit(self.time, self.particles.position,
                                                self.particles.radius))
         self._compute_forces(kick=True)
-        self._check()
+        self._check_overlap()
 
     def run(self, steps: int | None = None, until: float | None = None,
             callback: Callable[[Simulation], None] | None = None, every: int = 1) -> None:
@@ -363,25 +374,30 @@ class Simulation:
             if callback is not None and self.step_count % every == 0:
                 callback(self)
 
-    def _check(self) -> None:
+    def _where(self) -> str:
+        return f"at step {self.step_count} (t = {self.time:.6g} s)"
+
+    def _particle_failure(self, index: int, code: int) -> None:
         p = self.particles
-        index, code = check_particles(p.position, p.velocity, self.lower, self.upper,
-                                      self.periodic)
-        where = f"at step {self.step_count} (t = {self.time:.6g} s)"
-        if code:
-            gid = int(p.global_id[index])
-            x = p.position[index]
-            v = p.velocity[index]
-            if code == 1:
-                raise SimulationError(
-                    f"non-finite position or velocity of particle {gid} {where}: x = {x}, "
-                    f"v = {v}; likely cause: time step {self.dt:g} s too large for the "
-                    f"contact stiffness (see the Rayleigh and Hertz checks of 'validate')",
-                    self.step_count, self.time, gid)
+        gid = int(p.global_id[index])
+        x = p.position[index]
+        v = p.velocity[index]
+        # the step number and time refer to the step being taken
+        step, time = self.step_count + 1, self.time + self.dt
+        where = f"at step {step} (t = {time:.6g} s)"
+        if code == 1:
             raise SimulationError(
-                f"particle {gid} left the domain {where}: position {x.tolist()} outside "
-                f"[{self.lower.tolist()}, {self.upper.tolist()}], velocity {v.tolist()} m/s",
-                self.step_count, self.time, gid)
+                f"non-finite position or velocity of particle {gid} {where}: x = {x.tolist()}, "
+                f"v = {v.tolist()}; likely cause: time step {self.dt:g} s too large for the "
+                f"contact stiffness (see the Rayleigh and Hertz checks of 'validate')",
+                step, time, gid)
+        raise SimulationError(
+            f"particle {gid} left the domain {where}: position {x.tolist()} outside "
+            f"[{self.lower.tolist()}, {self.upper.tolist()}], velocity {v.tolist()} m/s",
+            step, time, gid)
+
+    def _check_overlap(self) -> None:
+        where = self._where()
         limit = self.case.simulation.max_overlap_ratio
         if self.max_overlap_ratio > limit:
             raise SimulationError(

@@ -15,23 +15,67 @@ import numpy as np
 from numba import njit, prange
 
 
+CHECK_CHUNK = 4096
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def kick_drift(position, velocity, angular_velocity, force, torque, mass, inertia, dt,
-               lower, upper, periodic):
-    """First half kick and drift; wraps positions on periodic axes."""
+               lower, upper, periodic, reference, chunk_check):
+    """First half kick and drift; wraps positions on periodic axes.
+
+    In the same pass, per chunk of CHECK_CHUNK particles, ``chunk_check`` receives the largest
+    squared displacement since ``reference`` (minimum image), and the first particle with a
+    non-finite value (code 1) or outside the domain on a non-periodic axis (code 2).
+    :func:`reduce_checks` combines the chunks in a fixed order.
+    """
     n = position.shape[0]
     half = 0.5 * dt
-    for i in prange(n):
-        inv_m = half / mass[i]
-        inv_i = half / inertia[i]
-        for a in range(3):
-            velocity[i, a] += force[i, a] * inv_m
-            angular_velocity[i, a] += torque[i, a] * inv_i
-            x = position[i, a] + velocity[i, a] * dt
-            if periodic[a]:
+    nchunks = (n + CHECK_CHUNK - 1) // CHECK_CHUNK
+    for c in prange(nchunks):
+        best = 0.0
+        bad = -1
+        code = 0
+        for i in range(c * CHECK_CHUNK, min(n, (c + 1) * CHECK_CHUNK)):
+            inv_m = half / mass[i]
+            inv_i = half / inertia[i]
+            d2 = 0.0
+            for a in range(3):
+                velocity[i, a] += force[i, a] * inv_m
+                angular_velocity[i, a] += torque[i, a] * inv_i
+                x = position[i, a] + velocity[i, a] * dt
                 length = upper[a] - lower[a]
-                x -= length * math.floor((x - lower[a]) / length)
-            position[i, a] = x
+                if periodic[a]:
+                    x -= length * math.floor((x - lower[a]) / length)
+                position[i, a] = x
+                dx = x - reference[i, a]
+                if periodic[a]:
+                    dx -= length * math.floor(dx / length + 0.5)
+                d2 += dx * dx
+                if bad < 0:
+                    if not (math.isfinite(x) and math.isfinite(velocity[i, a])):
+                        bad = i
+                        code = 1
+                    elif not periodic[a] and (x < lower[a] or x > upper[a]):
+                        bad = i
+                        code = 2
+            if d2 > best:
+                best = d2
+        chunk_check[c, 0] = best
+        chunk_check[c, 1] = bad
+        chunk_check[c, 2] = code
+
+
+@njit(cache=True, error_model="numpy")
+def reduce_checks(chunk_check, n):
+    """(largest displacement, first bad particle index or -1, its code) over all chunks."""
+    nchunks = (n + CHECK_CHUNK - 1) // CHECK_CHUNK
+    best = 0.0
+    for c in range(nchunks):
+        if chunk_check[c, 1] >= 0:
+            return math.sqrt(best), int(chunk_check[c, 1]), int(chunk_check[c, 2])
+        if chunk_check[c, 0] > best:
+            best = chunk_check[c, 0]
+    return math.sqrt(best), -1, 0
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -108,27 +152,8 @@ def reduce_and_kick(
 
 
 @njit(cache=True, error_model="numpy")
-def check_particles(position, velocity, lower, upper, periodic):
-    """First particle (array index) with a non-finite value or outside the domain.
-
-    Returns (index, code): code 0 all good, 1 non-finite position or velocity, 2 outside the
-    domain on a non-periodic axis.
-    """
-    for i in range(position.shape[0]):
-        for a in range(3):
-            x = position[i, a]
-            v = velocity[i, a]
-            if not (math.isfinite(x) and math.isfinite(v)):
-                return i, 1
-            if not periodic[a] and (x < lower[a] or x > upper[a]):
-                return i, 2
-    return -1, 0
-
-
-@njit(cache=True, error_model="numpy")
 def sum_rows(table, count):
-    """Column sums of the first ``count`` rows (fixed order), and the max of the column
-    ``max_col`` is not special-cased here: callers take maxima separately."""
+    """Column sums of the first ``count`` rows, in a fixed order."""
     out = np.zeros(table.shape[1])
     for r in range(count):
         for c in range(table.shape[1]):

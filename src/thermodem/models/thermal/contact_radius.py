@@ -13,6 +13,9 @@ A wall is passed as ``radius_j = inf`` (its material is ``mat_j`` in ``pack``); 
 then returns the R_j -> inf limit (R* = R_i). Kernels return 0 when the pair does not touch.
 The result is symmetric in i and j, so ``antisymmetric=False`` and the rows need no swap.
 
+Kernels are compiled with ``error_model="numpy"``: they never raise (a division by zero gives
+inf/NaN, which the NaN flag of the pair loop catches), as the architecture asks of kernels.
+
 Spec: ``dem-heat-transfer-models.md`` appendix A (Hertz, geometry) and section 2.8 (low
 stiffness corrections). The derivations and choices are in ``docs/models/contact_radius-*.md``.
 """
@@ -43,13 +46,13 @@ FAMILY = "contact_radius"
 
 
 # ------------------------------------------------------------------ shared scalar helpers
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def effective_radius(radius_i, radius_j):
     """R* = (1/R_i + 1/R_j)^-1 (appendix A); R_j = inf (wall) gives R_i. Exactly symmetric."""
     return 1.0 / (1.0 / radius_i + 1.0 / radius_j)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hertz_radius_from_force(normal_force, eff_radius, e_star):
     """R_c = (3 F_n R* / (4 E*))^{1/3} (appendix A, static Hertz); 0 for F_n <= 0."""
     if normal_force <= 0.0:
@@ -57,19 +60,19 @@ def hertz_radius_from_force(normal_force, eff_radius, e_star):
     return (0.75 * normal_force * eff_radius / e_star) ** (1.0 / 3.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hertz_max_contact_radius(mass_eff, eff_radius, e_star, impact_velocity):
     """R_c^max = (15/16 m* R*² v² / E*)^{1/5} of an elastic Hertz impact (appendix A)."""
     return (15.0 / 16.0 * mass_eff * eff_radius**2 * impact_velocity**2 / e_star) ** 0.2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hertz_collision_time(mass_eff, eff_radius, e_star, impact_velocity):
     """t_c = 2.87 (m*² / (R* E*² v))^{1/5}, total elastic Hertz collision time (appendix A)."""
     return 2.87 * (mass_eff**2 / (eff_radius * e_star**2 * impact_velocity)) ** 0.2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def geometric_contact_radius(radius_i, radius_j, overlap):
     """Radius of the intersection circle of two spheres (appendix A, R_c^geo).
 
@@ -110,7 +113,7 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
     return pad_row([])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def none_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     return 0.0
 
@@ -127,7 +130,7 @@ def pack_geometric(params: GeometricParams, pair: PairContext) -> np.ndarray:
     return pad_row([])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def geometric_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     return geometric_contact_radius(r_i, r_j, overlap)
 
@@ -142,7 +145,7 @@ def pack_hertz_force(params: HertzForceParams, pair: PairContext) -> np.ndarray:
     return pad_row([pair.effective_youngs_modulus])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hertz_force_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -158,7 +161,7 @@ def pack_hertz_overlap(params: HertzOverlapParams, pair: PairContext) -> np.ndar
     return pad_row([])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hertz_overlap_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -188,7 +191,7 @@ def pack_zhou2010(params: Zhou2010Params, pair: PairContext) -> np.ndarray:
     return pad_row([e_sim, (e_sim / e_real) ** 0.2, mode])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def zhou2010_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -227,7 +230,7 @@ def pack_lu2017(params: Lu2017Params, pair: PairContext) -> np.ndarray:
     return pad_row([params.normal_stiffness, e_real])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def lu2017_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -249,7 +252,7 @@ def pack_morris2016_area(params: Morris2016AreaParams, pair: PairContext) -> np.
     return pad_row([effective_youngs_modulus_real(pair, "contact_radius.morris2016_area")])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def morris2016_area_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -292,7 +295,7 @@ def pack_morris2016_area_time(params: Morris2016AreaTimeParams, pair: PairContex
     return pad_row([e_real, pair.effective_youngs_modulus, 1.0 if linear else 0.0, k_n])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def morris2016_area_time_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -311,7 +314,7 @@ def morris2016_area_time_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_im
 
 
 # ---------------------------------------------------------------------------- dispatcher
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def contact_radius_dispatch(model_id, p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     """Contact radius of model ``model_id`` (NaN for an unknown id, caught by the NaN flag)."""
     if model_id == GEOMETRIC:

@@ -20,6 +20,9 @@ Row layout shared by the family: [k_i, k_j, (ρc)_i, (ρc)_j, model-specific sym
 ``swap_pairs = ((0, 1), (2, 3))``. The static kernels read only columns 0-1, which is what
 lets the collisional models call them with their own row.
 
+Kernels are compiled with ``error_model="numpy"``: they never raise (a division by zero gives
+inf/NaN, which the NaN flag of the pair loop catches), as the architecture asks of kernels.
+
 Walls: where a formula has a finite R_j -> inf limit it is used (R* = R_i). Pipe and network
 models have a wall-side resistance ∝ R_j whose formal limit cuts conduction off: there the wall
 is isothermal at its surface and only the particle's segment remains (see each docs page).
@@ -92,7 +95,7 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
     return pad_row([])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def none_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     return 0.0
 
@@ -109,7 +112,7 @@ class BatchelorOBrienSimpleParams(StrictModel):
     """
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bob_simple_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0 or r_c <= 0.0:
         return 0.0
@@ -118,7 +121,7 @@ def bob_simple_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v
 
 
 # --------------------------------------------------------- Batchelor & O'Brien, complete
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bob_contact_h(eta, blend):
     """H̃_c + H̃_f of Batchelor & O'Brien (1977) for the contact parameter η (spec 2.3).
 
@@ -147,7 +150,7 @@ def bob_contact_h(eta, blend):
     return (1.0 - w) * 0.17 * eta * eta + w * (2.0 * eta / math.pi - 2.0 * math.log(eta))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bob_conductance(k_p, k_f, r_eff, r_c, overlap, blend, r_cyl, cutoff_gap):
     """Batchelor & O'Brien (1977) conductance H [W/K] between two surfaces (spec 2.3).
 
@@ -218,7 +221,7 @@ def bob_interaction_range(params: StrictModel, radius_i: float, radius_j: float)
     return params.cutoff_gap_ratio * r_eff
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bob_complete_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     r_eff = effective_radius(r_i, r_j)
     k_p = 2.0 * p[0] * p[1] / (p[0] + p[1])
@@ -254,7 +257,7 @@ def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) 
     return pad_row([k_i, k_j, 0.0, 0.0, *values, 1.0 if dai else 0.0])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bob_modified_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     r_eff = effective_radius(r_i, r_j)
     k_p = 2.0 * p[0] * p[1] / (p[0] + p[1])
@@ -279,7 +282,7 @@ class ThermalPipeParams(StrictModel):
     Q = k_i A_p / (R_i - δ) ΔT. Row: [k_i, k_j]."""
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def thermal_pipe_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0 or r_c <= 0.0:
         return 0.0
@@ -297,7 +300,7 @@ class QuintanaRuizCampello2020Params(StrictModel):
     Q = k_i π R_c² / R_i ΔT. Row: [k_i, k_j]."""
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def qrc2020_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0 or r_c <= 0.0:
         return 0.0
@@ -315,7 +318,7 @@ class Rojek2014Params(StrictModel):
     Wall: the particle's half bar (r̃ = R_i), Q = 2 k_i R_i ΔT. Row: [k_i, k_j]."""
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rojek2014_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
@@ -336,7 +339,7 @@ _STATIC_MODELS = {
 StaticModel = Literal[tuple(_STATIC_MODELS)]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def static_rate(
     static_id, p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff
 ):
@@ -353,7 +356,7 @@ def static_rate(
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def zhou2008_coefficient(ratio, fourier):
     """C of Zhou, Yu & Horio (2008) for ρc ratio r = ρ_i c_i/ρ_j c_j and Fourier number Fo.
 
@@ -424,7 +427,7 @@ def pack_zhou2008(params: Zhou2008Params, pair: PairContext) -> np.ndarray:
     return _pack_collisional(params, pair, "direct_conduction.zhou2008", 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def collisional_rate(
     p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff, zhou
 ):
@@ -437,6 +440,8 @@ def collisional_rate(
         t_c = hertz_collision_time(m_eff, r_eff, p[4], v_impact)
         if t_contact < t_c:
             r_max = hertz_max_contact_radius(m_eff, r_eff, p[4], v_impact)
+            if r_max <= 0.0:  # v_impact so small that R_c^max underflows: Q -> 0
+                return 0.0
             effusivity = 1.0 / math.sqrt(p[2] * p[0]) + 1.0 / math.sqrt(p[3] * p[1])
             if zhou:
                 area = r_max * r_max
@@ -450,20 +455,20 @@ def collisional_rate(
     return static_rate(int(p[6]), p, *args)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sun_chen1988_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     args = (t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff)
     return collisional_rate(p, *args, False)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def zhou2008_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     args = (t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff)
     return collisional_rate(p, *args, True)
 
 
 # ---------------------------------------------------------------------------- dispatcher
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def direct_conduction_dispatch(
     model_id, p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff
 ):

@@ -10,6 +10,9 @@ R_g the microgap and R_G the macrogap gas (Bahrami, Yovanovich & Culham 2006), R
 layers of the particles (Beaulieu 2020). Each resistance is its own small function below; the
 kernel has the family's signature (see ``direct_conduction.py``) and returns H (T_j - T_i).
 
+Kernels are compiled with ``error_model="numpy"``: they never raise (a division by zero gives
+inf/NaN, which the NaN flag of the pair loop catches), as the architecture asks of kernels.
+
 Choices (details and their reasons in ``docs/models/direct_conduction-resistance_network.md``):
 
 - r_c = c (3 F_n R*/(4 E*))^{1/3}, c = (E*_sim/E*_real)^{1/5} (Zhou et al. 2010) when a
@@ -51,7 +54,7 @@ _SQRT_PI = math.sqrt(math.pi)
 
 
 # ----------------------------------------------------------------------------- erfc^-1
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _erfcx(y):
     """exp(y²) erfc(y) for y >= 0 (asymptotic series beyond y = 25, where erfc underflows)."""
     if y < 25.0:
@@ -65,7 +68,7 @@ def _erfcx(y):
     return total / (y * _SQRT_PI)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _log_erfc(y):
     """ln erfc(y) for y >= 0, without underflow."""
     if y < 25.0:
@@ -73,7 +76,7 @@ def _log_erfc(y):
     return -y * y + math.log(_erfcx(y))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _erfinv_central(z):
     """erf⁻¹(z) for |z| <= 0.5: Maclaurin series start, then Halley steps on erf(y) - z."""
     z2 = z * z
@@ -105,7 +108,7 @@ def _erfinv_central(z):
     return y
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _erfcinv_tail(x):
     """erfc⁻¹(x) for 0 < x <= 0.5: Newton on ln erfc(y) = ln x from y0 = sqrt(-ln x).
 
@@ -122,7 +125,7 @@ def _erfcinv_tail(x):
     return y
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def erfcinv(x):
     """Inverse complementary error function on (0, 2), relative accuracy ~1e-15.
 
@@ -144,19 +147,19 @@ def erfcinv(x):
 
 
 # ------------------------------------------------------------------------- resistances
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_contact_surface(k_h, r_c):
     """R_L = 1/(2 k_h r_c) [K/W], contact-surface constriction (Batchelor & O'Brien 1977)."""
     return 1.0 / (2.0 * k_h * r_c)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_microcontacts(k_h, r_c, p0, h_micro, sigma, tau):
     """R_s = (H'/P_0)^0.96 1.184/(π r_c² k_h) (σ/τ) [K/W], microcontacts (Van Lew 2016)."""
     return (h_micro / p0) ** 0.96 * 1.184 / (math.pi * r_c * r_c * k_h) * (sigma / tau)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_microgap(k_g, r_c, sigma, a1, a2, m_gas):
     """R_g = 2√2 σ a2 / (π k_g r_c² ln(1 + a2/(a1 + M/(2√2 σ)))) [K/W], microgap gas
     (Bahrami, Yovanovich & Culham 2006); a1 >= 0 and M > 0 keep the logarithm finite."""
@@ -164,7 +167,7 @@ def resistance_microgap(k_g, r_c, sigma, a1, a2, m_gas):
     return s2 * a2 / (math.pi * k_g * r_c * r_c * math.log1p(a2 / (a1 + m_gas / s2)))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_solid_layer(k, r, r_c):
     """R_c,i = L_i/(k_i A_i), L_i = π r_i/4, A_i = π(r_i² - r_c²) [K/W] (Beaulieu 2020).
 
@@ -174,7 +177,7 @@ def resistance_solid_layer(k, r, r_c):
     return 0.25 / (k * r * (1.0 - q * q))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_macrogap(k_g, r_h, r_c, m_gas, b):
     """R_G = 2 / (π k_g [S ln((S - B)/(S - A)) + B - A]) [K/W], macrogap gas (Bahrami 2006).
 
@@ -195,7 +198,7 @@ def resistance_macrogap(k_g, r_h, r_c, m_gas, b):
     return 2.0 / (math.pi * k_g * bracket)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_network_conductance(
     k_i, k_j, r_i, r_j, f_n, e_star, c_zhou, h_micro, sigma, tau, k_g, m_gas, b
 ):
@@ -215,7 +218,7 @@ def resistance_network_conductance(
     return conductance + 1.0 / (resistance_contact_surface(k_h, r_c) + 1.0 / (g_s + g_g))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def resistance_network_rate(
     p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff
 ):
