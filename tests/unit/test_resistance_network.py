@@ -1,0 +1,217 @@
+"""Beaulieu (2020) resistance network and erfc⁻¹, against the spec's formulas written out here."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.special import erfc
+from scipy.special import erfcinv as sp_erfcinv
+
+from thermodem.models import registry
+from thermodem.models.thermal import resistance_network as rn
+from thermodem.state.materials import Material, resolve_pair
+
+PI = math.pi
+SQ2 = math.sqrt(2.0)
+
+
+# ------------------------------------------------------------------------------ erfc^-1
+def test_erfcinv_matches_scipy_over_the_whole_domain():
+    x = np.concatenate(
+        [
+            np.logspace(-300, -1, 3000),  # near 0
+            np.linspace(0.0, 2.0, 4001)[1:-1],
+            1.0 - np.logspace(-16, -1, 300),  # near 1 (result near 0: relative accuracy kept)
+            1.0 + np.logspace(-15.6, -1, 300),
+            2.0 - np.logspace(-15.6, -1, 3000),  # near 2 (spacing of doubles below 2: 2.2e-16)
+        ]
+    )
+    ours = np.array([rn.erfcinv(v) for v in x])
+    ref = sp_erfcinv(x)
+    np.testing.assert_allclose(ours, ref, rtol=1e-12, atol=0.0)
+
+
+def test_erfcinv_denormals_and_round_trip():
+    for x in (1e-320, 1e-310, 2.2e-308):  # scipy itself gives inf at 5e-324
+        assert rn.erfcinv(x) == pytest.approx(sp_erfcinv(x), rel=1e-12)
+    assert rn.erfcinv(5e-324) == pytest.approx(27.2133, rel=1e-5)
+    for x in (1e-200, 1e-9, 0.01, 0.7, 1.3, 1.99):
+        assert erfc(rn.erfcinv(x)) == pytest.approx(x, rel=1e-13)
+
+
+def test_erfcinv_outside_the_domain():
+    assert rn.erfcinv(0.0) == np.inf
+    assert rn.erfcinv(2.0) == -np.inf
+    assert rn.erfcinv(1.0) == 0.0
+    for x in (-1e-300, -1.0, 2.0 + 4.5e-16, 3.0, np.nan, np.inf):
+        assert np.isnan(rn.erfcinv(x))
+
+
+# --------------------------------------------------------------------------- resistances
+def test_each_resistance_by_hand():
+    k_h, r_c = 3.0, 1.0e-4
+    assert rn.resistance_contact_surface(k_h, r_c) == pytest.approx(1.0 / 6.0e-4, rel=1e-14)
+    sigma, tau, p0, h = 1.4e-6, 0.07, 5.0e7, 5.0e9
+    expected = 100.0**0.96 * 1.184 / (PI * 1e-8 * 3.0) * (1.4e-6 / 0.07)
+    assert rn.resistance_microcontacts(k_h, r_c, p0, h, sigma, tau) == pytest.approx(expected)
+    k_g, a1, a2, m = 0.0263, 1.2, 1.5, 3.4e-7
+    expected = (
+        2 * SQ2 * sigma * a2 / (PI * k_g * 1e-8 * math.log(1 + a2 / (a1 + m / (2 * SQ2 * sigma))))
+    )
+    assert rn.resistance_microgap(k_g, r_c, sigma, a1, a2, m) == pytest.approx(expected)
+    # solid layer: L/(k A), L = π r/4, A = π (r² - r_c²)
+    expected = (PI * 1e-3 / 4) / (2.0 * PI * (1e-6 - 1e-8))
+    assert rn.resistance_solid_layer(2.0, 1e-3, r_c) == pytest.approx(expected, rel=1e-14)
+    assert rn.resistance_solid_layer(2.0, np.inf, r_c) == 0.0
+
+
+@pytest.mark.parametrize("b", [0.0, 0.5])
+def test_macrogap_by_hand(b):
+    k_g, r_h, r_c, m = 0.0263, 1e-3, 1e-4, 3.4e-7
+    big_a = 2 * math.sqrt(r_h**2 - r_c**2)
+    big_s = 2 * (r_h - r_c**2 / (2 * r_h)) + m
+    big_b = b * r_h
+    expected = 2 / (
+        PI * k_g * (big_s * math.log((big_s - big_b) / (big_s - big_a)) + big_b - big_a)
+    )
+    assert rn.resistance_macrogap(k_g, r_h, r_c, m, b) == pytest.approx(expected, rel=1e-10)
+    assert rn.resistance_macrogap(k_g, r_h, r_c, m, 1.999) == np.inf  # B >= A: no gas region
+
+
+def test_gas_mean_free_path_and_parameter():
+    gas = rn.GasProperties()
+    lam = 1.380649e-23 * 300.0 / (SQ2 * PI * (3.66e-10) ** 2 * 101325.0)
+    assert gas.mean_free_path_value() == pytest.approx(lam, rel=1e-14)
+    assert lam == pytest.approx(6.87e-8, rel=1e-3)  # air at 300 K, 1 atm
+    assert rn.GasProperties(mean_free_path=1e-7).mean_free_path_value() == 1e-7
+    pr = 1.846e-5 * 1007.0 / 0.0263
+    expected = (1.2 / 0.8 + 1.5 / 0.5) * (2 * 1.4 / 2.4) * lam / pr
+    assert rn.gas_parameter(0.8, 0.5, gas) == pytest.approx(expected, rel=1e-14)
+
+
+# ---------------------------------------------------------------------- whole network
+def material(**kw) -> Material:
+    base = dict(density=2500.0, youngs_modulus=1.0e8, poisson_ratio=0.25, thermal_conductivity=2.0,
+                microhardness=5e9, surface_roughness=1e-6, surface_slope=0.05,
+                thermal_accommodation=0.8)  # fmt: skip
+    base.update(kw)
+    return Material(**base)
+
+
+MAT_I = material()
+MAT_J = material(thermal_conductivity=6.0, microhardness=2e9, surface_roughness=2e-6,
+                 surface_slope=0.1, thermal_accommodation=0.6, youngs_modulus=2e8)  # fmt: skip
+
+
+def hand_conductance(r_i, r_j, f, *, h_i=5e9, h_j=2e9, c=1.0, b=0.0):
+    """Spec .rst, with the documented choices: P0 = 3F/(2π r_c²) capped at H', a1 >= 0."""
+    k_i, k_j = 2.0, 6.0
+    e = 1 / ((1 - 0.25**2) / 1e8 + (1 - 0.25**2) / 2e8)
+    r_eff = r_i if math.isinf(r_j) else r_i * r_j / (r_i + r_j)
+    r_c = c * (3 * f * r_eff / (4 * e)) ** (1 / 3)
+    k_h = 2 * k_i * k_j / (k_i + k_j)
+    h = 2 * h_i * h_j / (h_i + h_j)
+    sigma, tau = math.sqrt(1e-12 + 4e-12), math.sqrt(0.05**2 + 0.1**2)
+    gas = rn.GasProperties()
+    k_g = gas.thermal_conductivity
+    m = (1.2 / 0.8 + 1.4 / 0.6) * (2 * 1.4 / 2.4) * gas.mean_free_path_value() / gas.prandtl()
+    p0 = min(1.5 * f / (PI * r_c**2), h)
+    a1 = float(sp_erfcinv(min(2 * p0 / h, 1.0)))
+    a2 = float(sp_erfcinv(0.03 * p0 / h)) - a1
+    r_l = 1 / (2 * k_h * r_c)
+    r_s = (h / p0) ** 0.96 * 1.184 / (PI * r_c**2 * k_h) * (sigma / tau)
+    r_g = (
+        2 * SQ2 * sigma * a2 / (PI * k_g * r_c**2 * math.log(1 + a2 / (a1 + m / (2 * SQ2 * sigma))))
+    )
+    r_cs = (PI * r_i / 4) / (k_i * PI * (r_i**2 - r_c**2))
+    if not math.isinf(r_j):
+        r_cs += (PI * r_j / 4) / (k_j * PI * (r_j**2 - r_c**2))
+    r_h = 2 * r_eff  # = 2 r_i r_j/(r_i + r_j), harmonic mean radius
+    big_a = 2 * math.sqrt(r_h**2 - r_c**2)
+    big_s = 2 * (r_h - r_c**2 / (2 * r_h)) + m
+    big_b = b * r_h
+    r_big_g = 2 / (PI * k_g * (big_s * math.log((big_s - big_b) / (big_s - big_a)) + big_b - big_a))
+    return 1 / (r_l + 1 / (1 / r_s + 1 / r_g)) + 1 / (r_cs + r_big_g)
+
+
+def network_row(mi=MAT_I, mj=MAT_J, is_wall=False, **params):
+    spec = registry.get("direct_conduction", "resistance_network")
+    return spec.pack(spec.params(**params), resolve_pair(mi, mj, is_wall=is_wall))
+
+
+def heat(p, r_i, r_j, f, overlap=1e-6):
+    kernel = registry.get("direct_conduction", "resistance_network").kernel
+    return kernel(p, 300.0, 310.0, r_i, r_j, 0.0, overlap, 0.0, f, 0.0, 0.0, 0.0)
+
+
+@pytest.mark.parametrize(("r_i", "r_j"), [(1e-3, 2e-3), (1e-3, np.inf), (2e-3, 2e-3)])
+@pytest.mark.parametrize("f", [1e-3, 0.1, 1.0, 30.0])
+def test_network_by_hand(r_i, r_j, f):
+    p = network_row(is_wall=math.isinf(r_j))
+    assert heat(p, r_i, r_j, f) == pytest.approx(10.0 * hand_conductance(r_i, r_j, f), rel=1e-10)
+
+
+def test_packing_constant_and_no_contact():
+    p = network_row(packing_constant=0.3)
+    assert heat(p, 1e-3, 2e-3, 1.0) == pytest.approx(10 * hand_conductance(1e-3, 2e-3, 1.0, b=0.3))
+    assert heat(p, 1e-3, 2e-3, 1.0, overlap=-1e-6) == 0.0
+    # touching with no force: only the solid layers and the macrogap remain
+    r_eff = 2e-3 / 3
+    gas = rn.GasProperties()
+    m = (1.2 / 0.8 + 1.4 / 0.6) * (2 * 1.4 / 2.4) * gas.mean_free_path_value() / gas.prandtl()
+    r_h = 2 * r_eff
+    big_s = 2 * r_h + m  # r_c = 0: A = 2 r_h, S - A = M, B = 0
+    r_big_g = 2 / (PI * gas.thermal_conductivity * (big_s * math.log(big_s / m) - 2 * r_h))
+    r_cs = 1 / (4 * 2.0 * 1e-3) + 1 / (4 * 6.0 * 2e-3)
+    assert heat(network_row(), 1e-3, 2e-3, 0.0) == pytest.approx(10 / (r_cs + r_big_g), rel=1e-10)
+
+
+def test_zhou_correction_only_with_a_real_modulus():
+    assert network_row()[5] == 1.0
+    soft = material(youngs_modulus_real=6.3e10)
+    p = network_row(soft, soft)
+    e_sim = 1 / (2 * (1 - 0.25**2) / 1e8)
+    e_real = 1 / (2 * (1 - 0.25**2) / 6.3e10)
+    assert p[5] == pytest.approx((e_sim / e_real) ** 0.2, rel=1e-14)
+    # one material softened, the other taken as not softened (real = simulation modulus)
+    p = network_row(soft, MAT_J)
+    e_sim = 1 / ((1 - 0.25**2) / 1e8 + (1 - 0.25**2) / 2e8)
+    e_real = 1 / ((1 - 0.25**2) / 6.3e10 + (1 - 0.25**2) / 2e8)
+    assert p[5] == pytest.approx((e_sim / e_real) ** 0.2, rel=1e-14)
+
+
+def test_missing_surface_property_is_named():
+    with pytest.raises(ValueError, match="microhardness"):
+        network_row(MAT_I, material(microhardness=None))
+    with pytest.raises(ValueError, match="thermal_accommodation"):
+        network_row(MAT_I, material(thermal_accommodation=None), is_wall=True)
+
+
+def test_plastic_limit_caps_are_continuous_and_finite():
+    """2P0/H' >= 1 (a1 capped at 0) and P0 >= H' (P0 capped): finite, continuous, hand value."""
+    h = 5e5  # soft surfaces: the caps are reached at moderate forces
+    mi, mj = material(microhardness=h), material(
+        microhardness=h, thermal_conductivity=6.0, surface_roughness=2e-6, surface_slope=0.1,
+        thermal_accommodation=0.6, youngs_modulus=2e8,
+    )  # fmt: skip
+    p = network_row(mi, mj)
+    r_i, r_j = 1e-3, 2e-3
+    r_eff = r_i * r_j / (r_i + r_j)
+    e = 1 / ((1 - 0.25**2) / 1e8 + (1 - 0.25**2) / 2e8)
+    # P0 = 1.5 F / (π r_c²) = 1.5 F^{1/3} / (π (3 R*/(4E*))^{2/3})  ->  F where P0 = target
+    force_at = lambda target: (target * PI * (0.75 * r_eff / e) ** (2 / 3) / 1.5) ** 3  # noqa: E731
+    for f_cap in (force_at(h / 2), force_at(h)):
+        lo, hi = heat(p, r_i, r_j, f_cap * (1 - 1e-9)), heat(p, r_i, r_j, f_cap * (1 + 1e-9))
+        assert np.isfinite(lo) and np.isfinite(hi)
+        assert hi == pytest.approx(lo, rel=1e-6)
+    for f in (force_at(0.3 * h), force_at(0.7 * h), force_at(2.0 * h), force_at(5.0 * h)):
+        expected = 10 * hand_conductance(r_i, r_j, f, h_i=h, h_j=h)
+        assert heat(p, r_i, r_j, f) == pytest.approx(expected, rel=1e-10)
+
+
+def test_conductance_increases_with_force_for_glass_beads_in_air():
+    p = network_row()
+    q = [heat(p, 1e-3, 2e-3, f) for f in np.logspace(-4, 3, 200)]
+    assert np.all(np.diff(q) > 0)

@@ -1,0 +1,151 @@
+"""Every registered contact_radius and direct_conduction model: dispatcher == own kernel, row
+shape, swap/symmetry, required properties named in errors, a docs page."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermodem.models import registry
+from thermodem.models.thermal.contact_radius import contact_radius_dispatch
+from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch, swap_row
+from thermodem.state.materials import Material, resolve_pair
+
+FAMILIES = ("contact_radius", "direct_conduction")
+DISPATCH = {
+    "contact_radius": contact_radius_dispatch,
+    "direct_conduction": direct_conduction_dispatch,
+}
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "models"
+
+
+def material(**kw) -> Material:
+    base = dict(
+        density=2500.0,
+        youngs_modulus=5.0e7,
+        poisson_ratio=0.25,
+        specific_heat=800.0,
+        thermal_conductivity=2.0,
+        microhardness=5e9,
+        surface_roughness=1e-6,
+        surface_slope=0.05,
+        thermal_accommodation=0.8,
+        youngs_modulus_real=6e10,
+    )
+    base.update(kw)
+    return Material(**base)
+
+
+MAT_I = material()
+MAT_J = material(
+    thermal_conductivity=7.0,
+    density=7800.0,
+    specific_heat=460.0,
+    youngs_modulus=2e8,
+    youngs_modulus_real=2e11,
+    poisson_ratio=0.3,
+    microhardness=2e9,
+    surface_roughness=3e-6,
+    thermal_accommodation=0.6,
+)
+
+SPECS = [registry.get(f, n) for f in FAMILIES for n in registry.names(f)]
+IDS = [f"{s.family}.{s.name}" for s in SPECS]
+
+
+def params_of(spec):
+    return spec.params(**spec.extra.get("example_params", {}))
+
+
+def random_inputs(rng, wall: bool):
+    r_i = rng.uniform(2e-4, 5e-3)
+    r_j = np.inf if wall else rng.uniform(2e-4, 5e-3)
+    overlap = rng.uniform(-1e-4, 2e-5)
+    d = r_i + r_j - overlap
+    r_c = rng.uniform(0.0, 1e-4) if overlap > 0 else 0.0
+    return dict(
+        t_i=rng.uniform(250, 1200),
+        t_j=rng.uniform(250, 1200),
+        r_i=r_i,
+        r_j=r_j,
+        dist=d,
+        overlap=overlap,
+        r_c=r_c,
+        f_n=rng.uniform(0, 5),
+        t_contact=rng.uniform(0, 1e-4),
+        v=rng.uniform(0, 2),
+        m=rng.uniform(1e-7, 1e-4),
+    )
+
+
+def call(spec, fn, p, x, swap=False):
+    i, j = ("j", "i") if swap else ("i", "j")
+    geo = (x[f"r_{i}"], x[f"r_{j}"], x["dist"], x["overlap"])
+    tail = (x["f_n"], x["t_contact"], x["v"], x["m"])
+    if spec.family == "contact_radius":
+        return fn(p, *geo, *tail)
+    return fn(p, x[f"t_{i}"], x[f"t_{j}"], *geo, x["r_c"], *tail)
+
+
+def same(a: float, b: float) -> bool:
+    return a == b or (math.isnan(a) and math.isnan(b))
+
+
+def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
+    for family in FAMILIES:
+        assert registry.get(family, "none").model_id == 0
+        ids = [registry.get(family, n).model_id for n in registry.names(family)]
+        assert sorted(ids) == list(range(len(ids)))
+    p = np.zeros(registry.PARAM_WIDTH)
+    unknown = len(registry.names("contact_radius"))
+    assert math.isnan(contact_radius_dispatch(unknown, p, 1e-3, 1e-3, 2e-3, 1e-6, 1.0, 0, 0, 1e-5))
+    unknown = len(registry.names("direct_conduction"))
+    q = direct_conduction_dispatch(unknown, p, 300, 310, 1e-3, 1e-3, 2e-3, 1e-6, 1e-5, 1, 0, 0, 1)
+    assert math.isnan(q)
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=IDS)
+@pytest.mark.parametrize("wall", [False, True])
+def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
+    p = spec.pack(params_of(spec), resolve_pair(MAT_I, MAT_J, is_wall=wall))
+    assert p.dtype == np.float64 and p.shape == (registry.PARAM_WIDTH,)
+    rng = np.random.default_rng(spec.model_id + 100 * wall)
+    dispatch = DISPATCH[spec.family]
+    for _ in range(60):
+        x = random_inputs(rng, wall)
+        own = call(spec, spec.kernel, p, x)
+        via = call(spec, lambda *a: dispatch(spec.model_id, *a), p, x)
+        assert same(own, via), (own, via)
+        assert np.isfinite(own)
+        if wall:
+            continue
+        if spec.antisymmetric:
+            swapped = call(spec, spec.kernel, swap_row(p, spec.extra["swap_pairs"]), x, swap=True)
+            assert swapped == -own
+        else:
+            assert spec.extra.get("symmetric")
+            assert call(spec, spec.kernel, p, x, swap=True) == pytest.approx(own, rel=1e-12)
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=IDS)
+def test_metadata_and_missing_properties(spec):
+    assert spec.summary and spec.reference and spec.params.__doc__
+    fields = Material.model_fields
+    for prop in spec.requires:
+        assert prop in fields, prop
+        if fields[prop].is_required():
+            continue  # always present
+        for broken in (resolve_pair(MAT_I, material(**{prop: None})),
+                       resolve_pair(material(**{prop: None}), MAT_J)):  # fmt: skip
+            with pytest.raises(ValueError, match=prop):
+                spec.pack(params_of(spec), broken)
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=IDS)
+def test_docs_page_exists(spec):
+    page = DOCS / f"{spec.family}-{spec.name}.md"
+    assert page.is_file(), page
+    assert spec.name in page.read_text(encoding="utf-8")
