@@ -46,8 +46,9 @@ def bed_geometry(n: int) -> tuple[float, float, float, int]:
     return tiles * side, fill_height + 4 * RADIUS, fill_height, tiles
 
 
-def case_dict(n: int, positions_file: str | None, dt: float, restitution: float,
-              end_time: float) -> dict:
+def case_dict(
+    n: int, positions_file: str | None, dt: float, restitution: float, end_time: float
+) -> dict:
     side, height, fill_height, _ = bed_geometry(n)
     material = {
         "density": 2500.0,
@@ -61,16 +62,28 @@ def case_dict(n: int, positions_file: str | None, dt: float, restitution: float,
         "domain": {"lower": [0, 0, 0], "upper": [side, side, height]},
         "materials": {"glass": material},
         "contact": {"normal": "hertz", "tangential": "mindlin", "rolling": "none"},
-        "walls": [{"kind": "box", "lower": [0, 0, 0], "upper": [side, side, height],
-                   "open_top": True, "material": "glass"}],
+        "walls": [
+            {
+                "kind": "box",
+                "lower": [0, 0, 0],
+                "upper": [side, side, height],
+                "open_top": True,
+                "material": "glass",
+            }
+        ],
         "output": {"vtu": False},
     }
     if positions_file is None:
-        case["insertion"] = [{
-            "kind": "random_box", "material": "glass", "count": n,
-            "distribution": {"kind": "mono", "radius": RADIUS},
-            "lower": [0, 0, 0], "upper": [side, side, fill_height],
-        }]
+        case["insertion"] = [
+            {
+                "kind": "random_box",
+                "material": "glass",
+                "count": n,
+                "distribution": {"kind": "mono", "radius": RADIUS},
+                "lower": [0, 0, 0],
+                "upper": [side, side, fill_height],
+            }
+        ]
     else:
         case["insertion"] = [{"kind": "file", "material": "glass", "path": positions_file}]
     return case
@@ -92,8 +105,9 @@ def settle(n: int) -> Path:
 
         base = load_particle_file(settle(n // (tiles * tiles)), "glass")
         step = side / tiles
-        pos = np.concatenate([base.position + [a * step, b * step, 0.0]
-                              for a in range(tiles) for b in range(tiles)])
+        pos = np.concatenate(
+            [base.position + [a * step, b * step, 0.0] for a in range(tiles) for b in range(tiles)]
+        )
         rad = np.tile(base.radius, tiles * tiles)
         save_particle_file(path, InsertedParticles(pos, rad, np.zeros_like(pos), None, "glass"))
         return path
@@ -103,14 +117,21 @@ def settle(n: int) -> Path:
     while True:
         sim.run(steps=2000)
         v = np.sqrt((sim.particles.velocity**2).sum(axis=1))
-        print(f"settling: t = {sim.time:.3f} s, max speed {v.max():.3g} m/s, mean "
-              f"{v.mean():.3g} m/s, {sim.contact_count} contacts "
-              f"({time.perf_counter() - t0:.0f} s)", flush=True)
+        print(
+            f"settling: t = {sim.time:.3f} s, max speed {v.max():.3g} m/s, mean "
+            f"{v.mean():.3g} m/s, {sim.contact_count} contacts "
+            f"({time.perf_counter() - t0:.0f} s)",
+            flush=True,
+        )
         if (v.max() < 0.02 and sim.time > 0.1) or sim.time > 1.0:
             break
     p = sim.particles
-    save_particle_file(path, InsertedParticles(p.position.copy(), p.radius.copy(),
-                                               np.zeros_like(p.velocity), None, "glass"))
+    save_particle_file(
+        path,
+        InsertedParticles(
+            p.position.copy(), p.radius.copy(), np.zeros_like(p.velocity), None, "glass"
+        ),
+    )
     return path
 
 
@@ -167,20 +188,32 @@ def main() -> None:
     results = []
     for th in args.threads:
         env = dict(os.environ, NUMBA_NUM_THREADS=str(th))
-        cmd = [sys.executable, __file__, "--child", "--n", str(args.n), "--steps",
-               str(args.steps), "--threads", str(th)]
+        cmd = [
+            sys.executable,
+            __file__,
+            "--child",
+            "--n",
+            str(args.n),
+            "--steps",
+            str(args.steps),
+            "--threads",
+            str(th),
+        ]
         if args.heat:
             cmd += ["--heat", args.heat]
         out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
         res = json.loads(out.strip().splitlines()[-1])
         results.append(res)
         if not args.json:
-            print(f"N = {res['n']}, threads = {th}: {res['particle_steps_per_s'] / 1e6:.2f} M "
-                  f"particle-steps/s ({res['steps']} steps, {res['rebuilds']} rebuilds, "
-                  f"{res['contacts_per_particle']:.2f} contacts/particle, "
-                  f"{res['pairs_per_particle']:.2f} listed pairs/particle); peak RSS "
-                  f"{res['peak_rss_mb']:.0f} MB, {res['bytes_per_particle_above_baseline']:.0f}"
-                  f" B/particle above baseline {res['baseline_rss_mb']:.0f} MB", flush=True)
+            print(
+                f"N = {res['n']}, threads = {th}: {res['particle_steps_per_s'] / 1e6:.2f} M "
+                f"particle-steps/s ({res['steps']} steps, {res['rebuilds']} rebuilds, "
+                f"{res['contacts_per_particle']:.2f} contacts/particle, "
+                f"{res['pairs_per_particle']:.2f} listed pairs/particle); peak RSS "
+                f"{res['peak_rss_mb']:.0f} MB, {res['bytes_per_particle_above_baseline']:.0f}"
+                f" B/particle above baseline {res['baseline_rss_mb']:.0f} MB",
+                flush=True,
+            )
     if args.json:
         print(json.dumps(results, indent=2))
 

@@ -11,8 +11,11 @@ import typer
 
 from thermodem.errors import ConfigError, SimulationError
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
-                  help="thermodem: thermal discrete element simulations")
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="thermodem: thermal discrete element simulations",
+)
 
 
 def _fail(message: str, code: int) -> None:
@@ -37,8 +40,10 @@ def run(
         _fail(str(exc), 2)
     except SimulationError as exc:
         _fail(str(exc), 1)
-    typer.echo(f"done: {sim.step_count} steps, {sim.particles.count} particles; "
-               f"open {output / 'particles.pvd'} in ParaView")
+    typer.echo(
+        f"done: {sim.step_count} steps, {sim.particles.count} particles; "
+        f"open {output / 'particles.pvd'} in ParaView"
+    )
 
 
 @app.command()
@@ -52,8 +57,13 @@ def validate(case: Path = typer.Argument(..., help="case file (YAML)")) -> None:
     try:
         c = load_case(case)
         sim = Simulation(c)
-        warnings = check_time_step(c, sim.particles.radius, sim.particles.type_id,
-                                   sim.material_names, sim.particles.velocity)
+        warnings = check_time_step(
+            c,
+            sim.particles.radius,
+            sim.particles.type_id,
+            sim.material_names,
+            sim.particles.velocity,
+        )
     except ConfigError as exc:
         _fail(str(exc), 2)
     for w in warnings:

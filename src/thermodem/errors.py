@@ -10,8 +10,14 @@ class ConfigError(ValueError):
 class SimulationError(RuntimeError):
     """A run that went wrong; the message says what, where (particle) and when (step, time)."""
 
-    def __init__(self, message: str, step: int = -1, time: float = float("nan"),
-                 particle: int = -1, checkpoint: str | None = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        step: int = -1,
+        time: float = float("nan"),
+        particle: int = -1,
+        checkpoint: str | None = None,
+    ) -> None:
         super().__init__(message)
         self.step = step
         self.time = time

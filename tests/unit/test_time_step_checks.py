@@ -14,11 +14,14 @@ from thermodem.errors import ConfigError
 
 def _case(dt: float, allow: bool = False, speed: float = 1.0) -> dict:
     return {
-        "simulation": {"time_step": dt, "end_time": 1.0, "gravity": [0, 0, 0],
-                       "time_step_check": {"impact_velocity": speed, "allow_unstable": allow}},
+        "simulation": {
+            "time_step": dt,
+            "end_time": 1.0,
+            "gravity": [0, 0, 0],
+            "time_step_check": {"impact_velocity": speed, "allow_unstable": allow},
+        },
         "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
-        "materials": {"glass": {"density": 2500.0, "youngs_modulus": 1e7,
-                                "poisson_ratio": 0.3}},
+        "materials": {"glass": {"density": 2500.0, "youngs_modulus": 1e7, "poisson_ratio": 0.3}},
     }
 
 
@@ -44,8 +47,7 @@ def test_small_step_passes_large_warns_too_large_refused() -> None:
     assert check_time_step(case_from_dict(_case(1e-6)), radius, types, ["glass"]) == []
     # 3e-5 s: 0.35 of the Rayleigh time (warn above 0.3); at 0.01 m/s the collision lasts
     # ~5.1e-4 s, i.e. ~17 steps (warn below 30, refuse below 10)
-    warnings = check_time_step(case_from_dict(_case(3e-5, speed=0.01)), radius, types,
-                               ["glass"])
+    warnings = check_time_step(case_from_dict(_case(3e-5, speed=0.01)), radius, types, ["glass"])
     assert len(warnings) == 2
     assert any("Rayleigh" in w for w in warnings)
     assert any("collision" in w for w in warnings)
@@ -55,6 +57,5 @@ def test_small_step_passes_large_warns_too_large_refused() -> None:
         check_time_step(case_from_dict(_case(1e-4)), radius, types, ["glass"])
     assert "simulation.time_step = 0.0001 s is 1.16 × the Rayleigh time" in str(err.value)
     # explicit permission turns the refusal into a warning
-    warnings = check_time_step(case_from_dict(_case(1e-4, allow=True)), radius, types,
-                               ["glass"])
+    warnings = check_time_step(case_from_dict(_case(1e-4, allow=True)), radius, types, ["glass"])
     assert any("Rayleigh" in w for w in warnings)

@@ -29,8 +29,9 @@ def _format_validation_error(exc: ValidationError) -> str:
 def case_from_dict(data: Any, source: str = "<case>") -> Case:
     """Validate a mapping into a Case, raising ConfigError with key paths."""
     if not isinstance(data, dict):
-        raise ConfigError(f"{source}: the case must be a mapping of sections, got "
-                          f"{type(data).__name__}")
+        raise ConfigError(
+            f"{source}: the case must be a mapping of sections, got {type(data).__name__}"
+        )
     try:
         return Case.model_validate(data)
     except ValidationError as exc:

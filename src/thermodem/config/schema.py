@@ -54,13 +54,13 @@ def parse_model_choice(family: str, value: Any, default: str) -> ModelChoice:
 class ContactModels(StrictModel):
     """Mechanical contact laws: ``normal``, ``tangential``, ``rolling``."""
 
-    normal: ModelChoice = Field(default_factory=lambda: parse_model_choice("normal", None,
-                                                                           "hertz"))
+    normal: ModelChoice = Field(default_factory=lambda: parse_model_choice("normal", None, "hertz"))
     tangential: ModelChoice = Field(
         default_factory=lambda: parse_model_choice("tangential", None, "mindlin")
     )
-    rolling: ModelChoice = Field(default_factory=lambda: parse_model_choice("rolling", None,
-                                                                            "none"))
+    rolling: ModelChoice = Field(
+        default_factory=lambda: parse_model_choice("rolling", None, "none")
+    )
 
     @field_validator("normal", mode="before")
     @classmethod
@@ -90,8 +90,9 @@ class Domain(StrictModel):
     def _check(self) -> Domain:
         for axis, lo, hi in zip("xyz", self.lower, self.upper, strict=True):
             if not lo < hi:
-                raise ValueError(f"lower must be < upper on every axis; on {axis}: lower={lo}, "
-                                 f"upper={hi}")
+                raise ValueError(
+                    f"lower must be < upper on every axis; on {axis}: lower={lo}, upper={hi}"
+                )
         return self
 
 
@@ -99,7 +100,8 @@ class Neighbors(StrictModel):
     """Neighbour list settings."""
 
     skin: float | None = Field(
-        default=None, ge=0,
+        default=None,
+        ge=0,
         description="Verlet skin [m]; default 0.1 × the largest particle diameter",
     )
     extra_distance: float = Field(
@@ -121,7 +123,8 @@ class TimeStepCheck(StrictModel):
     collision_warn_steps: float = Field(default=30.0, gt=0)
     collision_min_steps: float = Field(default=10.0, gt=0)
     impact_velocity: float | None = Field(
-        default=None, gt=0,
+        default=None,
+        gt=0,
         description="characteristic impact speed [m/s]; default: max(1, sqrt(2 g H), "
         "initial and wall speeds)",
     )
@@ -136,7 +139,9 @@ class SimulationSettings(StrictModel):
     initial_temperature: float = Field(default=293.15, gt=0, description="[K]")
     time_step_check: TimeStepCheck = Field(default_factory=TimeStepCheck)
     max_overlap_ratio: float = Field(
-        default=0.2, gt=0, le=1,
+        default=0.2,
+        gt=0,
+        le=1,
         description="stop when an overlap exceeds this fraction of the smaller radius",
     )
 
@@ -170,15 +175,18 @@ class Case(StrictModel):
         allowed = ", ".join(sorted(known))
         for k, w in enumerate(self.walls):
             if w.material not in known:
-                raise ValueError(f"walls.{k}.material: unknown material {w.material!r}; "
-                                 f"allowed: {allowed}")
+                raise ValueError(
+                    f"walls.{k}.material: unknown material {w.material!r}; allowed: {allowed}"
+                )
         for k, e in enumerate(self.insertion):
             if e.material not in known:
-                raise ValueError(f"insertion.{k}.material: unknown material {e.material!r}; "
-                                 f"allowed: {allowed}")
+                raise ValueError(
+                    f"insertion.{k}.material: unknown material {e.material!r}; allowed: {allowed}"
+                )
         for k, o in enumerate(self.interactions):
             for m in o.materials:
                 if m not in known:
-                    raise ValueError(f"interactions.{k}.materials: unknown material {m!r}; "
-                                     f"allowed: {allowed}")
+                    raise ValueError(
+                        f"interactions.{k}.materials: unknown material {m!r}; allowed: {allowed}"
+                    )
         return self

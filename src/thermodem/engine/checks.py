@@ -45,8 +45,13 @@ def characteristic_speed(case: Case, velocities: np.ndarray | None = None) -> fl
     return max(speeds)
 
 
-def critical_times(case: Case, radius: np.ndarray, type_id: np.ndarray,
-                   names: list[str], velocities: np.ndarray | None = None) -> dict[str, float]:
+def critical_times(
+    case: Case,
+    radius: np.ndarray,
+    type_id: np.ndarray,
+    names: list[str],
+    velocities: np.ndarray | None = None,
+) -> dict[str, float]:
     """Smallest Rayleigh time and collision time over materials present [s]."""
     v = characteristic_speed(case, velocities)
     r_min = {}
@@ -59,10 +64,10 @@ def critical_times(case: Case, radius: np.ndarray, type_id: np.ndarray,
     wall_mats = {w.material for w in case.walls}
     for a, ra in r_min.items():
         ma = case.materials[a]
-        out["rayleigh"] = min(out["rayleigh"], rayleigh_time(ra, ma.density, ma.shear_modulus,
-                                                             ma.poisson_ratio))
-        partners = [(b, r_min[b], False) for b in r_min] + [(b, math.inf, True)
-                                                               for b in wall_mats]
+        out["rayleigh"] = min(
+            out["rayleigh"], rayleigh_time(ra, ma.density, ma.shear_modulus, ma.poisson_ratio)
+        )
+        partners = [(b, r_min[b], False) for b in r_min] + [(b, math.inf, True) for b in wall_mats]
         for b, rb, is_wall in partners:
             mb = case.materials[b]
             m_a = ma.density * 4.0 / 3.0 * math.pi * ra**3
@@ -81,8 +86,13 @@ def critical_times(case: Case, radius: np.ndarray, type_id: np.ndarray,
     return out
 
 
-def check_time_step(case: Case, radius: np.ndarray, type_id: np.ndarray, names: list[str],
-                    velocities: np.ndarray | None = None) -> list[str]:
+def check_time_step(
+    case: Case,
+    radius: np.ndarray,
+    type_id: np.ndarray,
+    names: list[str],
+    velocities: np.ndarray | None = None,
+) -> list[str]:
     """Warnings about the time step; raises ConfigError when it is refused."""
     dt = case.simulation.time_step
     chk = case.simulation.time_step_check
@@ -91,22 +101,29 @@ def check_time_step(case: Case, radius: np.ndarray, type_id: np.ndarray, names: 
     refusals: list[str] = []
     if math.isfinite(t["rayleigh"]):
         frac = dt / t["rayleigh"]
-        msg = (f"simulation.time_step = {dt:.4g} s is {frac:.3g} × the Rayleigh time "
-               f"{t['rayleigh']:.4g} s (Li et al. 2005)")
+        msg = (
+            f"simulation.time_step = {dt:.4g} s is {frac:.3g} × the Rayleigh time "
+            f"{t['rayleigh']:.4g} s (Li et al. 2005)"
+        )
         if frac > 1.0:
             refusals.append(msg + "; the limit is 1")
         elif frac > chk.rayleigh_warn_fraction:
             warnings.append(msg + f"; above the warning fraction {chk.rayleigh_warn_fraction}")
     if math.isfinite(t["collision"]):
         steps = t["collision"] / dt
-        msg = (f"simulation.time_step = {dt:.4g} s resolves the collision time "
-               f"{t['collision']:.4g} s (at {t['impact_speed']:.3g} m/s) with {steps:.3g} steps")
+        msg = (
+            f"simulation.time_step = {dt:.4g} s resolves the collision time "
+            f"{t['collision']:.4g} s (at {t['impact_speed']:.3g} m/s) with {steps:.3g} steps"
+        )
         if steps < chk.collision_min_steps:
             refusals.append(msg + f"; at least {chk.collision_min_steps:g} are required")
         elif steps < chk.collision_warn_steps:
             warnings.append(msg + f"; fewer than {chk.collision_warn_steps:g} recommended")
     if refusals and not chk.allow_unstable:
-        raise ConfigError("time step refused:\n" + "\n".join(refusals)
-                          + "\n(set simulation.time_step_check.allow_unstable: true to run "
-                          "anyway)")
+        raise ConfigError(
+            "time step refused:\n"
+            + "\n".join(refusals)
+            + "\n(set simulation.time_step_check.allow_unstable: true to run "
+            "anyway)"
+        )
     return refusals + warnings

@@ -30,8 +30,10 @@ def prepare_output_dir(path: Path, overwrite: bool) -> None:
     if path.exists() and not path.is_dir():
         raise ConfigError(f"--output {str(path)!r} exists and is not a directory")
     if path.exists() and any(path.iterdir()) and not overwrite:
-        raise ConfigError(f"--output {str(path)!r} exists and is not empty; choose another "
-                          "directory or pass --overwrite")
+        raise ConfigError(
+            f"--output {str(path)!r} exists and is not empty; choose another "
+            "directory or pass --overwrite"
+        )
     path.mkdir(parents=True, exist_ok=True)
 
 
@@ -75,28 +77,40 @@ class FrameWriter:
         self.particles_pvd.add(sim.time, f"vtk/{name}")
         if sim.wall_rows.shape[0]:
             wname = f"walls_{sim.step_count:09d}.vtu"
-            write_walls_vtu(self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows,
-                            None, self.wall_extent)
+            write_walls_vtu(
+                self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows, None, self.wall_extent
+            )
             self.walls_pvd.add(sim.time, f"vtk/{wname}")
         self.frames += 1
 
 
-def run_case(case: Case, output: Path, threads: int | None = None, overwrite: bool = False,
-             log: TextIO = sys.stdout) -> Simulation:
+def run_case(
+    case: Case,
+    output: Path,
+    threads: int | None = None,
+    overwrite: bool = False,
+    log: TextIO = sys.stdout,
+) -> Simulation:
     """Validate, build, run to ``simulation.end_time`` and write the output directory."""
     output = Path(output)
     prepare_output_dir(output, overwrite)
     (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
     sim = Simulation(case, threads=threads)
-    for warning in check_time_step(case, sim.particles.radius, sim.particles.type_id,
-                                   sim.material_names, sim.particles.velocity):
+    for warning in check_time_step(
+        case,
+        sim.particles.radius,
+        sim.particles.type_id,
+        sim.material_names,
+        sim.particles.velocity,
+    ):
         print(f"warning: {warning}", file=log)
     settings = case.simulation
     interval = case.output.interval or settings.end_time / 20.0
     every = max(1, int(round(interval / sim.dt)))
     total = int(round(settings.end_time / sim.dt))
-    extent = case.output.wall_extent or 0.5 * float(np.max(np.subtract(case.domain.upper,
-                                                                       case.domain.lower)))
+    extent = case.output.wall_extent or 0.5 * float(
+        np.max(np.subtract(case.domain.upper, case.domain.lower))
+    )
     writer = FrameWriter(output, extent) if case.output.vtu else None
     if writer:
         writer.write(sim)
@@ -111,9 +125,12 @@ def run_case(case: Case, output: Path, threads: int | None = None, overwrite: bo
         now = wallclock.perf_counter()
         if now - last_log > 5.0 or sim.step_count == total:
             rate = particle_steps / max(now - start, 1e-9)
-            print(f"t = {sim.time:.5g} s ({100 * sim.step_count / total:.0f} %), step "
-                  f"{sim.step_count}, {sim.particles.count} particles, {sim.contact_count} "
-                  f"contacts, {rate:.3g} particle-steps/s", file=log)
+            print(
+                f"t = {sim.time:.5g} s ({100 * sim.step_count / total:.0f} %), step "
+                f"{sim.step_count}, {sim.particles.count} particles, {sim.contact_count} "
+                f"contacts, {rate:.3g} particle-steps/s",
+                file=log,
+            )
             last_log = now
     if writer and sim.step_count % every != 0:
         writer.write(sim)

@@ -14,7 +14,6 @@ Order inside one step (``Simulation.step``), held by the tests:
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 import numba
@@ -135,10 +134,11 @@ class Simulation:
         self.lower = np.asarray(dom.lower, np.float64)
         self.upper = np.asarray(dom.upper, np.float64)
         self.periodic = np.asarray(dom.periodic, np.bool_)
-        self.wall_kind, self.wall_rows, self.wall_labels = wall_rows(case.walls,
-                                                                     self.material_index)
+        self.wall_kind, self.wall_rows, self.wall_labels = wall_rows(
+            case.walls, self.material_index
+        )
         self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
-        self.wall_reference = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3].copy()
+        self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         # particles
         self.particles = Particles.empty()
         self.next_global_id = 0
@@ -147,8 +147,9 @@ class Simulation:
             if entry.kind == "pour":
                 self.pourers.append(Pourer(entry, self.rng))
             else:
-                self.add_particles(insert(entry, self.rng, self.particles.position,
-                                          self.particles.radius))
+                self.add_particles(
+                    insert(entry, self.rng, self.particles.position, self.particles.radius)
+                )
         # neighbour list
         nb = case.neighbors
         self.extra = float(nb.extra_distance)
@@ -189,8 +190,15 @@ class Simulation:
             temperature = np.full(n, self.case.simulation.initial_temperature)
         gids = np.arange(self.next_global_id, self.next_global_id + n, dtype=np.int64)
         self.next_global_id += n
-        extra = Particles.create(new.position, new.radius, np.full(n, self.density[t]),
-                                 np.full(n, t, np.int32), gids, new.velocity, temperature)
+        extra = Particles.create(
+            new.position,
+            new.radius,
+            np.full(n, self.density[t]),
+            np.full(n, t, np.int32),
+            gids,
+            new.velocity,
+            temperature,
+        )
         if hasattr(self, "ledger_cumulative"):
             self.ledger_cumulative["inserted_energy"] += float(
                 0.5 * np.sum(extra.mass * np.sum(extra.velocity**2, axis=1))
@@ -226,7 +234,10 @@ class Simulation:
                 raise SimulationError(
                     f"periodic axis {'xyz'[a]}: domain length {length[a]:.6g} m is shorter than "
                     f"twice the interaction cut-off {cell:.6g} m (minimum image needs >= "
-                    f"{2 * cell:.6g} m)", self.step_count, self.time)
+                    f"{2 * cell:.6g} m)",
+                    self.step_count,
+                    self.time,
+                )
         # old keys (global ids) before particles move in memory
         pb, wb = self.pairs, self.walls
         dims, edge = NB.cell_grid(self.lower, self.upper, cell, self.periodic)
@@ -237,14 +248,25 @@ class Simulation:
         p.permute(order)
         # particle pairs
         while True:
-            count = NB.build_pairs(p.position, p.radius, p.global_id, self.lower, self.upper,
-                                   self.periodic, dims, edge, cell_start, self.extra,
-                                   self.skin, pb.i, pb.j)
+            count = NB.build_pairs(
+                p.position,
+                p.radius,
+                p.global_id,
+                self.lower,
+                self.upper,
+                self.periodic,
+                dims,
+                edge,
+                cell_start,
+                self.extra,
+                self.skin,
+                pb.i,
+                pb.j,
+            )
             if count <= pb.capacity:
                 break
             pb.grow_keep_history(int(count * 1.25) + 16)
-        self._carry(pb, count, p.global_id[pb.i[:count]], p.global_id[pb.j[:count]],
-                    "lookup_start")
+        self._carry(pb, count, p.global_id[pb.i[:count]], p.global_id[pb.j[:count]], "lookup_start")
         if self.row_start.shape[0] != n + 1:
             self.row_start = np.zeros(n + 1, np.int64)
         if self.entries.shape[0] < 2 * pb.capacity:
@@ -254,23 +276,47 @@ class Simulation:
         if self.wall_row_start.shape[0] != n + 1:
             self.wall_row_start = np.zeros(n + 1, np.int64)
         while True:
-            wcount = NB.build_wall_pairs(p.position, p.radius, self.wall_kind, self.wall_rows,
-                                         self.extra, self.skin, wb.i, wb.j, self.wall_row_start)
+            wcount = NB.build_wall_pairs(
+                p.position,
+                p.radius,
+                self.wall_kind,
+                self.wall_rows,
+                self.extra,
+                self.skin,
+                wb.i,
+                wb.j,
+                self.wall_row_start,
+            )
             if wcount <= wb.capacity:
                 break
             wb.grow_keep_history(int(wcount * 1.25) + 16)
-        self._carry(wb, wcount, p.global_id[wb.i[:wcount]], wb.j[:wcount].astype(np.int64),
-                    "wall_lookup_start")
+        self._carry(
+            wb,
+            wcount,
+            p.global_id[wb.i[:wcount]],
+            wb.j[:wcount].astype(np.int64),
+            "wall_lookup_start",
+        )
         self.reference = p.position.copy()
-        self.wall_reference = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3].copy()
+        self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         self.rebuild_count += 1
         self._needs_rebuild = False
 
-    def _carry(self, buf: _PairBuffers, count: int, new_a: np.ndarray, new_b: np.ndarray,
-               lookup_attr: str) -> None:
+    def _carry(
+        self, buf: _PairBuffers, count: int, new_a: np.ndarray, new_b: np.ndarray, lookup_attr: str
+    ) -> None:
         old_start = getattr(self, lookup_attr)
-        NB.carry_history(new_a, new_b, count, buf.key_a, buf.key_b, old_start,
-                         buf.lookup_order, buf.history, buf.spare_history)
+        NB.carry_history(
+            new_a,
+            new_b,
+            count,
+            buf.key_a,
+            buf.key_b,
+            old_start,
+            buf.lookup_order,
+            buf.history,
+            buf.spare_history,
+        )
         buf.history, buf.spare_history = buf.spare_history, buf.history
         buf.key_a[:count] = new_a
         buf.key_b[:count] = new_b
@@ -286,7 +332,7 @@ class Simulation:
         moved = self.moved
         wall_moved = 0.0
         if self.wall_rows.shape[0]:
-            shift = self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3] - self.wall_reference
+            shift = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3] - self.wall_reference
             wall_moved = float(np.sqrt((shift**2).sum(axis=1)).max())
         return 2.0 * moved > self.skin or moved + wall_moved > self.skin
 
@@ -298,23 +344,87 @@ class Simulation:
         pb, wb = self.pairs, self.walls
         nid, tid, rid = self.model_ids
         C.particle_pair_pass(
-            p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
-            p.type_id, pb.i, pb.j, pb.count, pb.history, self.lower, self.upper, self.periodic,
-            self.extra, self.dt, nid, self.normal_table, tid, self.tangential_table, rid,
-            self.rolling_table, pb.force, pb.lever, pb.roll, pb.dissipation, pb.normal_force,
-            pb.state, pb.chunk_ledger,
+            p.position,
+            p.velocity,
+            p.angular_velocity,
+            p.radius,
+            p.mass,
+            p.moment_of_inertia,
+            p.type_id,
+            pb.i,
+            pb.j,
+            pb.count,
+            pb.history,
+            self.lower,
+            self.upper,
+            self.periodic,
+            self.extra,
+            self.dt,
+            nid,
+            self.normal_table,
+            tid,
+            self.tangential_table,
+            rid,
+            self.rolling_table,
+            pb.force,
+            pb.lever,
+            pb.roll,
+            pb.dissipation,
+            pb.normal_force,
+            pb.state,
+            pb.chunk_ledger,
         )
         C.wall_pair_pass(
-            p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
-            p.type_id, wb.i, wb.j, wb.count, wb.history, self.wall_kind, self.wall_rows,
-            self.wall_material, self.extra, self.dt, nid, self.normal_table, tid,
-            self.tangential_table, rid, self.rolling_table, wb.force, wb.lever, wb.roll,
-            wb.dissipation, wb.normal_force, wb.state, wb.chunk_ledger,
+            p.position,
+            p.velocity,
+            p.angular_velocity,
+            p.radius,
+            p.mass,
+            p.moment_of_inertia,
+            p.type_id,
+            wb.i,
+            wb.j,
+            wb.count,
+            wb.history,
+            self.wall_kind,
+            self.wall_rows,
+            self.wall_material,
+            self.extra,
+            self.dt,
+            nid,
+            self.normal_table,
+            tid,
+            self.tangential_table,
+            rid,
+            self.rolling_table,
+            wb.force,
+            wb.lever,
+            wb.roll,
+            wb.dissipation,
+            wb.normal_force,
+            wb.state,
+            wb.chunk_ledger,
         )
         reduce_and_kick(
-            p.radius, p.mass, p.moment_of_inertia, p.velocity, p.angular_velocity, p.force,
-            p.torque, self.gravity, self.dt, self.row_start, self.entries, pb.force, pb.lever,
-            pb.roll, self.wall_row_start, wb.force, wb.lever, wb.roll, kick,
+            p.radius,
+            p.mass,
+            p.moment_of_inertia,
+            p.velocity,
+            p.angular_velocity,
+            p.force,
+            p.torque,
+            self.gravity,
+            self.dt,
+            self.row_start,
+            self.entries,
+            pb.force,
+            pb.lever,
+            pb.roll,
+            self.wall_row_start,
+            wb.force,
+            wb.lever,
+            wb.roll,
+            kick,
         )
         self._accumulate_ledger(kick)
 
@@ -323,10 +433,12 @@ class Simulation:
         npc = (pb.count + C.CHUNK - 1) // C.CHUNK
         nwc = (wb.count + C.CHUNK - 1) // C.CHUNK
         sums = sum_rows(pb.chunk_ledger, npc) + sum_rows(wb.chunk_ledger, nwc)
-        self.elastic = sums[C.L_ELASTIC_NORMAL:C.L_ELASTIC_ROLLING + 1].copy()
+        self.elastic = sums[C.L_ELASTIC_NORMAL : C.L_ELASTIC_ROLLING + 1].copy()
         self.contact_count = int(sums[C.L_TOUCHING])
-        self.max_overlap_ratio = max(max_column(pb.chunk_ledger, npc, C.L_MAX_OVERLAP_RATIO),
-                                     max_column(wb.chunk_ledger, nwc, C.L_MAX_OVERLAP_RATIO))
+        self.max_overlap_ratio = max(
+            max_column(pb.chunk_ledger, npc, C.L_MAX_OVERLAP_RATIO),
+            max_column(wb.chunk_ledger, nwc, C.L_MAX_OVERLAP_RATIO),
+        )
         if count_dissipation:
             cum = self.ledger_cumulative
             cum["normal_damping"] += sums[C.L_NORMAL_DAMPING]
@@ -343,27 +455,45 @@ class Simulation:
         nchunks = p.count // CHECK_CHUNK + 1
         if self.chunk_check.shape[0] < nchunks:
             self.chunk_check = np.zeros((nchunks, 3))
-        kick_drift(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
-                   p.moment_of_inertia, self.dt, self.lower, self.upper, self.periodic,
-                   self.reference, self.chunk_check)
+        kick_drift(
+            p.position,
+            p.velocity,
+            p.angular_velocity,
+            p.force,
+            p.torque,
+            p.mass,
+            p.moment_of_inertia,
+            self.dt,
+            self.lower,
+            self.upper,
+            self.periodic,
+            self.reference,
+            self.chunk_check,
+        )
         self.moved, bad, code = reduce_checks(self.chunk_check, p.count)
         if bad >= 0:
             self._particle_failure(bad, code)
         self.time = (self.step_count + 1) * self.dt
         self.step_count += 1
         if self.wall_rows.shape[0]:
-            self.wall_rows[:, WL.COL_POINT:WL.COL_POINT + 3] += (
-                self.wall_rows[:, WL.COL_VELOCITY:WL.COL_VELOCITY + 3] * self.dt
+            self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3] += (
+                self.wall_rows[:, WL.COL_VELOCITY : WL.COL_VELOCITY + 3] * self.dt
             )
         for pourer in self.pourers:
             if pourer.due(self.time, self.dt):
-                self.add_particles(pourer.emit(self.time, self.particles.position,
-                                               self.particles.radius))
+                self.add_particles(
+                    pourer.emit(self.time, self.particles.position, self.particles.radius)
+                )
         self._compute_forces(kick=True)
         self._check_overlap()
 
-    def run(self, steps: int | None = None, until: float | None = None,
-            callback: Callable[[Simulation], None] | None = None, every: int = 1) -> None:
+    def run(
+        self,
+        steps: int | None = None,
+        until: float | None = None,
+        callback: Callable[[Simulation], None] | None = None,
+        every: int = 1,
+    ) -> None:
         """Advance ``steps`` steps, or until simulated time ``until`` [s]."""
         if (steps is None) == (until is None):
             raise ValueError("give exactly one of steps= or until=")
@@ -390,11 +520,17 @@ class Simulation:
                 f"non-finite position or velocity of particle {gid} {where}: x = {x.tolist()}, "
                 f"v = {v.tolist()}; likely cause: time step {self.dt:g} s too large for the "
                 f"contact stiffness (see the Rayleigh and Hertz checks of 'validate')",
-                step, time, gid)
+                step,
+                time,
+                gid,
+            )
         raise SimulationError(
             f"particle {gid} left the domain {where}: position {x.tolist()} outside "
             f"[{self.lower.tolist()}, {self.upper.tolist()}], velocity {v.tolist()} m/s",
-            step, time, gid)
+            step,
+            time,
+            gid,
+        )
 
     def _check_overlap(self) -> None:
         where = self._where()
@@ -404,7 +540,9 @@ class Simulation:
                 f"overlap of {self.max_overlap_ratio:.3g} × the smaller radius {where} exceeds "
                 f"simulation.max_overlap_ratio = {limit}; likely cause: contact stiffness too "
                 f"low for the loads, or time step {self.dt:g} s too large",
-                self.step_count, self.time)
+                self.step_count,
+                self.time,
+            )
 
     # ------------------------------------------------------------------------------ ledger
     def energies(self) -> dict[str, float]:
@@ -421,8 +559,13 @@ class Simulation:
             "elastic_tangential": float(self.elastic[1]),
             "elastic_rolling": float(self.elastic[2]),
         }
-        out.update({f"dissipated_{k}": v for k, v in self.ledger_cumulative.items()
-                    if k in LEDGER_DISSIPATION})
+        out.update(
+            {
+                f"dissipated_{k}": v
+                for k, v in self.ledger_cumulative.items()
+                if k in LEDGER_DISSIPATION
+            }
+        )
         out["stiffness_work"] = self.ledger_cumulative["stiffness_work"]
         out["wall_work"] = self.ledger_cumulative["wall_work"]
         out["inserted_energy"] = self.ledger_cumulative["inserted_energy"]
@@ -431,15 +574,27 @@ class Simulation:
     def total_energy(self) -> float:
         """Mechanical energy now: kinetic + gravitational + elastic [J]."""
         e = self.energies()
-        return (e["kinetic_translational"] + e["kinetic_rotational"] + e["gravitational"]
-                + e["elastic_normal"] + e["elastic_tangential"] + e["elastic_rolling"])
+        return (
+            e["kinetic_translational"]
+            + e["kinetic_rotational"]
+            + e["gravitational"]
+            + e["elastic_normal"]
+            + e["elastic_tangential"]
+            + e["elastic_rolling"]
+        )
 
     def energy_balance_error(self) -> float:
         """E(t) + dissipated - stiffness work - wall work - inserted - E(0) [J]; ~0."""
         e = self.energies()
         dissipated = sum(e[f"dissipated_{k}"] for k in LEDGER_DISSIPATION)
-        return (self.total_energy() + dissipated - e["stiffness_work"] - e["wall_work"]
-                - e["inserted_energy"] - self.initial_energy)
+        return (
+            self.total_energy()
+            + dissipated
+            - e["stiffness_work"]
+            - e["wall_work"]
+            - e["inserted_energy"]
+            - self.initial_energy
+        )
 
     # ------------------------------------------------------------------------ pair access
     def touching_pairs(self) -> tuple[np.ndarray, np.ndarray]:
@@ -464,7 +619,6 @@ class Simulation:
         """Rayleigh and Hertz collision times of the current particles (see engine.checks)."""
         from thermodem.engine.checks import critical_times
 
-        return critical_times(self.case, self.particles.radius, self.particles.type_id,
-                              self.material_names)
-
-
+        return critical_times(
+            self.case, self.particles.radius, self.particles.type_id, self.material_names
+        )

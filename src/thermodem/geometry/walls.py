@@ -55,8 +55,9 @@ class RectangleWall(_WallBase):
         n = _unit(self.normal, "normal")
         u = _unit(self.u_axis, "u_axis")
         if abs(float(n @ u)) > 1e-9:
-            raise ValueError(f"u_axis {list(self.u_axis)} must be perpendicular to normal "
-                             f"{list(self.normal)}")
+            raise ValueError(
+                f"u_axis {list(self.u_axis)} must be perpendicular to normal {list(self.normal)}"
+            )
         if min(self.half_extents) <= 0:
             raise ValueError(f"half_extents must be positive, got {list(self.half_extents)}")
         return self
@@ -73,8 +74,9 @@ class BoxWall(_WallBase):
     @model_validator(mode="after")
     def _check(self) -> BoxWall:
         if any(u <= lo for lo, u in zip(self.lower, self.upper, strict=True)):
-            raise ValueError(f"lower {list(self.lower)} must be below upper {list(self.upper)} "
-                             "on every axis")
+            raise ValueError(
+                f"lower {list(self.lower)} must be below upper {list(self.upper)} on every axis"
+            )
         return self
 
 
@@ -125,15 +127,23 @@ def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, 
                     va = (axis + 2) % 3
                     u = np.zeros(3)
                     u[ua] = 1.0
-                    faces.append((center, normal, u, h[ua], h[va], f"{label}.{'xyz'[axis]}"
-                                  f"{'-' if side < 0 else '+'}"))
+                    faces.append(
+                        (
+                            center,
+                            normal,
+                            u,
+                            h[ua],
+                            h[va],
+                            f"{label}.{'xyz'[axis]}{'-' if side < 0 else '+'}",
+                        )
+                    )
             for center, normal, u, hu, hv, lab in faces:
                 # v = normal x u must be the axis va (up to sign): use |hv| either way
                 row = np.zeros(L.WALL_WIDTH)
-                row[L.COL_POINT:L.COL_POINT + 3] = center
-                row[L.COL_NORMAL:L.COL_NORMAL + 3] = normal
-                row[L.COL_VELOCITY:L.COL_VELOCITY + 3] = w.velocity
-                row[L.COL_U:L.COL_U + 3] = u
+                row[L.COL_POINT : L.COL_POINT + 3] = center
+                row[L.COL_NORMAL : L.COL_NORMAL + 3] = normal
+                row[L.COL_VELOCITY : L.COL_VELOCITY + 3] = w.velocity
+                row[L.COL_U : L.COL_U + 3] = u
                 row[L.COL_HALF_U] = hu
                 row[L.COL_HALF_V] = hv
                 row[L.COL_MATERIAL] = mat
@@ -142,22 +152,22 @@ def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, 
                 labels.append(lab)
             continue
         row = np.zeros(L.WALL_WIDTH)
-        row[L.COL_VELOCITY:L.COL_VELOCITY + 3] = w.velocity
+        row[L.COL_VELOCITY : L.COL_VELOCITY + 3] = w.velocity
         row[L.COL_MATERIAL] = mat
         if isinstance(w, PlaneWall):
-            row[L.COL_POINT:L.COL_POINT + 3] = w.point
-            row[L.COL_NORMAL:L.COL_NORMAL + 3] = _unit(w.normal, "normal")
+            row[L.COL_POINT : L.COL_POINT + 3] = w.point
+            row[L.COL_NORMAL : L.COL_NORMAL + 3] = _unit(w.normal, "normal")
             kinds.append(L.PLANE)
         elif isinstance(w, RectangleWall):
-            row[L.COL_POINT:L.COL_POINT + 3] = w.center
-            row[L.COL_NORMAL:L.COL_NORMAL + 3] = _unit(w.normal, "normal")
-            row[L.COL_U:L.COL_U + 3] = _unit(w.u_axis, "u_axis")
+            row[L.COL_POINT : L.COL_POINT + 3] = w.center
+            row[L.COL_NORMAL : L.COL_NORMAL + 3] = _unit(w.normal, "normal")
+            row[L.COL_U : L.COL_U + 3] = _unit(w.u_axis, "u_axis")
             row[L.COL_HALF_U] = w.half_extents[0]
             row[L.COL_HALF_V] = w.half_extents[1]
             kinds.append(L.RECTANGLE)
         elif isinstance(w, CylinderWall):
-            row[L.COL_POINT:L.COL_POINT + 3] = w.center
-            row[L.COL_AXIS:L.COL_AXIS + 3] = _unit(w.axis, "axis")
+            row[L.COL_POINT : L.COL_POINT + 3] = w.center
+            row[L.COL_AXIS : L.COL_AXIS + 3] = _unit(w.axis, "axis")
             row[L.COL_RADIUS] = w.radius
             row[L.COL_HALF_LENGTH] = np.inf if w.length is None else 0.5 * w.length
             row[L.COL_SIDE] = 1.0 if w.inside else -1.0

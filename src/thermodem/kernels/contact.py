@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_AXIS, COL_OMEGA, COL_POINT, COL_VELOCITY
@@ -86,10 +85,34 @@ def _rotate_into_plane(h, k, c0, nx, ny, nz):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def contact_response(
-    k, history, nx, ny, nz, overlap, eff_radius, eff_mass, rolling_inertia,
-    vrx, vry, vrz, wrx, wry, wrz, dt,
-    normal_id, p_normal, tangential_id, p_tangential, rolling_id, p_rolling,
-    out_force, out_lever, out_roll, out_diss, out_normal_force, ledger_row,
+    k,
+    history,
+    nx,
+    ny,
+    nz,
+    overlap,
+    eff_radius,
+    eff_mass,
+    rolling_inertia,
+    vrx,
+    vry,
+    vrz,
+    wrx,
+    wry,
+    wrz,
+    dt,
+    normal_id,
+    p_normal,
+    tangential_id,
+    p_tangential,
+    rolling_id,
+    p_rolling,
+    out_force,
+    out_lever,
+    out_roll,
+    out_diss,
+    out_normal_force,
+    ledger_row,
 ):
     """Forces of one touching contact (row k of the pair or wall-pair arrays).
 
@@ -108,11 +131,29 @@ def contact_response(
     vtz = vrz - rate * nz
     sx, sy, sz = _rotate_into_plane(history, k, H_SPRING, nx, ny, nz)
     ftx, fty, ftz, sx, sy, sz, k_t, p_tdamp, e_slip = tangential_dispatch(
-        tangential_id, p_tangential, k_ref, gamma_n, eff_radius, overlap, f_n,
-        vtx, vty, vtz, sx, sy, sz, dt,
+        tangential_id,
+        p_tangential,
+        k_ref,
+        gamma_n,
+        eff_radius,
+        overlap,
+        f_n,
+        vtx,
+        vty,
+        vtz,
+        sx,
+        sy,
+        sz,
+        dt,
     )
-    u_t_rotated = 0.5 * k_t * (
-        history[k, H_SPRING] ** 2 + history[k, H_SPRING + 1] ** 2 + history[k, H_SPRING + 2] ** 2
+    u_t_rotated = (
+        0.5
+        * k_t
+        * (
+            history[k, H_SPRING] ** 2
+            + history[k, H_SPRING + 1] ** 2
+            + history[k, H_SPRING + 2] ** 2
+        )
     )
     stiffness_work = u_t_rotated - history[k, H_SPRING_ENERGY]
     u_t = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
@@ -136,8 +177,19 @@ def contact_response(
         my = 0.0
         mz = 0.0
     tx, ty, tz, mx, my, mz, k_r, e_roll = rolling_dispatch(
-        rolling_id, p_rolling, k_ref, eff_radius, rolling_inertia, f_n,
-        wrx, wry, wrz, mx, my, mz, dt,
+        rolling_id,
+        p_rolling,
+        k_ref,
+        eff_radius,
+        rolling_inertia,
+        f_n,
+        wrx,
+        wry,
+        wrz,
+        mx,
+        my,
+        mz,
+        dt,
     )
     u_r = 0.0
     if has_roll_history:
@@ -180,8 +232,9 @@ def contact_response(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _clear_contact(k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
-                   ledger_row):
+def _clear_contact(
+    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, ledger_row
+):
     # energy left in springs when a contact opens is released as friction (documented)
     ledger_row[L_SLIDING_FRICTION] += history[k, H_SPRING_ENERGY]
     if history.shape[1] >= HISTORY_WIDTH_ROLLING:
@@ -201,10 +254,35 @@ def _clear_contact(k, history, out_force, out_lever, out_roll, out_diss, out_nor
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def particle_pair_pass(
-    position, velocity, angular_velocity, radius, mass, inertia, type_id,
-    pair_i, pair_j, npairs, history, lower, upper, periodic, extra, dt,
-    normal_id, normal_table, tangential_id, tangential_table, rolling_id, rolling_table,
-    out_force, out_lever, out_roll, out_diss, out_normal_force, out_state, chunk_ledger,
+    position,
+    velocity,
+    angular_velocity,
+    radius,
+    mass,
+    inertia,
+    type_id,
+    pair_i,
+    pair_j,
+    npairs,
+    history,
+    lower,
+    upper,
+    periodic,
+    extra,
+    dt,
+    normal_id,
+    normal_table,
+    tangential_id,
+    tangential_table,
+    rolling_id,
+    rolling_table,
+    out_force,
+    out_lever,
+    out_roll,
+    out_diss,
+    out_normal_force,
+    out_state,
+    chunk_ledger,
 ):
     """Contact forces of every listed particle pair (see module docstring)."""
     length = upper - lower
@@ -225,8 +303,9 @@ def particle_pair_pass(
             overlap = ri + rj - dist
             if overlap <= 0.0 or dist == 0.0:
                 if history[k, H_DURATION] != 0.0:
-                    _clear_contact(k, history, out_force, out_lever, out_roll, out_diss,
-                                   out_normal_force, row)
+                    _clear_contact(
+                        k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
+                    )
                 else:
                     for q in range(3):
                         out_force[k, q] = 0.0
@@ -264,11 +343,34 @@ def particle_pair_pass(
             ti = type_id[i]
             tj = type_id[j]
             contact_response(
-                k, history, nx, ny, nz, overlap, eff_radius, eff_mass, rolling_inertia,
-                vrx, vry, vrz, wix - wjx, wiy - wjy, wiz - wjz, dt,
-                normal_id, normal_table[ti, tj], tangential_id, tangential_table[ti, tj],
-                rolling_id, rolling_table[ti, tj],
-                out_force, out_lever, out_roll, out_diss, out_normal_force, row,
+                k,
+                history,
+                nx,
+                ny,
+                nz,
+                overlap,
+                eff_radius,
+                eff_mass,
+                rolling_inertia,
+                vrx,
+                vry,
+                vrz,
+                wix - wjx,
+                wiy - wjy,
+                wiz - wjz,
+                dt,
+                normal_id,
+                normal_table[ti, tj],
+                tangential_id,
+                tangential_table[ti, tj],
+                rolling_id,
+                rolling_table[ti, tj],
+                out_force,
+                out_lever,
+                out_roll,
+                out_diss,
+                out_normal_force,
+                row,
             )
             ratio = overlap / min(ri, rj)
             if ratio > row[L_MAX_OVERLAP_RATIO]:
@@ -277,10 +379,35 @@ def particle_pair_pass(
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def wall_pair_pass(
-    position, velocity, angular_velocity, radius, mass, inertia, type_id,
-    wall_pair_i, wall_pair_w, nwpairs, history, wall_kind, wall_rows, wall_material, extra, dt,
-    normal_id, normal_table, tangential_id, tangential_table, rolling_id, rolling_table,
-    out_force, out_lever, out_roll, out_diss, out_normal_force, out_state, chunk_ledger,
+    position,
+    velocity,
+    angular_velocity,
+    radius,
+    mass,
+    inertia,
+    type_id,
+    wall_pair_i,
+    wall_pair_w,
+    nwpairs,
+    history,
+    wall_kind,
+    wall_rows,
+    wall_material,
+    extra,
+    dt,
+    normal_id,
+    normal_table,
+    tangential_id,
+    tangential_table,
+    rolling_id,
+    rolling_table,
+    out_force,
+    out_lever,
+    out_roll,
+    out_diss,
+    out_normal_force,
+    out_state,
+    chunk_ledger,
 ):
     """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass)."""
     nchunks = (nwpairs + CHUNK - 1) // CHUNK
@@ -297,8 +424,9 @@ def wall_pair_pass(
             overlap = ri - d
             if overlap <= 0.0:
                 if history[k, H_DURATION] != 0.0:
-                    _clear_contact(k, history, out_force, out_lever, out_roll, out_diss,
-                                   out_normal_force, row)
+                    _clear_contact(
+                        k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
+                    )
                 else:
                     for q in range(3):
                         out_force[k, q] = 0.0
@@ -337,11 +465,34 @@ def wall_pair_pass(
             tw = wall_material[w]
             rolling_inertia = inertia[i] + mass[i] * ri * ri
             f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
-                k, history, nx, ny, nz, overlap, ri, mass[i], rolling_inertia,
-                vrx, vry, vrz, wix - ax, wiy - ay, wiz - az, dt,
-                normal_id, normal_table[ti, tw], tangential_id, tangential_table[ti, tw],
-                rolling_id, rolling_table[ti, tw],
-                out_force, out_lever, out_roll, out_diss, out_normal_force, row,
+                k,
+                history,
+                nx,
+                ny,
+                nz,
+                overlap,
+                ri,
+                mass[i],
+                rolling_inertia,
+                vrx,
+                vry,
+                vrz,
+                wix - ax,
+                wiy - ay,
+                wiz - az,
+                dt,
+                normal_id,
+                normal_table[ti, tw],
+                tangential_id,
+                tangential_table[ti, tw],
+                rolling_id,
+                rolling_table[ti, tw],
+                out_force,
+                out_lever,
+                out_roll,
+                out_diss,
+                out_normal_force,
+                row,
             )
             # work done by the wall on the particle this step
             fx = -f_n * nx + ftx

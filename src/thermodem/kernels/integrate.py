@@ -14,13 +14,25 @@ import math
 import numpy as np
 from numba import njit, prange
 
-
 CHECK_CHUNK = 4096
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def kick_drift(position, velocity, angular_velocity, force, torque, mass, inertia, dt,
-               lower, upper, periodic, reference, chunk_check):
+def kick_drift(
+    position,
+    velocity,
+    angular_velocity,
+    force,
+    torque,
+    mass,
+    inertia,
+    dt,
+    lower,
+    upper,
+    periodic,
+    reference,
+    chunk_check,
+):
     """First half kick and drift; wraps positions on periodic axes.
 
     In the same pass, per chunk of CHECK_CHUNK particles, ``chunk_check`` receives the largest
@@ -80,9 +92,25 @@ def reduce_checks(chunk_check, n):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def reduce_and_kick(
-    radius, mass, inertia, velocity, angular_velocity, force, torque, gravity, dt,
-    row_start, entries, pair_force, pair_lever, pair_roll,
-    wall_row_start, wall_force, wall_lever, wall_roll, kick,
+    radius,
+    mass,
+    inertia,
+    velocity,
+    angular_velocity,
+    force,
+    torque,
+    gravity,
+    dt,
+    row_start,
+    entries,
+    pair_force,
+    pair_lever,
+    pair_roll,
+    wall_row_start,
+    wall_force,
+    wall_lever,
+    wall_roll,
+    kick,
 ):
     """Sum each particle's pair and wall contributions in a fixed order, add gravity, and
     (if ``kick``) apply the second half kick."""

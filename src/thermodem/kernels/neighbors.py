@@ -122,8 +122,21 @@ def _stencil_axis(k, n, periodic, out):
 
 
 @njit(cache=True, error_model="numpy")
-def build_pairs(position, radius, global_id, lower, upper, periodic, dims, edge, cell_start,
-                extra, skin, pair_i, pair_j):
+def build_pairs(
+    position,
+    radius,
+    global_id,
+    lower,
+    upper,
+    periodic,
+    dims,
+    edge,
+    cell_start,
+    extra,
+    skin,
+    pair_i,
+    pair_j,
+):
     """List every pair (i, j) with distance < R_i + R_j + extra + skin, each pair once.
 
     Particles must already be sorted by cell (``cell_start`` from :func:`sort_by_cell` applied
@@ -248,8 +261,9 @@ def wall_distance(kind, row, x):
 
 
 @njit(cache=True, error_model="numpy")
-def build_wall_pairs(position, radius, wall_kind, wall_rows, extra, skin, wall_pair_i,
-                     wall_pair_w, wall_row_start):
+def build_wall_pairs(
+    position, radius, wall_kind, wall_rows, extra, skin, wall_pair_i, wall_pair_w, wall_row_start
+):
     """List (particle, wall) pairs within R + extra + skin, grouped by particle.
 
     Writes ``wall_row_start`` (n + 1 offsets into the wall pair arrays). Returns the count;
@@ -287,8 +301,9 @@ def index_by_first_key(key_a, count, nkeys, start, order):
 
 
 @njit(cache=True, error_model="numpy")
-def carry_history(new_a, new_b, new_count, old_a, old_b, old_start, old_order, old_history,
-                  new_history):
+def carry_history(
+    new_a, new_b, new_count, old_a, old_b, old_start, old_order, old_history, new_history
+):
     """Copy each new pair's history row from the old pair with the same key (a, b), or zero.
 
     ``old_start``/``old_order`` group the old pairs by key a (:func:`index_by_first_key`).

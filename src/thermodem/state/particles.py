@@ -48,8 +48,9 @@ class Particles:
 
     @classmethod
     def empty(cls) -> Particles:
-        return cls.create(np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0, np.int32),
-                          np.zeros(0, np.int64))
+        return cls.create(
+            np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0, np.int32), np.zeros(0, np.int64)
+        )
 
     @classmethod
     def create(

@@ -21,26 +21,95 @@ def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def tangential_dispatch(model_id, p, ref_stiffness, normal_damping, eff_radius, overlap,
-                        normal_force, vtx, vty, vtz, sx, sy, sz, dt):
+def tangential_dispatch(
+    model_id,
+    p,
+    ref_stiffness,
+    normal_damping,
+    eff_radius,
+    overlap,
+    normal_force,
+    vtx,
+    vty,
+    vtz,
+    sx,
+    sy,
+    sz,
+    dt,
+):
     if model_id == tangential.MINDLIN:
-        return tangential.mindlin(p, ref_stiffness, normal_damping, eff_radius, overlap,
-                                  normal_force, vtx, vty, vtz, sx, sy, sz, dt)
+        return tangential.mindlin(
+            p,
+            ref_stiffness,
+            normal_damping,
+            eff_radius,
+            overlap,
+            normal_force,
+            vtx,
+            vty,
+            vtz,
+            sx,
+            sy,
+            sz,
+            dt,
+        )
     if model_id == tangential.LINEAR:
-        return tangential.linear_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap,
-                                            normal_force, vtx, vty, vtz, sx, sy, sz, dt)
-    return tangential.no_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap,
-                                    normal_force, vtx, vty, vtz, sx, sy, sz, dt)
+        return tangential.linear_tangential(
+            p,
+            ref_stiffness,
+            normal_damping,
+            eff_radius,
+            overlap,
+            normal_force,
+            vtx,
+            vty,
+            vtz,
+            sx,
+            sy,
+            sz,
+            dt,
+        )
+    return tangential.no_tangential(
+        p,
+        ref_stiffness,
+        normal_damping,
+        eff_radius,
+        overlap,
+        normal_force,
+        vtx,
+        vty,
+        vtz,
+        sx,
+        sy,
+        sz,
+        dt,
+    )
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def rolling_dispatch(model_id, p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
-                     wx, wy, wz, mx, my, mz, dt):
+def rolling_dispatch(
+    model_id,
+    p,
+    ref_stiffness,
+    eff_radius,
+    rolling_inertia,
+    normal_force,
+    wx,
+    wy,
+    wz,
+    mx,
+    my,
+    mz,
+    dt,
+):
     if model_id == rolling.CONSTANT_TORQUE:
-        return rolling.constant_torque(p, ref_stiffness, eff_radius, rolling_inertia,
-                                       normal_force, wx, wy, wz, mx, my, mz, dt)
+        return rolling.constant_torque(
+            p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt
+        )
     if model_id == rolling.EPSD:
-        return rolling.epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
-                            wx, wy, wz, mx, my, mz, dt)
-    return rolling.no_rolling(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
-                              wx, wy, wz, mx, my, mz, dt)
+        return rolling.epsd(
+            p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt
+        )
+    return rolling.no_rolling(
+        p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt
+    )

@@ -64,8 +64,9 @@ def hertz_restitution_of_alpha(alpha: float) -> float:
 
     opened.terminal = True  # type: ignore[attr-defined]
     opened.direction = -1  # type: ignore[attr-defined]
-    sol = solve_ivp(rhs, (0.0, 60.0), [0.0, 1.0], events=opened, rtol=1e-11, atol=1e-14,
-                    max_step=0.01)
+    sol = solve_ivp(
+        rhs, (0.0, 60.0), [0.0, 1.0], events=opened, rtol=1e-11, atol=1e-14, max_step=0.01
+    )
     if sol.t_events[0].size == 0:
         return 0.0
     return float(-sol.y_events[0][0][1])
@@ -87,8 +88,11 @@ def hertz_alpha_of_restitution(restitution: float) -> float:
             else:
                 hi = mid
         return hi
-    return float(brentq(lambda a: hertz_restitution_of_alpha(a) - restitution, 0.0, 4.0,
-                        xtol=1e-13, rtol=1e-13))
+    return float(
+        brentq(
+            lambda a: hertz_restitution_of_alpha(a) - restitution, 0.0, 4.0, xtol=1e-13, rtol=1e-13
+        )
+    )
 
 
 def pack_hertz(params: HertzParams, pair: PairContext) -> np.ndarray:

@@ -39,8 +39,9 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def no_rolling(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
-               wx, wy, wz, mx, my, mz, dt):
+def no_rolling(
+    p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt
+):
     return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
 
 
@@ -62,8 +63,9 @@ def pack_constant(params: ConstantTorqueParams, pair: PairContext) -> np.ndarray
 
 
 @njit(cache=True, error_model="numpy")
-def constant_torque(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
-                    wx, wy, wz, mx, my, mz, dt):
+def constant_torque(
+    p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt
+):
     w = math.sqrt(wx * wx + wy * wy + wz * wz)
     if w <= p[1] or normal_force <= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -90,8 +92,7 @@ def pack_epsd(params: EPSDParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
-         wx, wy, wz, mx, my, mz, dt):
+def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt):
     mu_r = p[0]
     k_r = 2.25 * ref_stiffness * mu_r * mu_r * eff_radius * eff_radius
     c_r = p[1] * 2.0 * math.sqrt(rolling_inertia * k_r)
@@ -115,15 +116,37 @@ def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force,
     return mx - damp * wx, my - damp * wy, mz - damp * wz, mx, my, mz, k_r, dissipated
 
 
-register(family="rolling", name="none", model_id=NONE, kernel=no_rolling, params=NoneParams,
-         pack=pack_none, summary="no rolling resistance", reference="-")
-register(family="rolling", name="constant_torque", model_id=CONSTANT_TORQUE,
-         kernel=constant_torque, params=ConstantTorqueParams, pack=pack_constant,
-         summary="constant directional torque μ_r R* F_n opposing relative rolling",
-         reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model A); Zhou et al. (1999)",
-         requires=("rolling_friction",))
-register(family="rolling", name="epsd", model_id=EPSD, kernel=epsd, params=EPSDParams,
-         pack=pack_epsd,
-         summary="elastic-plastic spring-dashpot rolling torque (model C)",
-         reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model C); Iwashita & Oda (1998)",
-         requires=("rolling_friction",), history_width=3, history_flip=(True, True, True))
+register(
+    family="rolling",
+    name="none",
+    model_id=NONE,
+    kernel=no_rolling,
+    params=NoneParams,
+    pack=pack_none,
+    summary="no rolling resistance",
+    reference="-",
+)
+register(
+    family="rolling",
+    name="constant_torque",
+    model_id=CONSTANT_TORQUE,
+    kernel=constant_torque,
+    params=ConstantTorqueParams,
+    pack=pack_constant,
+    summary="constant directional torque μ_r R* F_n opposing relative rolling",
+    reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model A); Zhou et al. (1999)",
+    requires=("rolling_friction",),
+)
+register(
+    family="rolling",
+    name="epsd",
+    model_id=EPSD,
+    kernel=epsd,
+    params=EPSDParams,
+    pack=pack_epsd,
+    summary="elastic-plastic spring-dashpot rolling torque (model C)",
+    reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model C); Iwashita & Oda (1998)",
+    requires=("rolling_friction",),
+    history_width=3,
+    history_flip=(True, True, True),
+)

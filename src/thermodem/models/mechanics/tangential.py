@@ -9,7 +9,8 @@ Kernel signature (all float64)::
 ``v_t`` is the tangential velocity of i relative to j at the contact point; ``s`` the
 accumulated tangential spring displacement (history), already rotated into the current tangent
 plane by the caller. Returned: the tangential force on i, the updated displacement, the spring
-stiffness k_t (the stored elastic energy is ½ k_t |s|²), the power dissipated by the tangential dashpot and the energy
+stiffness k_t (the stored elastic energy is ½ k_t |s|²), the power dissipated by the
+tangential dashpot and the energy
 released by sliding this step (the spring energy given up when the trial force exceeds the
 Coulomb limit μ max(F_n, 0)). When the cap is reached the displacement is rescaled so that the
 spring plus dashpot force equals the limit (the history is "rescaled when the cap is reached").
@@ -77,8 +78,21 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def no_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
-                  vtx, vty, vtz, sx, sy, sz, dt):
+def no_tangential(
+    p,
+    ref_stiffness,
+    normal_damping,
+    eff_radius,
+    overlap,
+    normal_force,
+    vtx,
+    vty,
+    vtz,
+    sx,
+    sy,
+    sz,
+    dt,
+):
     return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
 
 
@@ -97,8 +111,21 @@ def pack_mindlin(params: MindlinParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def mindlin(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
-            vtx, vty, vtz, sx, sy, sz, dt):
+def mindlin(
+    p,
+    ref_stiffness,
+    normal_damping,
+    eff_radius,
+    overlap,
+    normal_force,
+    vtx,
+    vty,
+    vtz,
+    sx,
+    sy,
+    sz,
+    dt,
+):
     k_t = 8.0 * p[0] * math.sqrt(eff_radius * overlap)
     gamma_t = normal_damping * math.sqrt(k_t / ref_stiffness) if ref_stiffness > 0.0 else 0.0
     return _spring_dashpot_capped(k_t, gamma_t, p[1], normal_force, vtx, vty, vtz, sx, sy, sz, dt)
@@ -121,24 +148,60 @@ def pack_linear(params: LinearTangentialParams, pair: PairContext) -> np.ndarray
 
 
 @njit(cache=True, error_model="numpy")
-def linear_tangential(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
-                      vtx, vty, vtz, sx, sy, sz, dt):
+def linear_tangential(
+    p,
+    ref_stiffness,
+    normal_damping,
+    eff_radius,
+    overlap,
+    normal_force,
+    vtx,
+    vty,
+    vtz,
+    sx,
+    sy,
+    sz,
+    dt,
+):
     k_t = p[0] * ref_stiffness
     gamma_t = normal_damping * math.sqrt(p[0])
     return _spring_dashpot_capped(k_t, gamma_t, p[1], normal_force, vtx, vty, vtz, sx, sy, sz, dt)
 
 
 _COMMON = dict(history_width=3, history_flip=(True, True, True))
-register(family="tangential", name="none", model_id=NONE, kernel=no_tangential,
-         params=NoneParams, pack=pack_none, summary="no tangential force",
-         reference="-", history_width=0, history_flip=())
-register(family="tangential", name="mindlin", model_id=MINDLIN, kernel=mindlin,
-         params=MindlinParams, pack=pack_mindlin,
-         summary="Mindlin no-slip stiffness 8G*sqrt(R*δ), Coulomb cap, history rescaled",
-         reference="Mindlin (1949) J. Appl. Mech. 16, 259-268; Di Renzo & Di Maio (2004)",
-         requires=("youngs_modulus", "poisson_ratio", "sliding_friction"), **_COMMON)
-register(family="tangential", name="linear", model_id=LINEAR, kernel=linear_tangential,
-         params=LinearTangentialParams, pack=pack_linear,
-         summary="linear tangential spring k_t = r k_n, Coulomb cap, history rescaled",
-         reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
-         requires=("sliding_friction",), **_COMMON)
+register(
+    family="tangential",
+    name="none",
+    model_id=NONE,
+    kernel=no_tangential,
+    params=NoneParams,
+    pack=pack_none,
+    summary="no tangential force",
+    reference="-",
+    history_width=0,
+    history_flip=(),
+)
+register(
+    family="tangential",
+    name="mindlin",
+    model_id=MINDLIN,
+    kernel=mindlin,
+    params=MindlinParams,
+    pack=pack_mindlin,
+    summary="Mindlin no-slip stiffness 8G*sqrt(R*δ), Coulomb cap, history rescaled",
+    reference="Mindlin (1949) J. Appl. Mech. 16, 259-268; Di Renzo & Di Maio (2004)",
+    requires=("youngs_modulus", "poisson_ratio", "sliding_friction"),
+    **_COMMON,
+)
+register(
+    family="tangential",
+    name="linear",
+    model_id=LINEAR,
+    kernel=linear_tangential,
+    params=LinearTangentialParams,
+    pack=pack_linear,
+    summary="linear tangential spring k_t = r k_n, Coulomb cap, history rescaled",
+    reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
+    requires=("sliding_friction",),
+    **_COMMON,
+)
