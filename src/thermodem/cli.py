@@ -50,20 +50,14 @@ def run(
 def validate(case: Path = typer.Argument(..., help="case file (YAML)")) -> None:
     """Check a case (schema, time step) and print it with every default filled in."""
     from thermodem.config.load import load_case
-    from thermodem.engine.checks import check_time_step
+    from thermodem.engine.checks import check_simulation_time_step
     from thermodem.engine.runner import resolved_case_yaml
     from thermodem.engine.simulation import Simulation
 
     try:
         c = load_case(case)
         sim = Simulation(c)
-        warnings = check_time_step(
-            c,
-            sim.particles.radius,
-            sim.particles.type_id,
-            sim.material_names,
-            sim.particles.velocity,
-        )
+        warnings = check_simulation_time_step(sim)
     except ConfigError as exc:
         _fail(str(exc), 2)
     for w in warnings:

@@ -127,3 +127,30 @@ def check_time_step(
             "anyway)"
         )
     return refusals + warnings
+
+
+def check_simulation_time_step(sim) -> list[str]:  # noqa: ANN001 (avoids an import cycle)
+    """:func:`check_time_step` over the particles present and those that pouring will add.
+
+    Pour entries contribute 1,000 radii drawn from their distribution (with a generator of
+    their own, so the simulation's random sequence is untouched) and their initial velocity.
+    """
+    from thermodem.geometry.insertion import sample_radii
+
+    radius = [sim.particles.radius]
+    types = [sim.particles.type_id]
+    velocity = [sim.particles.velocity]
+    rng = np.random.default_rng(0)
+    for pourer in sim.pourers:
+        entry = pourer.entry
+        r = sample_radii(entry.distribution, 1000, rng)
+        radius.append(r)
+        types.append(np.full(r.size, sim.material_index[entry.material], np.int32))
+        velocity.append(np.tile(np.asarray(entry.velocity, float), (r.size, 1)))
+    return check_time_step(
+        sim.case,
+        np.concatenate(radius),
+        np.concatenate(types),
+        sim.material_names,
+        np.concatenate(velocity),
+    )

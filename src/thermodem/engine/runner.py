@@ -19,7 +19,7 @@ import numpy as np
 import yaml
 
 from thermodem.config.schema import Case
-from thermodem.engine.checks import check_time_step
+from thermodem.engine.checks import check_simulation_time_step
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import ConfigError
 from thermodem.io.vtk import PVDWriter, write_particles_vtu, write_walls_vtu
@@ -96,13 +96,7 @@ def run_case(
     prepare_output_dir(output, overwrite)
     (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
     sim = Simulation(case, threads=threads)
-    for warning in check_time_step(
-        case,
-        sim.particles.radius,
-        sim.particles.type_id,
-        sim.material_names,
-        sim.particles.velocity,
-    ):
+    for warning in check_simulation_time_step(sim):
         print(f"warning: {warning}", file=log)
     settings = case.simulation
     interval = case.output.interval or settings.end_time / 20.0

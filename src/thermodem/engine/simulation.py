@@ -1,15 +1,20 @@
 """The simulation: orchestration in plain Python around the Numba kernels.
 
-Order inside one step (``Simulation.step``), held by the tests:
+Order inside one step (``Simulation.step``):
 
-1. first half kick and drift (velocity Verlet), walls move, pouring inserts particles;
-2. rebuild the pair lists if a particle moved more than half the skin (history carried by key);
-3. pair pass: geometry and contact forces of every particle and wall pair, dissipation per
+1. first half kick and drift (velocity Verlet); in the same pass each particle is checked
+   (non-finite value, outside the domain) and the largest displacement since the last
+   neighbour build is found; a failed check raises before anything else moves;
+2. walls translate; pouring inserts the particles that are due;
+3. the pair lists are rebuilt if a particle moved more than half the skin, or a particle plus
+   a wall moved more than the skin, or particles were inserted (history carried by key);
+4. pair passes: geometry and contact forces of every particle and wall pair, dissipation per
    mechanism, history, ledger rows per chunk;
-4. particle pass: gravity (thermal sources come with the thermal engine);
-5. reduce to per-particle force and torque in a fixed order, second half kick;
-6. check flags (non-finite values, particles outside the domain, excessive overlap);
-7. writers on their triggers (owned by the caller, see ``thermodem.engine.runner``).
+5. reduction to per-particle force and torque in a fixed order, with gravity added there
+   (the per-particle heat sources of the thermal engine will join this pass), and the second
+   half kick;
+6. overlap check; 7. writers on their triggers (owned by the caller, see
+   ``thermodem.engine.runner``).
 """
 
 from __future__ import annotations
@@ -175,7 +180,7 @@ class Simulation:
         self.max_overlap_ratio = 0.0
         self.contact_count = 0
         self.callbacks: list[tuple[int, Callable[[Simulation], None]]] = []
-        self._compute_forces(kick=False)
+        self._compute_forces(kick=False, contact_dt=0.0)
         self.initial_energy = self.total_energy()
 
     # ------------------------------------------------------------------ particles in and out
@@ -337,7 +342,13 @@ class Simulation:
         return 2.0 * moved > self.skin or moved + wall_moved > self.skin
 
     # ------------------------------------------------------------------------------ forces
-    def _compute_forces(self, kick: bool) -> None:
+    def _compute_forces(self, kick: bool, contact_dt: float | None = None) -> None:
+        """Pair passes, reduction and (if ``kick``) the second half kick.
+
+        ``contact_dt`` is the time the contact histories advance by (the time step, or 0 for
+        the force evaluation at t = 0, so that a contact present at the start has not aged).
+        """
+        dt = self.dt if contact_dt is None else contact_dt
         if self._rebuild_due():
             self.rebuild()
         p = self.particles
@@ -359,7 +370,7 @@ class Simulation:
             self.upper,
             self.periodic,
             self.extra,
-            self.dt,
+            dt,
             nid,
             self.normal_table,
             tid,
@@ -390,7 +401,7 @@ class Simulation:
             self.wall_rows,
             self.wall_material,
             self.extra,
-            self.dt,
+            dt,
             nid,
             self.normal_table,
             tid,

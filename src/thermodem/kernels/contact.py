@@ -3,8 +3,8 @@
 ``prange`` runs over fixed-size chunks of the pair list; each pair writes its own output rows
 (force on i, lever vector n x F_t, rolling torque on i, dissipated power per mechanism, state),
 and each chunk writes its own ledger row. Nothing is accumulated across pairs with atomics, so
-the results do not depend on the number of threads; the per-particle reduction is in
-:mod:`thermodem.kernels.reduce`.
+the results do not depend on the number of threads; the per-particle reduction is
+:func:`thermodem.kernels.integrate.reduce_and_kick`.
 
 Sign conventions: n is the unit vector from i to j; the relative velocity of i with respect to j
 at the contact point is v_rel = (v_i + ω_i × R_i n) - (v_j - ω_j × R_j n); the overlap rate is
@@ -216,8 +216,9 @@ def contact_response(
     p_ndamp = f_damp * rate
     out_diss[k, D_NORMAL_DAMPING] = p_ndamp
     out_diss[k, D_TANGENTIAL_DAMPING] = p_tdamp
-    out_diss[k, D_SLIDING_FRICTION] = e_slip / dt
-    out_diss[k, D_ROLLING_FRICTION] = e_roll / dt
+    inv_dt = 1.0 / dt if dt > 0.0 else 0.0
+    out_diss[k, D_SLIDING_FRICTION] = e_slip * inv_dt
+    out_diss[k, D_ROLLING_FRICTION] = e_roll * inv_dt
     out_normal_force[k] = f_n
     ledger_row[L_ELASTIC_NORMAL] += u_n
     ledger_row[L_ELASTIC_TANGENTIAL] += u_t

@@ -8,6 +8,7 @@ each dispatcher agrees with every registered model's own kernel (a missing branc
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from thermodem.models.mechanics import normal, rolling, tangential
@@ -17,7 +18,10 @@ from thermodem.models.mechanics import normal, rolling, tangential
 def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass):
     if model_id == normal.HERTZ:
         return normal.hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass)
-    return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+    if model_id == normal.LINEAR:
+        return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+    nan = np.nan  # unknown id: NaN forces stop the run at the next check
+    return nan, nan, nan, nan, nan
 
 
 @njit(cache=True, inline="always", error_model="numpy")

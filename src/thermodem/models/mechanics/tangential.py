@@ -10,10 +10,10 @@ Kernel signature (all float64)::
 accumulated tangential spring displacement (history), already rotated into the current tangent
 plane by the caller. Returned: the tangential force on i, the updated displacement, the spring
 stiffness k_t (the stored elastic energy is ½ k_t |s|²), the power dissipated by the
-tangential dashpot and the energy
-released by sliding this step (the spring energy given up when the trial force exceeds the
-Coulomb limit μ max(F_n, 0)). When the cap is reached the displacement is rescaled so that the
-spring plus dashpot force equals the limit (the history is "rescaled when the cap is reached").
+tangential dashpot and the energy released by sliding this step (the spring energy given up
+when the trial force exceeds the Coulomb limit μ max(F_n, 0)). When the cap is reached, force
+and dashpot are scaled by λ = limit/|trial| and the displacement is rescaled so that spring
+plus scaled dashpot force equals the limit (the history is "rescaled when the cap is reached").
 
 The tangential dashpot uses the damping ratio of the normal law: γ_t = γ_n sqrt(k_t / k_n),
 where k_n is the normal law's reference stiffness (Tsuji et al. 1992 use the same α for both
