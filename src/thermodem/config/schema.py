@@ -13,6 +13,7 @@ from pydantic import BaseModel, Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.config.insertion import InsertionEntry
+from thermodem.config.thermal import ThermalSettings
 from thermodem.geometry.walls import Wall
 from thermodem.models import registry
 from thermodem.state.materials import InteractionOverride, Material
@@ -166,6 +167,9 @@ class Case(StrictModel):
     walls: list[Wall] = Field(default_factory=list)
     insertion: list[InsertionEntry] = Field(default_factory=list)
     output: Output = Field(default_factory=Output)
+    thermal: ThermalSettings | None = Field(
+        default=None, description="heat transfer; absent = mechanics only"
+    )
 
     @model_validator(mode="after")
     def _names(self) -> Case:
@@ -189,4 +193,22 @@ class Case(StrictModel):
                     raise ValueError(
                         f"interactions.{k}.materials: unknown material {m!r}; allowed: {allowed}"
                     )
+        th = self.thermal
+        if th is not None:
+            for key in ("fixed_temperature", "heat_flux", "volumetric_source"):
+                for k, entry in enumerate(getattr(th, key)):
+                    m = entry.select.material
+                    if m is not None and m not in known:
+                        raise ValueError(
+                            f"thermal.{key}.{k}.select.material: unknown material {m!r}; "
+                            f"allowed: {allowed}"
+                        )
+            rule = th.initial_temperature
+            if rule is not None and rule.kind == "per_material":
+                for m in rule.values:
+                    if m not in known:
+                        raise ValueError(
+                            f"thermal.initial_temperature.values: unknown material {m!r}; "
+                            f"allowed: {allowed}"
+                        )
         return self

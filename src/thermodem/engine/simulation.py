@@ -144,6 +144,12 @@ class Simulation:
         )
         self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
+        # thermal engine (absent = mechanics only)
+        self.thermal = None
+        if case.thermal is not None:
+            from thermodem.engine.thermal import ThermalEngine
+
+            self.thermal = ThermalEngine(self, case.thermal)
         # particles
         self.particles = Particles.empty()
         self.next_global_id = 0
@@ -182,6 +188,9 @@ class Simulation:
         self.callbacks: list[tuple[int, Callable[[Simulation], None]]] = []
         self._compute_forces(kick=False, contact_dt=0.0)
         self.initial_energy = self.total_energy()
+        if self.thermal is not None:
+            self.thermal.compute_rates(self.time)
+            self.thermal.initial_energy = self.thermal.thermal_energy()
 
     # ------------------------------------------------------------------ particles in and out
     def add_particles(self, new: InsertedParticles) -> None:
@@ -191,7 +200,9 @@ class Simulation:
             return
         t = self.material_index[new.material]
         temperature = new.temperature
-        if temperature is None:
+        if temperature is None and self.thermal is not None:
+            temperature = self.thermal.initial_temperature(new.position, np.full(n, t))
+        elif temperature is None:
             temperature = np.full(n, self.case.simulation.initial_temperature)
         gids = np.arange(self.next_global_id, self.next_global_id + n, dtype=np.int64)
         self.next_global_id += n
@@ -462,6 +473,17 @@ class Simulation:
     # -------------------------------------------------------------------------------- step
     def step(self) -> None:
         """Advance one time step (see the module docstring for the order)."""
+        th = self.thermal
+        if th is not None and th.settings.frozen_mechanics:
+            th.step(th.settings.time_step, self.time)
+            self.step_count += 1
+            self.time = self.step_count * th.settings.time_step
+            return
+        if th is not None and self.step_count >= th.next_step:
+            # heat over the next n steps from the positions, contacts and temperatures now
+            n = th.substeps
+            th.step(n * self.dt, self.time)
+            th.next_step = self.step_count + n
         p = self.particles
         nchunks = p.count // CHECK_CHUNK + 1
         if self.chunk_check.shape[0] < nchunks:
@@ -509,7 +531,10 @@ class Simulation:
         if (steps is None) == (until is None):
             raise ValueError("give exactly one of steps= or until=")
         if until is not None:
-            steps = max(0, int(round((until - self.time) / self.dt)))
+            dt = self.dt
+            if self.thermal is not None and self.thermal.settings.frozen_mechanics:
+                dt = self.thermal.settings.time_step
+            steps = max(0, int(round((until - self.time) / dt)))
         for _ in range(int(steps)):
             self.step()
             if callback is not None and self.step_count % every == 0:

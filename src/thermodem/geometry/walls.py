@@ -8,6 +8,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
+from thermodem.config.thermal import WallThermal
 from thermodem.geometry import wall_layout as L
 
 Vec3 = tuple[float, float, float]
@@ -25,6 +26,7 @@ class _WallBase(StrictModel):
     material: str = Field(description="name of the wall material")
     velocity: Vec3 = Field(default=(0.0, 0.0, 0.0), description="translation velocity [m/s]")
     name: str | None = Field(default=None, description="label used in output")
+    thermal: WallThermal = Field(default_factory=WallThermal, description="thermal condition")
 
 
 class PlaneWall(_WallBase):

@@ -1,0 +1,241 @@
+"""Case-file section ``thermal``: the heat transfer models, time integration and conditions.
+
+Example::
+
+    thermal:
+      contact_radius: geometric
+      direct_conduction: batchelor_obrien_simple
+      substeps: 1                  # solve heat every n mechanical steps, or "auto"
+      initial_temperature: {kind: uniform, value: 293.15}
+      fixed_temperature: [{select: {material: heater}, temperature: 400.0}]
+      heat_flux: [{select: {region: {lower: [...], upper: [...]}}, flux: 1000.0}]
+
+Walls take part through their own ``thermal`` key (adiabatic by default).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import Field, field_validator, model_validator
+
+from thermodem.config.base import StrictModel
+from thermodem.models import registry
+
+Vec3 = tuple[float, float, float]
+
+
+def parse_thermal_choice(family: str, value: Any, default: str):  # noqa: ANN201
+    from thermodem.config.schema import parse_model_choice
+
+    return parse_model_choice(family, value, default)
+
+
+class Box(StrictModel):
+    """Axis-aligned box region."""
+
+    lower: Vec3
+    upper: Vec3
+
+    @model_validator(mode="after")
+    def _check(self) -> Box:
+        for axis, lo, hi in zip("xyz", self.lower, self.upper, strict=True):
+            if not lo < hi:
+                raise ValueError(
+                    f"lower must be < upper on every axis; on {axis}: lower={lo}, upper={hi}"
+                )
+        return self
+
+
+class Selection(StrictModel):
+    """Which particles: every given criterion must hold (material, box region, global ids).
+
+    The selection is evaluated on the particles present when the simulation is built and on
+    particles inserted later (material and ids), except ``region``, which is evaluated at each
+    thermal step on the current positions.
+    """
+
+    material: str | None = None
+    region: Box | None = None
+    ids: list[int] | None = None
+
+    @model_validator(mode="after")
+    def _some(self) -> Selection:
+        if self.material is None and self.region is None and self.ids is None:
+            raise ValueError("give at least one of material, region, ids")
+        return self
+
+
+class UniformTemperature(StrictModel):
+    kind: Literal["uniform"] = "uniform"
+    value: float = Field(gt=0, description="[K]")
+
+
+class PerMaterialTemperature(StrictModel):
+    kind: Literal["per_material"] = "per_material"
+    values: dict[str, float] = Field(description="material name -> temperature [K]")
+    default: float = Field(default=293.15, gt=0, description="[K] for materials not listed")
+
+
+class RegionTemperature(StrictModel):
+    """Temperature per box region (the last region containing a particle wins)."""
+
+    kind: Literal["regions"] = "regions"
+    regions: list[tuple[Box, float]] = Field(description="[(box, temperature [K]), ...]")
+    default: float = Field(default=293.15, gt=0, description="[K] outside every region")
+
+
+class ExpressionTemperature(StrictModel):
+    """T = expression of x, y, z [m] (numpy functions allowed: sin, exp, ...)."""
+
+    kind: Literal["expression"] = "expression"
+    expression: str
+
+    @field_validator("expression")
+    @classmethod
+    def _compiles(cls, v: str) -> str:
+        from thermodem.engine.expressions import compile_expression
+
+        compile_expression(v, ("x", "y", "z"))
+        return v
+
+
+InitialTemperature = Annotated[
+    UniformTemperature | PerMaterialTemperature | RegionTemperature | ExpressionTemperature,
+    Field(discriminator="kind"),
+]
+
+
+class FixedTemperature(StrictModel):
+    """Particles held at a temperature (a heat bath); the heat they absorb is ledgered."""
+
+    select: Selection
+    temperature: float = Field(gt=0, description="[K]")
+
+
+class HeatFlux(StrictModel):
+    """Surface heat flux q [W/m²] applied as q × 4πR² to the selected particles."""
+
+    select: Selection
+    flux: float = Field(description="[W/m^2], positive heats")
+
+
+class VolumetricSource(StrictModel):
+    """Volumetric source s [W/m³] applied as s × 4/3πR³ to the selected particles."""
+
+    select: Selection
+    power_density: float = Field(description="[W/m^3], positive heats")
+
+
+class ExternalSource(StrictModel):
+    """External source Q_e (a beam, a burner): total power shared by the particles in a region.
+
+    ``profile: uniform`` gives every particle in the region the same share of the power in
+    proportion to its cross-section πR²; ``gaussian`` weights the share by
+    exp(-r²/(2σ²)) with r the distance from the region's axis line through its centre along
+    ``axis``. Active for ``start_time <= t < end_time``.
+    """
+
+    power: float = Field(description="total power [W]")
+    region: Box
+    profile: Literal["uniform", "gaussian"] = "uniform"
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    sigma: float | None = Field(default=None, gt=0, description="[m], gaussian profile")
+    start_time: float = Field(default=0.0, ge=0)
+    end_time: float = Field(default=float("inf"), gt=0)
+
+    @model_validator(mode="after")
+    def _check(self) -> ExternalSource:
+        if self.profile == "gaussian" and self.sigma is None:
+            raise ValueError("profile 'gaussian' needs sigma [m]")
+        if self.end_time <= self.start_time:
+            raise ValueError(f"end_time {self.end_time} must be after start_time {self.start_time}")
+        return self
+
+
+class ThermalStability(StrictModel):
+    """Explicit Euler stability: Δt_th <= m c / ΣH per particle, and ρ c R² / k (spec 1.4)."""
+
+    warn_fraction: float = Field(default=0.5, gt=0, le=1)
+    allow_unstable: bool = False
+
+
+class ThermalSettings(StrictModel):
+    """Heat transfer between particles (explicit Euler, spec section 1.2)."""
+
+    contact_radius: Any = Field(
+        default="geometric", validate_default=True, description="contact_radius model"
+    )
+    direct_conduction: Any = Field(
+        default="batchelor_obrien_simple",
+        validate_default=True,
+        description="direct_conduction model",
+    )
+    substeps: int | Literal["auto"] = Field(
+        default=1, description="solve heat every n mechanical steps, or 'auto' from the limit"
+    )
+    max_substeps: int = Field(default=1000, ge=1)
+    frozen_mechanics: bool = Field(
+        default=False, description="positions and contacts fixed; heat only"
+    )
+    time_step: float | None = Field(
+        default=None, gt=0, description="thermal time step with frozen mechanics [s]"
+    )
+    initial_temperature: InitialTemperature | None = None
+    fixed_temperature: list[FixedTemperature] = Field(default_factory=list)
+    heat_flux: list[HeatFlux] = Field(default_factory=list)
+    volumetric_source: list[VolumetricSource] = Field(default_factory=list)
+    external_source: list[ExternalSource] = Field(default_factory=list)
+    stability: ThermalStability = Field(default_factory=ThermalStability)
+
+    @field_validator("contact_radius", mode="before")
+    @classmethod
+    def _cr(cls, v: Any):  # noqa: ANN206
+        return parse_thermal_choice("contact_radius", v, "geometric")
+
+    @field_validator("direct_conduction", mode="before")
+    @classmethod
+    def _dc(cls, v: Any):  # noqa: ANN206
+        return parse_thermal_choice("direct_conduction", v, "batchelor_obrien_simple")
+
+    @field_validator("substeps")
+    @classmethod
+    def _positive(cls, v: int | str) -> int | str:
+        if isinstance(v, int) and v < 1:
+            raise ValueError(f"substeps must be >= 1 or 'auto', got {v}")
+        return v
+
+    @model_validator(mode="after")
+    def _frozen(self) -> ThermalSettings:
+        if self.frozen_mechanics and self.time_step is None:
+            raise ValueError("frozen_mechanics needs thermal.time_step [s]")
+        return self
+
+
+class WallThermal(StrictModel):
+    """Thermal condition of a wall: adiabatic, or a fixed temperature.
+
+    ``temperature`` is a constant [K], a table ``[[t, T], ...]`` interpolated linearly in time
+    (held constant outside), or an expression of ``t`` [s] (e.g. ``"300 + 50 * (t > 1)"``).
+    """
+
+    kind: Literal["adiabatic", "fixed"] = "adiabatic"
+    temperature: float | list[tuple[float, float]] | str | None = None
+
+    @model_validator(mode="after")
+    def _check(self) -> WallThermal:
+        if self.kind == "fixed" and self.temperature is None:
+            raise ValueError("a fixed-temperature wall needs temperature")
+        if isinstance(self.temperature, list):
+            times = [t for t, _ in self.temperature]
+            if len(times) < 1 or any(b <= a for a, b in zip(times, times[1:], strict=False)):
+                raise ValueError("temperature table times must increase strictly")
+        if isinstance(self.temperature, str):
+            from thermodem.engine.expressions import compile_expression
+
+            compile_expression(self.temperature, ("t",))
+        return self
+
+
+def ensure_registry_loaded() -> None:
+    registry.names("direct_conduction")

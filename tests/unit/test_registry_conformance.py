@@ -1,0 +1,277 @@
+"""Mechanical model registry: every registered model of the families normal, tangential and
+rolling agrees with its family dispatcher, and the laws have the properties they claim.
+
+* conformance: for random inputs, ``<family>_dispatch(spec.model_id, ...)`` returns exactly what
+  the model's own kernel returns (a missing or wrong branch of a dispatcher fails here);
+* Hertz: the elastic force equals the closed form (4/3) E* sqrt(R*) δ^{3/2} and the derivative of
+  the elastic energy it reports (central finite difference); the same for the linear law;
+* tangential laws: |F_t| <= μ max(F_n, 0) for any history, velocity and normal force;
+* constant-torque rolling: |M| = μ_r R* F_n while rolling, opposing the relative rotation;
+* Hertz damping calibration: e(α(e)) = e to 1e-9.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, example, given, settings
+from hypothesis import strategies as st
+
+from thermodem.models import registry
+from thermodem.models.mechanics import dispatch, normal, rolling, tangential
+from thermodem.models.mechanics.normal import (
+    hertz_alpha_of_restitution,
+    hertz_restitution_of_alpha,
+)
+from thermodem.state.materials import Material, resolve_pair
+
+FAMILIES = ("normal", "tangential", "rolling")
+DISPATCH = {
+    "normal": dispatch.normal_dispatch,
+    "tangential": dispatch.tangential_dispatch,
+    "rolling": dispatch.rolling_dispatch,
+}
+N_RANDOM = 200
+
+
+def specs(family: str) -> list[registry.ModelSpec]:
+    return [s for s in registry.all_models() if s.family == family]
+
+
+def default_params(spec: registry.ModelSpec):
+    """The model's parameters with defaults (a value for the required ones)."""
+    required = {"stiffness": 3.0e4}  # normal.linear
+    fields = spec.params.model_fields
+    return spec.params(**{k: v for k, v in required.items() if k in fields})
+
+
+def random_material(rng: np.random.Generator) -> Material:
+    return Material(
+        density=float(rng.uniform(500, 8000)),
+        youngs_modulus=float(10 ** rng.uniform(5, 11)),
+        poisson_ratio=float(rng.uniform(0.0, 0.49)),
+        restitution=float(rng.choice([0.3, 0.5, 0.9, 1.0])),  # few values: α(e) is cached
+        sliding_friction=float(rng.uniform(0, 1)),
+        rolling_friction=float(rng.uniform(0, 0.3)),
+    )
+
+
+def parameter_rows(spec: registry.ModelSpec, rng: np.random.Generator) -> list[np.ndarray]:
+    """Rows packed from random materials, and raw random rows (any finite values)."""
+    params = default_params(spec)
+    rows = [
+        spec.pack(params, resolve_pair(random_material(rng), random_material(rng)))
+        for _ in range(4)
+    ]
+    rows += [10 ** rng.uniform(-3, 3, registry.PARAM_WIDTH) for _ in range(4)]
+    return rows
+
+
+def random_arguments(family: str, rng: np.random.Generator) -> tuple:
+    """Arguments after the parameter row, physically shaped but random (signs included)."""
+    u = rng.uniform
+    if family == "normal":
+        # overlap, overlap_rate, eff_radius, eff_mass
+        return (10 ** u(-9, -3), u(-5, 5), 10 ** u(-4, -1), 10 ** u(-6, 1))
+    if family == "tangential":
+        # ref_stiffness, normal_damping, eff_radius, overlap, normal_force, v_t, s, dt
+        return (
+            10 ** u(1, 8),
+            10 ** u(-3, 2),
+            10 ** u(-4, -1),
+            10 ** u(-9, -3),
+            u(-1, 100),
+            u(-2, 2),
+            u(-2, 2),
+            u(-2, 2),
+            u(-1e-4, 1e-4),
+            u(-1e-4, 1e-4),
+            u(-1e-4, 1e-4),
+            10 ** u(-7, -4),
+        )
+    # rolling: ref_stiffness, eff_radius, rolling_inertia, normal_force, w, m, dt
+    return (
+        10 ** u(1, 8),
+        10 ** u(-4, -1),
+        10 ** u(-12, -6),
+        u(-1, 100),
+        u(-50, 50),
+        u(-50, 50),
+        u(-50, 50),
+        u(-1e-3, 1e-3),
+        u(-1e-3, 1e-3),
+        u(-1e-3, 1e-3),
+        10 ** u(-7, -4),
+    )
+
+
+# --------------------------------------------------------------------------- conformance
+def test_every_family_has_models_with_unique_ids():
+    for family in FAMILIES:
+        models = specs(family)
+        assert len(models) >= 2, family
+        ids = [s.model_id for s in models]
+        assert len(ids) == len(set(ids)), family
+    assert registry.get("normal", "hertz").model_id == normal.HERTZ
+    assert registry.get("normal", "linear").model_id == normal.LINEAR
+    assert registry.get("tangential", "mindlin").model_id == tangential.MINDLIN
+    assert registry.get("tangential", "linear").model_id == tangential.LINEAR
+    assert registry.get("rolling", "constant_torque").model_id == rolling.CONSTANT_TORQUE
+    assert registry.get("rolling", "epsd").model_id == rolling.EPSD
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [s for f in FAMILIES for s in specs(f)],
+    ids=lambda s: f"{s.family}.{s.name}",
+)
+def test_dispatcher_equals_model_kernel(spec):
+    rng = np.random.default_rng(zlib.crc32(f"{spec.family}.{spec.name}".encode()))
+    fn = DISPATCH[spec.family]
+    others = [s for s in specs(spec.family) if s.name != spec.name]
+    distinguished = set()
+    for p in parameter_rows(spec, rng):
+        for _ in range(N_RANDOM // 8):
+            args = random_arguments(spec.family, rng)
+            own = np.array(spec.kernel(p, *args), dtype=np.float64)
+            via = np.array(fn(spec.model_id, p, *args), dtype=np.float64)
+            assert np.all(np.isfinite(own)), (spec.name, args, own)
+            assert np.array_equal(own, via), (spec.name, p, args, own, via)
+            # the inputs are rich enough to tell this model from every other of its family
+            for other in others:
+                if not np.array_equal(own, np.array(other.kernel(p, *args))):
+                    distinguished.add(other.name)
+    assert distinguished == {o.name for o in others}
+
+
+def test_normal_dispatcher_rejects_unknown_id():
+    p = np.ones(registry.PARAM_WIDTH)
+    unknown = max(s.model_id for s in specs("normal")) + 1
+    out = dispatch.normal_dispatch(unknown, p, 1e-6, 0.1, 1e-3, 1e-3)
+    assert all(math.isnan(x) for x in out)
+
+
+# ---------------------------------------------------------------------------- properties
+SETTINGS = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@SETTINGS
+@given(
+    e_star=st.floats(1e5, 1e11),
+    eff_radius=st.floats(1e-5, 1.0),
+    rel_overlap=st.floats(1e-8, 0.1),
+    alpha=st.floats(0.0, 2.0),
+    eff_mass=st.floats(1e-9, 10.0),
+)
+def test_hertz_force_is_energy_derivative(e_star, eff_radius, rel_overlap, alpha, eff_mass):
+    p = np.zeros(registry.PARAM_WIDTH)
+    p[0] = e_star
+    p[1] = alpha
+    delta = rel_overlap * eff_radius
+    f_el, f_damp, _, _, _ = normal.hertz_force(p, delta, 0.0, eff_radius, eff_mass)
+    assert f_damp == 0.0
+    closed = 4.0 / 3.0 * e_star * math.sqrt(eff_radius) * delta**1.5
+    assert f_el == pytest.approx(closed, rel=1e-12)
+    h = 1e-4 * delta
+    u_plus = normal.hertz_force(p, delta + h, 0.0, eff_radius, eff_mass)[4]
+    u_minus = normal.hertz_force(p, delta - h, 0.0, eff_radius, eff_mass)[4]
+    # truncation (h/δ)² / 8 ~ 1e-9, round-off ~ 1e-16 / 1e-4 = 1e-12
+    assert (u_plus - u_minus) / (2.0 * h) == pytest.approx(f_el, rel=1e-7)
+
+
+@SETTINGS
+@given(stiffness=st.floats(1.0, 1e9), delta=st.floats(1e-9, 1e-2), zeta=st.floats(0.0, 1.0))
+def test_linear_force_is_energy_derivative(stiffness, delta, zeta):
+    p = np.zeros(registry.PARAM_WIDTH)
+    p[0] = stiffness
+    p[1] = zeta
+    f_el = normal.linear_force(p, delta, 0.0, 1e-3, 1e-3)[0]
+    assert f_el == pytest.approx(stiffness * delta, rel=1e-15)
+    h = 1e-4 * delta
+    u_plus = normal.linear_force(p, delta + h, 0.0, 1e-3, 1e-3)[4]
+    u_minus = normal.linear_force(p, delta - h, 0.0, 1e-3, 1e-3)[4]
+    assert (u_plus - u_minus) / (2.0 * h) == pytest.approx(f_el, rel=1e-7)
+
+
+TANGENTIAL = [s.name for s in specs("tangential")]
+component = st.floats(-10.0, 10.0)
+spring = st.floats(-1e-3, 1e-3)
+
+
+@SETTINGS
+@given(
+    name=st.sampled_from(TANGENTIAL),
+    mu=st.floats(0.0, 2.0),
+    youngs=st.floats(1e5, 1e11),
+    ref_stiffness=st.floats(1.0, 1e9),
+    normal_damping=st.floats(0.0, 1e4),
+    eff_radius=st.floats(1e-5, 0.1),
+    overlap=st.floats(1e-10, 1e-3),
+    normal_force=st.floats(-100.0, 1e4),
+    v=st.tuples(component, component, component),
+    s=st.tuples(spring, spring, spring),
+    dt=st.floats(1e-8, 1e-3),
+)
+def test_tangential_force_never_exceeds_coulomb(
+    name, mu, youngs, ref_stiffness, normal_damping, eff_radius, overlap, normal_force, v, s, dt
+):
+    spec = registry.get("tangential", name)
+    mat = Material(density=2500.0, youngs_modulus=youngs, poisson_ratio=0.3, sliding_friction=mu)
+    pair = resolve_pair(mat, mat)
+    assert pair.sliding_friction == pytest.approx(mu)
+    p = spec.pack(default_params(spec), pair)
+    out = dispatch.tangential_dispatch(
+        spec.model_id,
+        p,
+        ref_stiffness,
+        normal_damping,
+        eff_radius,
+        overlap,
+        normal_force,
+        *v,
+        *s,
+        dt,
+    )
+    f_t = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
+    assert f_t <= pair.sliding_friction * max(normal_force, 0.0) * (1.0 + 1e-12)
+    # the slip energy is what the spring gives up: never negative (to round-off)
+    trial = 0.5 * out[6] * sum((si + vi * dt) ** 2 for si, vi in zip(s, v, strict=True))
+    assert out[8] >= -1e-12 * trial
+
+
+@SETTINGS
+@given(
+    mu_r=st.floats(0.0, 1.0),
+    eff_radius=st.floats(1e-5, 0.1),
+    normal_force=st.floats(-100.0, 1e4),
+    w=st.tuples(component, component, component),
+)
+def test_constant_torque_magnitude_and_direction(mu_r, eff_radius, normal_force, w):
+    spec = registry.get("rolling", "constant_torque")
+    mat = Material(density=2500.0, youngs_modulus=1e7, poisson_ratio=0.3, rolling_friction=mu_r)
+    p = spec.pack(default_params(spec), resolve_pair(mat, mat))
+    out = dispatch.rolling_dispatch(
+        spec.model_id, p, 1e5, eff_radius, 1e-8, normal_force, *w, 0.0, 0.0, 0.0, 1e-5
+    )
+    torque = np.array(out[:3])
+    w_mag = math.sqrt(sum(c * c for c in w))
+    if w_mag <= p[1] or normal_force <= 0.0:
+        assert not torque.any()
+        return
+    expected = mu_r * eff_radius * normal_force
+    assert math.hypot(*torque) == pytest.approx(expected, rel=1e-12, abs=1e-300)
+    assert torque @ np.array(w) <= 0.0
+    assert out[7] == pytest.approx(expected * w_mag * 1e-5, rel=1e-12, abs=1e-300)
+
+
+@settings(max_examples=6, deadline=None)
+@given(e=st.floats(0.01, 1.0))
+@example(e=1.0)
+@example(e=0.5)
+def test_hertz_restitution_round_trip(e):
+    alpha = hertz_alpha_of_restitution(e)
+    assert alpha >= 0.0
+    assert abs(hertz_restitution_of_alpha(alpha) - e) < 1e-9

@@ -1,0 +1,97 @@
+"""Results do not depend on the number of Numba threads.
+
+The pair pass writes one row per pair and one ledger row per chunk of ``CHUNK`` pairs, and the
+per-particle reduction sums each particle's pairs in the order of the neighbours' global ids,
+so a run with 1 thread and a run with 2 threads must be bit-identical. The bed below has more
+than 4096 particles and several chunks of pairs, so every parallel loop is split between the
+threads.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+
+from thermodem.config.load import case_from_dict
+from thermodem.engine.simulation import Simulation
+from thermodem.geometry.insertion import InsertedParticles, save_particle_file
+from thermodem.kernels import contact as C
+
+R0 = 0.005
+SPACING = 1.99 * R0
+SHAPE = (17, 17, 16)  # 4624 particles
+
+
+def write_bed(path: Path) -> None:
+    rng = np.random.default_rng(99)
+    grid = np.stack(np.meshgrid(*(np.arange(n) for n in SHAPE), indexing="ij"), -1)
+    pos = (grid.reshape(-1, 3) + 0.5) * SPACING + rng.uniform(-0.01, 0.01, (grid.size // 3, 3)) * R0
+    rad = rng.uniform(0.97 * R0, R0, len(pos))  # jammed start: small overlaps
+    vel = rng.normal(0.0, 0.2, pos.shape)
+    save_particle_file(path, InsertedParticles(pos, rad, vel, None, "grain"))
+
+
+def run(path: Path, threads: int, steps: int) -> tuple[Simulation, list[int]]:
+    numba.set_num_threads(threads)
+    upper = [SHAPE[0] * SPACING, SHAPE[1] * SPACING, 0.3]
+    case = {
+        "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0.0, 0.0, -9.81]},
+        "domain": {"lower": [-0.01, -0.01, -0.01], "upper": [u + 0.01 for u in upper]},
+        "materials": {
+            "grain": {
+                "density": 2500.0,
+                "youngs_modulus": 1e7,
+                "poisson_ratio": 0.3,
+                "restitution": 0.5,
+                "sliding_friction": 0.5,
+                "rolling_friction": 0.1,
+            }
+        },
+        "contact": {"normal": "hertz", "tangential": "mindlin", "rolling": "epsd"},
+        "neighbors": {"skin": 0.01 * R0, "extra_distance": 0.2 * R0},
+        "walls": [
+            {
+                "kind": "box",
+                "material": "grain",
+                "lower": [0.0, 0.0, 0.0],
+                "upper": upper,
+                "open_top": True,
+            }
+        ],
+        "insertion": [{"kind": "file", "material": "grain", "path": str(path)}],
+    }
+    sim = Simulation(case_from_dict(case))
+    seen: list[int] = []
+    sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
+    return sim, seen
+
+
+def by_gid(sim: Simulation, name: str) -> np.ndarray:
+    p = sim.particles
+    return getattr(p, name)[np.argsort(p.global_id)]
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
+def test_one_and_two_threads_bit_identical(tmp_path):
+    path = tmp_path / "bed.txt"
+    write_bed(path)
+    previous = numba.get_num_threads()
+    try:
+        one, seen_one = run(path, 1, 60)
+        two, seen_two = run(path, 2, 60)
+    finally:
+        numba.set_num_threads(previous)
+    assert set(seen_one) == {1} and set(seen_two) == {2}
+    # every parallel loop has work for both threads
+    assert one.particles.count > 4096
+    assert one.pairs.count > 2 * C.CHUNK
+    assert one.rebuild_count > 1 and one.contact_count > one.particles.count // 2
+    assert one.rebuild_count == two.rebuild_count
+    for name in ("position", "velocity", "angular_velocity", "force", "torque"):
+        a = by_gid(one, name)
+        b = by_gid(two, name)
+        assert np.array_equal(a, b), (name, np.abs(a - b).max())
+    assert one.energies() == two.energies()
