@@ -227,3 +227,39 @@ def test_auto_substeps_follow_the_limit(tmp_path: Path) -> None:
     sim.run(steps=10)
     assert sim.thermal.substeps == min(int(0.5 * sim.thermal.limit / sim.dt), 1000)
     assert sim.thermal.substeps > 1
+
+
+def test_temperature_dependent_specific_heat_integrates_enthalpy_exactly(tmp_path: Path) -> None:
+    # one sphere, constant power; c(T) = c0 + b (T - 300) between 300 and 500 K
+    c0, b = 800.0, 2.0
+    path = _write(tmp_path / "one.txt", [(0.0, 0.0, 0.0, R, 300.0)])
+    case = _case(
+        path,
+        {
+            "frozen_mechanics": True,
+            "time_step": 0.5,
+            "volumetric_source": [{"select": {"ids": [0]}, "power_density": 2e5}],
+        },
+    )
+    case["materials"]["glass"]["specific_heat_table"] = [[300.0, c0], [500.0, c0 + b * 200.0]]
+    sim = Simulation(case_from_dict(case))
+    u0 = sim.thermal.thermal_energy()
+    sim.run(until=40.0)
+    q = 2e5 * 4.0 / 3.0 * math.pi * R**3
+    # m (c0 x + b x²/2) = Q t with x = T - 300
+    x = (-c0 + math.sqrt(c0**2 + 2.0 * b * q * 40.0 / MASS)) / b
+    assert sim.particles.temperature[0] == pytest.approx(300.0 + x, rel=1e-12)
+    assert sim.thermal.thermal_energy() - u0 == pytest.approx(q * 40.0, rel=1e-12)
+
+
+def test_temperature_dependent_conductivity_uses_each_particles_k(tmp_path: Path) -> None:
+    d = 1.95e-3
+    path = _write(tmp_path / "two.txt", [(0.0, 0.0, 0.0, R, 300.0), (d, 0.0, 0.0, R, 400.0)])
+    case = _case(path, {"frozen_mechanics": True, "time_step": 0.1})
+    case["materials"]["glass"]["thermal_conductivity_table"] = [[300.0, 1.0], [400.0, 3.0]]
+    sim = Simulation(case_from_dict(case))
+    q = sim.particles.heat_rate_by_mechanism[np.argsort(sim.particles.global_id), 0]
+    a = math.sqrt(R**2 - (d / 2) ** 2)
+    k_bar = 1.0 * 3.0 / (1.0 + 3.0)  # k(300 K) = 1, k(400 K) = 3
+    assert q[0] == pytest.approx(4.0 * k_bar * a * 100.0, rel=1e-12)
+    assert q[1] == -q[0]

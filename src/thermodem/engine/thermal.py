@@ -85,6 +85,7 @@ class ThermalEngine:
                             f"thermal.{choice.family} = {choice.model!r} cannot be set up for "
                             f"materials {na!r} and {nb!r}: {exc}"
                         ) from None
+        self._property_tables(case, names, particle_mats)
         self.specific_heat_by_type = np.zeros(n)
         for t, name in enumerate(names):
             c = case.materials[name].specific_heat
@@ -103,6 +104,7 @@ class ThermalEngine:
         self.pair_heat = np.zeros(0)
         self.wall_conductance = np.zeros(0)
         self.wall_heat = np.zeros(0)
+        self._empty = np.zeros(0)
         self.fixed = np.zeros(0, np.bool_)
         self.source = np.zeros(0)
         self.conductance_sum = np.zeros(0)
@@ -118,6 +120,56 @@ class ThermalEngine:
     @staticmethod
     def _particle_materials(case) -> list[str]:  # noqa: ANN001
         return [e.material for e in case.insertion]
+
+    def _property_tables(self, case, names: list[str], particle_mats: set[str]) -> None:  # noqa: ANN001
+        """Per-material tables of k(T) and c(T) (a constant is a one-node table)."""
+        n = len(names)
+        width = 1
+        for name in names:
+            m = case.materials[name]
+            for tab in (m.thermal_conductivity_table, m.specific_heat_table):
+                width = max(width, len(tab) if tab else 1)
+        self.k_t = np.zeros((n, width))
+        self.k_v = np.zeros((n, width))
+        self.k_n = np.ones(n, np.int64)
+        self.c_t = np.zeros((n, width))
+        self.c_v = np.zeros((n, width))
+        self.c_n = np.ones(n, np.int64)
+        self.density_by_type = np.array([case.materials[m].density for m in names])
+        has_k = has_c = False
+        for a, name in enumerate(names):
+            m = case.materials[name]
+            for tab, const, tt, vv, nn in (
+                (m.thermal_conductivity_table, m.thermal_conductivity, self.k_t, self.k_v,
+                 self.k_n),
+                (m.specific_heat_table, m.specific_heat, self.c_t, self.c_v, self.c_n),
+            ):  # fmt: skip
+                if tab:
+                    arr = np.asarray(tab, float)
+                    nn[a] = arr.shape[0]
+                    tt[a, : nn[a]] = arr[:, 0]
+                    vv[a, : nn[a]] = arr[:, 1]
+                else:
+                    vv[a, 0] = const or 0.0
+            has_k |= m.thermal_conductivity_table is not None
+            has_c |= m.specific_heat_table is not None and name in particle_mats
+        self.has_c_table = has_c
+        self.override = 2 if (has_c or has_k) and has_c else (1 if has_k else 0)
+        self.scratch = np.zeros((1, 16))
+
+    def _interp(
+        self,
+        tt: np.ndarray,
+        vv: np.ndarray,
+        nn: np.ndarray,
+        type_id: np.ndarray,
+        temperature: np.ndarray,
+    ) -> np.ndarray:
+        out = vv[type_id, 0].copy()
+        for a in np.nonzero(nn > 1)[0]:
+            sel = type_id == a
+            out[sel] = np.interp(temperature[sel], tt[a, : nn[a]], vv[a, : nn[a]])
+        return out
 
     # ------------------------------------------------------------------ initial conditions
     def initial_temperature(self, position: np.ndarray, type_id: np.ndarray) -> np.ndarray:
@@ -229,17 +281,31 @@ class ThermalEngine:
         self._buffers()
         self._update_walls(time)
         fixed, source = self._fixed_and_sources(time)
+        k_p = rhoc_p = k_w = rhoc_w = self._empty
+        if self.override:
+            k_p = self._interp(self.k_t, self.k_v, self.k_n, p.type_id, p.temperature)
+            c_p = self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
+            rhoc_p = self.density_by_type[p.type_id] * c_p
+            wt = sim.wall_rows[:, WL.COL_TEMPERATURE]
+            k_w = self._interp(self.k_t, self.k_v, self.k_n, sim.wall_material, wt)
+            rhoc_w = self.density_by_type[sim.wall_material] * self._interp(
+                self.c_t, self.c_v, self.c_n, sim.wall_material, wt
+            )
+            rows = max(pb.count, wb.count) // K.CHUNK + 1
+            if self.scratch.shape[0] < rows:
+                self.scratch = np.zeros((rows, 16))
         K.conduction_pair_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
             pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
             self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
-            self.pair_conductance, self.pair_heat,
+            self.override, k_p, rhoc_p, self.scratch, self.pair_conductance, self.pair_heat,
         )  # fmt: skip
         K.conduction_wall_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
             wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
             sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
-            self.conduction_table, self.wall_conductance, self.wall_heat,
+            self.conduction_table, self.override, k_p, rhoc_p, k_w, rhoc_w, self.scratch,
+            self.wall_conductance, self.wall_heat,
         )  # fmt: skip
         K.heat_gather(
             sim.row_start, sim.entries, self.pair_conductance, self.pair_heat,
@@ -249,7 +315,11 @@ class ThermalEngine:
         return fixed
 
     def specific_heat(self) -> np.ndarray:
-        return self.specific_heat_by_type[self.sim.particles.type_id]
+        """c(T) of every particle [J/(kg K)]."""
+        p = self.sim.particles
+        if self.has_c_table:
+            return self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
+        return self.specific_heat_by_type[p.type_id]
 
     def step(self, dt: float, time: float) -> None:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler)."""
@@ -272,7 +342,12 @@ class ThermalEngine:
             )
         wall_q = float(np.sum(p.heat_rate_by_mechanism[:, K.M_WALL]))
         source_q = float(np.sum(self.source))
-        absorbed, bad = K.euler_update(p.temperature, p.heat_rate, p.mass, c, fixed, dt)
+        if self.has_c_table:
+            absorbed, bad = K.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
+                                                    p.type_id, self.c_t, self.c_v, self.c_n,
+                                                    fixed, dt)  # fmt: skip
+        else:
+            absorbed, bad = K.euler_update(p.temperature, p.heat_rate, p.mass, c, fixed, dt)
         self.cumulative["wall_heat"] += wall_q * dt
         self.cumulative["source_heat"] += source_q * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
@@ -293,8 +368,11 @@ class ThermalEngine:
 
     # ---------------------------------------------------------------------------- ledger
     def thermal_energy(self) -> float:
-        """Σ m c T over all particles [J]."""
+        """Σ m c T over all particles [J] (Σ m h(T) with a temperature-dependent c)."""
         p = self.sim.particles
+        if self.has_c_table:
+            return K.total_enthalpy(p.temperature, p.mass, p.type_id, self.c_t, self.c_v,
+                                    self.c_n)  # fmt: skip
         return float(np.sum(p.mass * self.specific_heat() * p.temperature))
 
     def balance_error(self) -> float:

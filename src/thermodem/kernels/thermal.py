@@ -29,12 +29,18 @@ M_WALL = 6
 def conduction_pair_pass(
     position, radius, mass, temperature, type_id, pair_i, pair_j, npairs, state, normal_force,
     history, lower, upper, periodic, radius_id, radius_table, conduction_id, conduction_table,
-    out_conductance, out_heat,
+    override, k_particle, rhoc_particle, scratch, out_conductance, out_heat,
 ):  # fmt: skip
-    """Conductance and heat rate into i of every listed particle pair (near pairs included)."""
+    """Conductance and heat rate into i of every listed particle pair (near pairs included).
+
+    With ``override`` > 0 the conductivity columns (0, 1) of the model's row are replaced by
+    the particles' current k(T), and with ``override`` > 1 also the heat capacity columns
+    (2, 3) by ρ c(T) (temperature-dependent properties).
+    """
     length = upper - lower
     nchunks = (npairs + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
+        row = scratch[c]
         for k in range(c * CHUNK, min(npairs, (c + 1) * CHUNK)):
             if state[k] == STATE_FAR:
                 out_conductance[k] = 0.0
@@ -68,9 +74,19 @@ def conduction_pair_pass(
                     v_imp,
                     m_eff,
                 )
+            p = conduction_table[ti, tj]
+            if override > 0:
+                for q in range(p.shape[0]):
+                    row[q] = p[q]
+                row[0] = k_particle[i]
+                row[1] = k_particle[j]
+                if override > 1:
+                    row[2] = rhoc_particle[i]
+                    row[3] = rhoc_particle[j]
+                p = row
             h = direct_conduction_dispatch(
                 conduction_id,
-                conduction_table[ti, tj],
+                p,
                 0.0,
                 1.0,
                 ri,
@@ -91,11 +107,17 @@ def conduction_pair_pass(
 def conduction_wall_pass(
     position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
     normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
-    conduction_id, conduction_table, out_conductance, out_heat,
+    conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
+    scratch, out_conductance, out_heat,
 ):  # fmt: skip
-    """Heat from fixed-temperature walls into particles (adiabatic walls give zero)."""
+    """Heat from fixed-temperature walls into particles (adiabatic walls give zero).
+
+    ``override`` as in :func:`conduction_pair_pass`; the wall's values are ``k_wall[w]`` and
+    ``rhoc_wall[w]`` (its material at the wall temperature).
+    """
     nchunks = (nwpairs + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
+        row = scratch[c]
         for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
             w = wall_pair_w[k]
             wrow = wall_rows[w]
@@ -125,9 +147,19 @@ def conduction_wall_pass(
                     v_imp,
                     mass[i],
                 )
+            p = conduction_table[ti, tw]
+            if override > 0:
+                for q in range(p.shape[0]):
+                    row[q] = p[q]
+                row[0] = k_particle[i]
+                row[1] = k_wall[w]
+                if override > 1:
+                    row[2] = rhoc_particle[i]
+                    row[3] = rhoc_wall[w]
+                p = row
             h = direct_conduction_dispatch(
                 conduction_id,
-                conduction_table[ti, tw],
+                p,
                 0.0,
                 1.0,
                 ri,
@@ -209,3 +241,74 @@ def stability_limit(mass, specific_heat, conductance_sum, fixed):
             best = lim
             where = i
     return best, where
+
+
+@njit(cache=True, error_model="numpy")
+def enthalpy(t, tt, cc, n):
+    """h(T) = ∫_0^T c dT' [J/kg] for c piecewise linear on the nodes tt[:n] (values cc[:n]),
+    constant outside them; a single node is a constant c (h = c T)."""
+    if t <= tt[0]:
+        return cc[0] * t
+    h = cc[0] * tt[0]
+    for s in range(n - 1):
+        a = tt[s]
+        b = tt[s + 1]
+        if t <= b:
+            x = t - a
+            return h + cc[s] * x + 0.5 * (cc[s + 1] - cc[s]) / (b - a) * x * x
+        h += 0.5 * (cc[s] + cc[s + 1]) * (b - a)
+    return h + cc[n - 1] * (t - tt[n - 1])
+
+
+@njit(cache=True, error_model="numpy")
+def temperature_of_enthalpy(hv, tt, cc, n):
+    """Inverse of :func:`enthalpy` (c > 0, so h is increasing)."""
+    h = cc[0] * tt[0]
+    if hv <= h:
+        return hv / cc[0]
+    for s in range(n - 1):
+        a = tt[s]
+        b = tt[s + 1]
+        seg = 0.5 * (cc[s] + cc[s + 1]) * (b - a)
+        if hv <= h + seg:
+            r = hv - h
+            slope = (cc[s + 1] - cc[s]) / (b - a)
+            # 0.5 slope x² + c_s x = r, in the cancellation-free form
+            return a + 2.0 * r / (cc[s] + math.sqrt(cc[s] * cc[s] + 2.0 * slope * r))
+        h += seg
+    return tt[n - 1] + (hv - h) / cc[n - 1]
+
+
+@njit(cache=True, error_model="numpy")
+def euler_update_enthalpy(
+    temperature, heat_rate, mass, type_id, table_t, table_c, table_n, fixed, dt
+):
+    """Explicit Euler on the specific enthalpy, h += dt Q / m, then T = h⁻¹(h).
+
+    Used with temperature-dependent specific heat: Σ m h(T) then changes by exactly Σ Q dt.
+    Returns (heat absorbed by fixed particles [W], first bad particle index or -1).
+    """
+    absorbed = 0.0
+    bad = -1
+    for i in range(temperature.shape[0]):
+        if fixed[i]:
+            absorbed += heat_rate[i]
+            continue
+        m = type_id[i]
+        n = table_n[m]
+        h = enthalpy(temperature[i], table_t[m], table_c[m], n) + dt * heat_rate[i] / mass[i]
+        t = temperature_of_enthalpy(h, table_t[m], table_c[m], n)
+        temperature[i] = t
+        if bad < 0 and not (t > 0.0 and math.isfinite(t)):
+            bad = i
+    return absorbed, bad
+
+
+@njit(cache=True, error_model="numpy")
+def total_enthalpy(temperature, mass, type_id, table_t, table_c, table_n):
+    """Σ m h(T) [J]."""
+    total = 0.0
+    for i in range(temperature.shape[0]):
+        m = type_id[i]
+        total += mass[i] * enthalpy(temperature[i], table_t[m], table_c[m], table_n[m])
+    return total

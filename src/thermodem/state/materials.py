@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pydantic import Field
+from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 
@@ -38,6 +38,38 @@ class Material(StrictModel):
     thermal_accommodation: float | None = Field(default=None, gt=0, le=1.0, description="[-]")
     # Real (physical) Young's modulus for low-stiffness corrections of the contact radius.
     youngs_modulus_real: float | None = Field(default=None, gt=0, description="[Pa]")
+    # Temperature-dependent properties: [[T (K), value], ...], linear in T between the nodes
+    # and held constant outside them. When given, they replace the constants at run time.
+    thermal_conductivity_table: list[tuple[float, float]] | None = Field(
+        default=None, description="[[T (K), k (W/(m K))], ...]"
+    )
+    specific_heat_table: list[tuple[float, float]] | None = Field(
+        default=None, description="[[T (K), c (J/(kg K))], ...]"
+    )
+
+    @field_validator("thermal_conductivity_table", "specific_heat_table")
+    @classmethod
+    def _table(cls, v: list[tuple[float, float]] | None) -> list[tuple[float, float]] | None:
+        if v is None:
+            return v
+        if len(v) < 1:
+            raise ValueError("a table needs at least one [T, value] row")
+        temps = [row[0] for row in v]
+        if any(b <= a for a, b in zip(temps, temps[1:], strict=False)):
+            raise ValueError(f"table temperatures must increase strictly, got {temps}")
+        if any(row[0] <= 0 or row[1] <= 0 for row in v):
+            raise ValueError("table temperatures and values must be > 0")
+        return v
+
+    @model_validator(mode="after")
+    def _reference_values(self) -> Material:
+        # the constant is the reference a model's parameter row is packed with; at run time
+        # the conductivity / heat capacity columns of the row are replaced by table values
+        if self.thermal_conductivity_table and self.thermal_conductivity is None:
+            self.__dict__["thermal_conductivity"] = self.thermal_conductivity_table[0][1]
+        if self.specific_heat_table and self.specific_heat is None:
+            self.__dict__["specific_heat"] = self.specific_heat_table[0][1]
+        return self
 
     @property
     def shear_modulus(self) -> float:
