@@ -263,3 +263,24 @@ def test_temperature_dependent_conductivity_uses_each_particles_k(tmp_path: Path
     k_bar = 1.0 * 3.0 / (1.0 + 3.0)  # k(300 K) = 1, k(400 K) = 3
     assert q[0] == pytest.approx(4.0 * k_bar * a * 100.0, rel=1e-12)
     assert q[1] == -q[0]
+
+
+def test_pre_run_thermal_checks_refuse_and_warn_with_numbers(tmp_path: Path) -> None:
+    from thermodem.engine.checks import check_thermal_time_step
+    from thermodem.errors import ConfigError
+
+    d = 1.95e-3
+    path = _write(tmp_path / "two.txt", [(0.0, 0.0, 0.0, R, 300.0), (d, 0.0, 0.0, R, 400.0)])
+    h = 2.0 * K * math.sqrt(R**2 - (d / 2) ** 2)
+    limit = MASS * C / h  # m c / ΣH for one contact
+    spec_limit = RHO * C * R**2 / K  # 2.0 s
+    assert spec_limit < limit
+    ok = Simulation(case_from_dict(_case(path, {"frozen_mechanics": True, "time_step": 0.1})))
+    assert check_thermal_time_step(ok) == []
+    warn = Simulation(case_from_dict(_case(path, {"frozen_mechanics": True, "time_step": 1.5})))
+    (msg,) = check_thermal_time_step(warn)
+    assert "ρ c R² / k = 2 s" in msg
+    bad = Simulation(case_from_dict(_case(path, {"frozen_mechanics": True, "time_step": 20.0})))
+    with pytest.raises(ConfigError) as err:
+        check_thermal_time_step(bad)
+    assert f"m c / ΣH = {limit:.4g} s" in str(err.value)

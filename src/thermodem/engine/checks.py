@@ -147,10 +147,68 @@ def check_simulation_time_step(sim) -> list[str]:  # noqa: ANN001 (avoids an imp
         radius.append(r)
         types.append(np.full(r.size, sim.material_index[entry.material], np.int32))
         velocity.append(np.tile(np.asarray(entry.velocity, float), (r.size, 1)))
-    return check_time_step(
+    mechanical = check_time_step(
         sim.case,
         np.concatenate(radius),
         np.concatenate(types),
         sim.material_names,
         np.concatenate(velocity),
     )
+    return mechanical + check_thermal_time_step(sim)
+
+
+def check_thermal_time_step(sim) -> list[str]:  # noqa: ANN001 (avoids an import cycle)
+    """Thermal time step against ρ c R² / k (spec 1.4, Rojek 2014) and m c / ΣH.
+
+    The spec's criterion is evaluated per particle material with its smallest radius; the
+    sharper per-particle limit m c / ΣH uses the conductances of the contacts present at the
+    start (it is re-checked at every thermal step during the run). Refused above either
+    limit unless ``thermal.stability.allow_unstable``; warned above ``warn_fraction`` × limit.
+    """
+    th = sim.thermal
+    if th is None or sim.particles.count == 0:
+        return []
+    s = th.settings
+    dt = s.time_step if s.frozen_mechanics else (1 if s.substeps == "auto" else s.substeps)
+    if not s.frozen_mechanics:
+        dt = dt * sim.dt
+    warnings: list[str] = []
+    refusals: list[str] = []
+    p = sim.particles
+    for t, name in enumerate(sim.material_names):
+        sel = p.type_id == t
+        m = sim.case.materials[name]
+        if not sel.any() or m.thermal_conductivity is None or m.specific_heat is None:
+            continue
+        r = float(p.radius[sel].min())
+        limit = m.density * m.specific_heat * r**2 / m.thermal_conductivity
+        msg = (
+            f"thermal time step {dt:.4g} s vs ρ c R² / k = {limit:.4g} s of material "
+            f"{name!r} (R = {r:.4g} m)"
+        )
+        if dt > limit:
+            refusals.append(msg + ": above the limit")
+        elif dt > s.stability.warn_fraction * limit:
+            warnings.append(msg + f": above {s.stability.warn_fraction} × the limit")
+    fixed = th.fixed if th.fixed.shape[0] == p.count else np.zeros(p.count, np.bool_)
+    from thermodem.kernels.thermal import stability_limit
+
+    limit, where = stability_limit(p.mass, th.specific_heat(), th.conductance_sum, fixed)
+    if math.isfinite(limit):
+        gid = int(p.global_id[where])
+        msg = (
+            f"thermal time step {dt:.4g} s vs the explicit Euler limit m c / ΣH = {limit:.4g} s "
+            f"(particle {gid}, from the contacts at the start)"
+        )
+        if dt > limit:
+            refusals.append(msg + ": above the limit")
+        elif dt > s.stability.warn_fraction * limit:
+            warnings.append(msg + f": above {s.stability.warn_fraction} × the limit")
+    if refusals and not s.stability.allow_unstable:
+        raise ConfigError(
+            "thermal time step refused:\n"
+            + "\n".join(refusals)
+            + "\n(reduce thermal.substeps or thermal.time_step, use substeps: auto, or set "
+            "thermal.stability.allow_unstable: true)"
+        )
+    return refusals + warnings
