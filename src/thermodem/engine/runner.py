@@ -22,7 +22,9 @@ from thermodem.config.schema import Case
 from thermodem.engine.checks import check_simulation_time_step
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import ConfigError
+from thermodem.geometry import wall_layout as WL
 from thermodem.io.vtk import PVDWriter, write_particles_vtu, write_walls_vtu
+from thermodem.state.particles import HEAT_MECHANISMS
 
 
 def prepare_output_dir(path: Path, overwrite: bool) -> None:
@@ -71,14 +73,23 @@ class FrameWriter:
             "torque": p.torque,
             "temperature": p.temperature,
             "heat_rate": p.heat_rate,
+            **{
+                f"heat_rate_{name}": p.heat_rate_by_mechanism[:, k]
+                for k, name in enumerate(HEAT_MECHANISMS)
+            },
             "coordination_number": sim.coordination_number().astype(np.int32),
         }
         write_particles_vtu(self.out / "vtk" / name, p.position, fields)
         self.particles_pvd.add(sim.time, f"vtk/{name}")
         if sim.wall_rows.shape[0]:
             wname = f"walls_{sim.step_count:09d}.vtu"
+            wall_fields = {"temperature": sim.wall_rows[:, WL.COL_TEMPERATURE].copy()}
             write_walls_vtu(
-                self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows, None, self.wall_extent
+                self.out / "vtk" / wname,
+                sim.wall_kind,
+                sim.wall_rows,
+                wall_fields,
+                self.wall_extent,
             )
             self.walls_pvd.add(sim.time, f"vtk/{wname}")
         self.frames += 1
