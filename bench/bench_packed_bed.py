@@ -46,8 +46,22 @@ def bed_geometry(n: int) -> tuple[float, float, float, int]:
     return tiles * side, fill_height + 4 * RADIUS, fill_height, tiles
 
 
+THERMAL_PROPERTIES = {
+    "thermal_conductivity": 1.0, "specific_heat": 800.0, "microhardness": 3e9,
+    "surface_roughness": 1e-6, "surface_slope": 0.1, "thermal_accommodation": 0.8,
+    "youngs_modulus_real": 7e10,
+}  # fmt: skip
+HEAT_PARAMS = {"batchelor_obrien_complete": {"fluid_conductivity": 0.026},
+               "batchelor_obrien_modified": {"fluid_conductivity": 0.026}}  # fmt: skip
+
+
 def case_dict(
-    n: int, positions_file: str | None, dt: float, restitution: float, end_time: float
+    n: int,
+    positions_file: str | None,
+    dt: float,
+    restitution: float,
+    end_time: float,
+    heat: str | None = None,
 ) -> dict:
     side, height, fill_height, _ = bed_geometry(n)
     material = {
@@ -73,6 +87,13 @@ def case_dict(
         ],
         "output": {"vtu": False},
     }
+    if heat is not None:
+        material.update(THERMAL_PROPERTIES)
+        case["thermal"] = {
+            "direct_conduction": {"model": heat, **HEAT_PARAMS.get(heat, {})},
+            "contact_radius": "geometric",
+            "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * z"},
+        }
     if positions_file is None:
         case["insertion"] = [
             {
@@ -146,10 +167,10 @@ def timed(n: int, steps: int, threads: int, heat: str | None) -> dict:
 
     bed = settle(n)
     # baseline: interpreter + libraries + compiled kernels on a tiny case
-    tiny = Simulation(case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0)), threads=threads)
+    tiny = Simulation(case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0, heat)), threads=threads)
     tiny.run(steps=5)
     baseline = rss_bytes()
-    sim = Simulation(case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0)), threads=threads)
+    sim = Simulation(case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0, heat)), threads=threads)
     sim.run(steps=20)  # warm-up
     r0 = sim.rebuild_count
     t0 = time.perf_counter()

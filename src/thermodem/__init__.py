@@ -6,6 +6,15 @@ compiled kernels in a cache directory named after a hash of all of its own sourc
 (``~/.cache/thermodem/numba-<hash>``, or under ``$THERMODEM_CACHE_DIR``): any source change
 gives a fresh cache, and an unchanged installation loads everything from disk. Setting
 ``NUMBA_CACHE_DIR`` yourself overrides this.
+
+The Python API (imported on first use, so ``import thermodem`` stays light)::
+
+    import thermodem
+    case = thermodem.load_case("examples/default.yaml")      # or thermodem.case_from_dict({...})
+    sim = thermodem.Simulation(case, threads=2)
+    sim.run(steps=1000, callback=lambda s: print(s.time), every=100)
+    sim.particles.position, sim.energies(), sim.report()
+    thermodem.run_case(case, "out/")                          # the same outputs as the CLI
 """
 
 from __future__ import annotations
@@ -37,3 +46,32 @@ def _configure_numba_cache() -> None:
 
 
 _configure_numba_cache()
+
+_API = {
+    "Case": "thermodem.config.schema",
+    "load_case": "thermodem.config.load",
+    "case_from_dict": "thermodem.config.load",
+    "resolved_case_yaml": "thermodem.config.dump",
+    "Simulation": "thermodem.engine.simulation",
+    "run_case": "thermodem.engine.runner",
+    "restart_run": "thermodem.engine.runner",
+    "run_from_checkpoint": "thermodem.engine.runner",
+    "read_checkpoint": "thermodem.io.checkpoint",
+    "write_checkpoint": "thermodem.io.checkpoint",
+    "ConfigError": "thermodem.errors",
+    "SimulationError": "thermodem.errors",
+    "RunInterrupted": "thermodem.errors",
+}
+
+__all__ = ["__version__", *_API]
+
+
+def __getattr__(name: str):  # noqa: ANN202 (PEP 562 lazy attributes)
+    module = _API.get(name)
+    if module is None:
+        raise AttributeError(f"module 'thermodem' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

@@ -1,6 +1,7 @@
-"""Command line: ``thermodem run | validate | models``.
+"""Command line: ``thermodem run | validate | restart | info | plot | models``.
 
-Exit codes: 0 success, 1 simulation failure, 2 bad input.
+Exit codes: 0 success, 1 simulation failure, 2 bad input (case, arguments, files), 130 (143)
+when a run was stopped by SIGINT (SIGTERM) after writing a checkpoint.
 """
 
 from __future__ import annotations
@@ -9,12 +10,23 @@ from pathlib import Path
 
 import typer
 
-from thermodem.errors import ConfigError, SimulationError
+from thermodem.errors import ConfigError, RunInterrupted, SimulationError
 
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
-    help="thermodem: thermal discrete element simulations",
+    help="thermodem: thermal discrete element simulations. Exit codes: 0 success, "
+    "1 simulation failure, 2 bad input, 130 interrupted (checkpoint written).",
+)
+
+EXIT_OK, EXIT_SIMULATION, EXIT_INPUT = 0, 1, 2
+
+_THREADS = typer.Option(None, "--threads", "-t", min=1, help="Numba threads")
+_PROGRESS = typer.Option(
+    None, "--progress/--no-progress", help="progress bar (default: only on a terminal)"
+)
+_LOG_INTERVAL = typer.Option(
+    10.0, "--log-interval", min=0.0, help="seconds between plain progress lines"
 )
 
 
@@ -23,59 +35,167 @@ def _fail(message: str, code: int) -> None:
     raise typer.Exit(code)
 
 
+def _guarded(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+    """Map thermodem's exceptions to messages and exit codes (never a traceback)."""
+    try:
+        return fn(*args, **kwargs)
+    except ConfigError as exc:
+        _fail(str(exc), EXIT_INPUT)
+    except SimulationError as exc:
+        _fail(str(exc), EXIT_SIMULATION)
+    except RunInterrupted as exc:
+        typer.echo(str(exc), err=True)
+        raise typer.Exit(exc.exit_code) from None
+
+
 @app.command()
 def run(
-    case: Path = typer.Argument(..., help="case file (YAML)"),
+    case: Path | None = typer.Argument(
+        None, help="case file (YAML); optional with --restart (the stored case)"
+    ),
     output: Path = typer.Option(..., "--output", "-o", help="output directory"),
-    threads: int | None = typer.Option(None, "--threads", "-t", min=1, help="Numba threads"),
+    threads: int | None = _THREADS,
     overwrite: bool = typer.Option(False, "--overwrite", help="reuse a non-empty directory"),
+    restart: Path | None = typer.Option(
+        None, "--restart", help="start from this checkpoint (.h5) instead of t = 0"
+    ),
+    progress: bool | None = _PROGRESS,
+    log_interval: float = _LOG_INTERVAL,
 ) -> None:
-    """Run a case and write VTU/PVD output."""
+    """Run a case: VTU/PVD frames, timeseries.csv, checkpoints, run.log, status.json."""
     from thermodem.config.load import load_case
-    from thermodem.engine.runner import run_case
+    from thermodem.engine.runner import run_case, run_from_checkpoint
 
-    try:
-        sim = run_case(load_case(case), output, threads=threads, overwrite=overwrite)
-    except ConfigError as exc:
-        _fail(str(exc), 2)
-    except SimulationError as exc:
-        _fail(str(exc), 1)
-    typer.echo(
-        f"done: {sim.step_count} steps, {sim.particles.count} particles; "
-        f"open {output / 'particles.pvd'} in ParaView"
+    def go() -> None:
+        if case is None and restart is None:
+            raise ConfigError("give a case file, or --restart CHECKPOINT")
+        loaded = load_case(case) if case is not None else None
+        name = case.stem if case is not None else None
+        options = dict(progress=progress, log_interval=log_interval, case_name=name)
+        if restart is not None:
+            run_from_checkpoint(restart, output, loaded, threads, overwrite, **options)
+        else:
+            run_case(loaded, output, threads, overwrite, **options)
+
+    _guarded(go)
+
+
+@app.command()
+def restart(
+    directory: Path = typer.Argument(..., help="output directory of an earlier run"),
+    threads: int | None = _THREADS,
+    end_time: float | None = typer.Option(
+        None, "--end-time", help="new end time [s] (default: the case's)"
+    ),
+    progress: bool | None = _PROGRESS,
+    log_interval: float = _LOG_INTERVAL,
+) -> None:
+    """Continue a run from the newest checkpoint in DIRECTORY (appending to its outputs)."""
+    from thermodem.engine.runner import restart_run
+
+    _guarded(
+        restart_run,
+        directory,
+        threads,
+        end_time=end_time,
+        progress=progress,
+        log_interval=log_interval,
     )
 
 
 @app.command()
-def validate(case: Path = typer.Argument(..., help="case file (YAML)")) -> None:
-    """Check a case (schema, time step) and print it with every default filled in."""
-    from thermodem.config.load import load_case
-    from thermodem.engine.checks import check_simulation_time_step
-    from thermodem.engine.runner import resolved_case_yaml
-    from thermodem.engine.simulation import Simulation
+def validate(
+    case: Path = typer.Argument(..., help="case file (YAML)"),
+    threads: int | None = _THREADS,
+) -> None:
+    """Check a case (schema, completeness, time step, resources); print it resolved."""
+    from thermodem.config.dump import resolved_case_yaml
+    from thermodem.engine.validation import validate_case
 
-    try:
-        c = load_case(case)
-        sim = Simulation(c)
-        warnings = check_simulation_time_step(sim)
-    except ConfigError as exc:
-        _fail(str(exc), 2)
-    for w in warnings:
+    result = _guarded(validate_case, case, threads)
+    for w in result.warnings:
         typer.echo(f"warning: {w}", err=True)
-    typer.echo(resolved_case_yaml(c))
+    typer.echo(f"# {case}: valid (schema, completeness, time step, resources)")
+    for line in result.estimate.lines():
+        typer.echo(f"# {line}")
+    typer.echo(resolved_case_yaml(result.case))
 
 
 @app.command()
-def models() -> None:
-    """List every registered model: family, name, parameters, reference."""
-    from thermodem.models.registry import all_models
+def info(directory: Path = typer.Argument(..., help="output directory")) -> None:
+    """Summarise an output directory: status, time reached, frames, checkpoints, last row."""
+    from thermodem.engine.runner import output_summary
 
-    for spec in all_models():
-        typer.echo(f"{spec.family}.{spec.name}: {spec.summary}")
-        for pname, field in spec.params.model_fields.items():
-            default = "" if field.is_required() else f" (default {field.default!r})"
-            typer.echo(f"    {pname}: {field.description or ''}{default}")
-        typer.echo(f"    reference: {spec.reference}")
+    for line in _guarded(output_summary, directory):
+        typer.echo(line)
+
+
+@app.command()
+def plot(
+    directory: Path = typer.Argument(..., help="output directory"),
+    out: Path | None = typer.Option(None, "--out", help="where the PNGs go (default DIR/plots)"),
+) -> None:
+    """PNG figures of timeseries.csv: energies, contacts, temperatures and heat."""
+    from thermodem.io.plots import plot_directory
+
+    for path in _guarded(plot_directory, directory, out):
+        typer.echo(str(path))
+
+
+def _bounds(field) -> str:  # noqa: ANN001
+    parts = []
+    for m in field.metadata:
+        for attr, sym in (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<=")):
+            value = getattr(m, attr, None)
+            if value is not None:
+                parts.append(f"{sym} {value:g}" if isinstance(value, float | int) else "")
+    return ", ".join(p for p in parts if p)
+
+
+def _unit(description: str) -> tuple[str, str]:
+    """('[unit]', rest of the description) from 'text [unit] more'."""
+    import re
+
+    m = re.search(r"\[([^\]]*)\]", description)
+    if not m:
+        return "", description
+    rest = (description[: m.start()] + description[m.end() :]).strip(" ,;")
+    return m.group(1), rest
+
+
+@app.command()
+def models(
+    family: str | None = typer.Argument(None, help="only this family (e.g. normal)"),
+) -> None:
+    """List every model: parameters (unit, default, bounds), requirements, reference."""
+    from thermodem.models.registry import FAMILIES, all_models
+
+    if family is not None and family not in FAMILIES:
+        _fail(f"unknown family {family!r}; families: {', '.join(FAMILIES)}", EXIT_INPUT)
+    specs = all_models()
+    for fam in FAMILIES:
+        if family is not None and fam != family:
+            continue
+        members = [s for s in specs if s.family == fam]
+        typer.echo(f"== {fam} ==")
+        if not members:
+            typer.echo("  (no models registered yet)")
+        for spec in members:
+            typer.echo(f"  {fam}.{spec.name}: {spec.summary}")
+            if spec.requires:
+                typer.echo(f"    requires materials.*: {', '.join(spec.requires)}")
+            fields = spec.params.model_fields
+            if not fields:
+                typer.echo("    parameters: none")
+            for pname, field in fields.items():
+                unit, text = _unit(field.description or "")
+                default = "required" if field.is_required() else f"default {field.default!r}"
+                bounds = _bounds(field)
+                details = ", ".join(
+                    x for x in (f"[{unit}]" if unit else "", default, bounds, text) if x
+                )
+                typer.echo(f"    {pname}: {details}")
+            typer.echo(f"    reference: {spec.reference}")
 
 
 if __name__ == "__main__":  # pragma: no cover

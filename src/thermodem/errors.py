@@ -1,4 +1,5 @@
-"""Typed exceptions: bad input (ConfigError) and a run that went wrong (SimulationError)."""
+"""Typed exceptions: bad input (ConfigError), a run that went wrong (SimulationError), a run
+stopped by a signal after writing a checkpoint (RunInterrupted)."""
 
 from __future__ import annotations
 
@@ -23,3 +24,20 @@ class SimulationError(RuntimeError):
         self.time = time
         self.particle = particle
         self.checkpoint = checkpoint
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT) or SIGTERM after writing a checkpoint.
+
+    ``checkpoint`` is the file to continue from (``thermodem restart OUT``); ``exit_code`` is
+    128 + the signal number (130 for SIGINT, 143 for SIGTERM), what the CLI exits with.
+    """
+
+    def __init__(self, message: str, checkpoint: str | None = None, exit_code: int = 130) -> None:
+        super().__init__(message)
+        self.message = message
+        self.checkpoint = checkpoint
+        self.exit_code = exit_code
+
+    def __str__(self) -> str:
+        return self.message

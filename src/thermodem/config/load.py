@@ -8,22 +8,33 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
+from thermodem.config.messages import format_validation_error
 from thermodem.config.schema import Case
 from thermodem.errors import ConfigError
 
 
-def _format_validation_error(exc: ValidationError) -> str:
-    lines = []
-    for err in exc.errors():
-        path = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-"))
-        msg = err["msg"].removeprefix("Value error, ")
-        value = err.get("input")
-        shown = "" if isinstance(value, dict | list) else f" (got {value!r})"
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key"
-            shown = ""
-        lines.append(f"{path}: {msg}{shown}")
-    return "\n".join(lines)
+def _format_validation_error(exc: ValidationError, data: Any = None) -> str:
+    return format_validation_error(exc, data)
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """A safe loader that refuses duplicate keys (PyYAML would keep the last one silently)."""
+
+
+def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False):  # noqa: ANN202
+    seen: dict[Any, Any] = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            mark = key_node.start_mark
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key {key!r} (first at line {seen[key] + 1})", mark
+            )
+        seen[key] = key_node.start_mark.line
+    return loader.construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 
 
 def case_from_dict(data: Any, source: str = "<case>") -> Case:
@@ -35,7 +46,9 @@ def case_from_dict(data: Any, source: str = "<case>") -> Case:
     try:
         return Case.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(f"{source}: invalid case\n{_format_validation_error(exc)}") from None
+        raise ConfigError(
+            f"{source}: invalid case\n{_format_validation_error(exc, data)}"
+        ) from None
 
 
 def load_case(path: str | Path) -> Case:
@@ -45,15 +58,24 @@ def load_case(path: str | Path) -> Case:
         raise ConfigError(f"case file {str(path)!r} does not exist")
     if path.is_dir():
         raise ConfigError(f"case file {str(path)!r} is a directory, expected a YAML file")
-    text = path.read_text()
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"case file {str(path)!r} is not UTF-8 text ({exc.reason})") from None
+    except OSError as exc:
+        raise ConfigError(f"case file {str(path)!r} cannot be read: {exc.strerror}") from None
     if not text.strip():
         raise ConfigError(f"case file {str(path)!r} is empty")
     try:
-        data = yaml.safe_load(text)
+        data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader subclass)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown place"
         raise ConfigError(f"{path}: YAML syntax error at {where}: {exc.problem}") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: YAML error: {exc}") from None
+    if data is None:
+        raise ConfigError(f"case file {str(path)!r} is empty (only comments or blank lines)")
     case = case_from_dict(data, str(path))
     # relative file paths in the case are relative to the case file
     for entry in case.insertion:

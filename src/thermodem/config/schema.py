@@ -153,6 +153,15 @@ class Output(StrictModel):
     wall_extent: float | None = Field(
         default=None, gt=0, description="half size drawn for infinite walls [m]"
     )
+    timeseries_interval: float | None = Field(
+        default=None, gt=0, description="timeseries.csv row interval [s]; default end_time / 1000"
+    )
+    checkpoint_interval: float | None = Field(
+        default=None, gt=0, description="HDF5 checkpoint interval [s]; default end_time / 10"
+    )
+    checkpoint_keep: int | None = Field(
+        default=2, ge=1, description="newest periodic checkpoints kept; null: keep all"
+    )
 
 
 class Case(StrictModel):

@@ -76,6 +76,14 @@ class PerMaterialTemperature(StrictModel):
     values: dict[str, float] = Field(description="material name -> temperature [K]")
     default: float = Field(default=293.15, gt=0, description="[K] for materials not listed")
 
+    @field_validator("values")
+    @classmethod
+    def _positive(cls, v: dict[str, float]) -> dict[str, float]:
+        for name, temp in v.items():
+            if not temp > 0:
+                raise ValueError(f"temperature of {name!r} must be > 0 K, got {temp}")
+        return v
+
 
 class RegionTemperature(StrictModel):
     """Temperature per box region (the last region containing a particle wins)."""
@@ -83,6 +91,14 @@ class RegionTemperature(StrictModel):
     kind: Literal["regions"] = "regions"
     regions: list[tuple[Box, float]] = Field(description="[(box, temperature [K]), ...]")
     default: float = Field(default=293.15, gt=0, description="[K] outside every region")
+
+    @field_validator("regions")
+    @classmethod
+    def _positive(cls, v: list[tuple[Box, float]]) -> list[tuple[Box, float]]:
+        for k, (_, temp) in enumerate(v):
+            if not temp > 0:
+                raise ValueError(f"temperature of region {k} must be > 0 K, got {temp}")
+        return v
 
 
 class ExpressionTemperature(StrictModel):
@@ -148,6 +164,8 @@ class ExternalSource(StrictModel):
     def _check(self) -> ExternalSource:
         if self.profile == "gaussian" and self.sigma is None:
             raise ValueError("profile 'gaussian' needs sigma [m]")
+        if not sum(a * a for a in self.axis) > 0.0:
+            raise ValueError(f"axis must be a non-zero vector, got {list(self.axis)}")
         if self.end_time <= self.start_time:
             raise ValueError(f"end_time {self.end_time} must be after start_time {self.start_time}")
         return self
@@ -226,10 +244,18 @@ class WallThermal(StrictModel):
     def _check(self) -> WallThermal:
         if self.kind == "fixed" and self.temperature is None:
             raise ValueError("a fixed-temperature wall needs temperature")
+        if self.kind == "adiabatic" and self.temperature is not None:
+            raise ValueError(
+                "temperature is given but kind is 'adiabatic' (the default): set kind: fixed"
+            )
+        if isinstance(self.temperature, int | float) and not self.temperature > 0:
+            raise ValueError(f"temperature must be > 0 K, got {self.temperature}")
         if isinstance(self.temperature, list):
             times = [t for t, _ in self.temperature]
             if len(times) < 1 or any(b <= a for a, b in zip(times, times[1:], strict=False)):
                 raise ValueError("temperature table times must increase strictly")
+            if any(not temp > 0 for _, temp in self.temperature):
+                raise ValueError("temperature table values must be > 0 K")
         if isinstance(self.temperature, str):
             from thermodem.engine.expressions import compile_expression
 

@@ -25,6 +25,8 @@ import numba
 import numpy as np
 
 from thermodem.config.schema import Case, ModelChoice
+from thermodem.engine import diagnostics as D
+from thermodem.engine.validation import check_completeness
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
 from thermodem.geometry.insertion import InsertedParticles, Pourer, insert
@@ -108,9 +110,14 @@ class _PairBuffers:
 class Simulation:
     """A thermal DEM simulation built from a validated :class:`~thermodem.config.schema.Case`."""
 
-    def __init__(self, case: Case, threads: int | None = None) -> None:
+    def __init__(
+        self, case: Case, threads: int | None = None, *, insert_particles: bool = True
+    ) -> None:
+        """Build the simulation; ``insert_particles=False`` skips the static insertion entries
+        (used when the state comes from a checkpoint, see :meth:`from_checkpoint`)."""
         if threads is not None:
             numba.set_num_threads(int(threads))
+        check_completeness(case)  # validation layer 2 (engine/validation.py)
         self.case = case
         sim = case.simulation
         self.dt = float(sim.time_step)
@@ -145,6 +152,12 @@ class Simulation:
         self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         # thermal engine (absent = mechanics only)
+        z1, z3 = np.zeros(0), np.zeros((1, 1, 16))
+        self._no_heat = (
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, np.zeros((1, 16)), z1, z1),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, np.zeros((1, 16)), z1, z1),
+        )
+        self._no_reduce_heat = (False, z1, z1, z1, z1, np.zeros((1, 7)), z1)
         self.thermal = None
         if case.thermal is not None:
             from thermodem.engine.thermal import ThermalEngine
@@ -157,7 +170,7 @@ class Simulation:
         for entry in case.insertion:
             if entry.kind == "pour":
                 self.pourers.append(Pourer(entry, self.rng))
-            else:
+            elif insert_particles:
                 self.add_particles(
                     insert(entry, self.rng, self.particles.position, self.particles.radius)
                 )
@@ -189,8 +202,12 @@ class Simulation:
         self._compute_forces(kick=False, contact_dt=0.0)
         self.initial_energy = self.total_energy()
         if self.thermal is not None:
-            self.thermal.compute_rates(self.time)
+            if self.thermal.fresh:
+                self.thermal.gather(self.time, reduced=True)
+            else:
+                self.thermal.compute_rates(self.time)
             self.thermal.initial_energy = self.thermal.thermal_energy()
+            self.thermal.cumulative["fixed_reset"] = 0.0  # resets before t = 0 are the start
 
     # ------------------------------------------------------------------ particles in and out
     def add_particles(self, new: InsertedParticles) -> None:
@@ -220,6 +237,8 @@ class Simulation:
                 0.5 * np.sum(extra.mass * np.sum(extra.velocity**2, axis=1))
                 - np.sum(extra.mass * (extra.position @ self.gravity))
             )
+        if self.thermal is not None and hasattr(self, "ledger_cumulative"):
+            self.thermal.inserted(extra.temperature, extra.mass, extra.type_id)
         self.particles.append(extra)
         if hasattr(self, "reference"):
             self.reference = np.concatenate([self.reference, extra.position])
@@ -365,6 +384,16 @@ class Simulation:
         p = self.particles
         pb, wb = self.pairs, self.walls
         nid, tid, rid = self.model_ids
+        th = self.thermal
+        heat_due = (
+            th is not None and not th.settings.frozen_mechanics and th.next_step <= self.step_count
+        )
+        if heat_due:
+            # conduction evaluated in the contact pass, for the thermal step that follows
+            th.prepare(self.time)
+            pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+        else:
+            pair_heat, wall_heat = self._no_heat
         C.particle_pair_pass(
             p.position,
             p.velocity,
@@ -395,6 +424,7 @@ class Simulation:
             pb.normal_force,
             pb.state,
             pb.chunk_ledger,
+            *pair_heat,
         )
         C.wall_pair_pass(
             p.position,
@@ -426,7 +456,13 @@ class Simulation:
             wb.normal_force,
             wb.state,
             wb.chunk_ledger,
+            *wall_heat,
         )
+        if heat_due:
+            th.fresh = True
+            red_heat = th.reduce_heat_args()
+        else:
+            red_heat = self._no_reduce_heat
         reduce_and_kick(
             p.radius,
             p.mass,
@@ -447,6 +483,7 @@ class Simulation:
             wb.lever,
             wb.roll,
             kick,
+            *red_heat,
         )
         self._accumulate_ledger(kick)
 
@@ -554,15 +591,15 @@ class Simulation:
         if code == 1:
             raise SimulationError(
                 f"non-finite position or velocity of particle {gid} {where}: x = {x.tolist()}, "
-                f"v = {v.tolist()}; likely cause: time step {self.dt:g} s too large for the "
-                f"contact stiffness (see the Rayleigh and Hertz checks of 'validate')",
+                f"v = {v.tolist()}; likely cause: {D.time_step_cause(self)}",
                 step,
                 time,
                 gid,
             )
         raise SimulationError(
             f"particle {gid} left the domain {where}: position {x.tolist()} outside "
-            f"[{self.lower.tolist()}, {self.upper.tolist()}], velocity {v.tolist()} m/s",
+            f"[{self.lower.tolist()}, {self.upper.tolist()}], velocity {v.tolist()} m/s; "
+            f"likely cause: {D.left_domain_cause(self, index)}",
             step,
             time,
             gid,
@@ -572,12 +609,15 @@ class Simulation:
         where = self._where()
         limit = self.case.simulation.max_overlap_ratio
         if self.max_overlap_ratio > limit:
+            _, gid, other, kind = D.worst_overlap(self)
+            who = f"particle {gid} and {kind}" + (f" {other}" if other >= 0 else "")
             raise SimulationError(
-                f"overlap of {self.max_overlap_ratio:.3g} × the smaller radius {where} exceeds "
-                f"simulation.max_overlap_ratio = {limit}; likely cause: contact stiffness too "
-                f"low for the loads, or time step {self.dt:g} s too large",
+                f"overlap of {self.max_overlap_ratio:.3g} × the smaller radius ({who}) {where} "
+                f"exceeds simulation.max_overlap_ratio = {limit}; likely cause: "
+                f"{D.overlap_cause(self)}",
                 self.step_count,
                 self.time,
+                gid,
             )
 
     # ------------------------------------------------------------------------------ ledger
@@ -658,3 +698,42 @@ class Simulation:
         return critical_times(
             self.case, self.particles.radius, self.particles.type_id, self.material_names
         )
+
+    # ------------------------------------------------------------- reports and restart state
+    def report(self) -> dict[str, float]:
+        """One row of the time series: the energy ledger, its balance error, counts and the
+        largest overlap ratio, plus the thermal summary when there is a thermal engine.
+
+        ``engine/runner.py`` writes every key as a column of ``timeseries.csv``.
+        """
+        out: dict[str, float] = dict(self.energies())
+        out["energy_balance_error"] = self.energy_balance_error()
+        out["particle_count"] = self.particles.count
+        out["contact_count"] = self.contact_count
+        out["max_overlap_ratio"] = self.max_overlap_ratio
+        if self.thermal is not None:
+            out.update(self.thermal.summary())
+        return out
+
+    def state_dict(self) -> dict:
+        """The complete restart state (copies); see :mod:`thermodem.engine.restart`."""
+        from thermodem.engine.restart import capture
+
+        return capture(self)
+
+    def load_state(self, state: dict) -> None:
+        """Continue from a state of :meth:`state_dict` (same case, built with
+        ``insert_particles=False``)."""
+        from thermodem.engine.restart import restore
+
+        restore(self, state)
+
+    @classmethod
+    def from_checkpoint(
+        cls, path: str, threads: int | None = None, case: Case | None = None
+    ) -> Simulation:
+        """A simulation continuing from an HDF5 checkpoint (``case``: replaces the stored
+        case, e.g. with a later end time)."""
+        from thermodem.io.checkpoint import load_simulation
+
+        return load_simulation(path, threads=threads, case=case)

@@ -108,12 +108,19 @@ class ThermalEngine:
         self.fixed = np.zeros(0, np.bool_)
         self.source = np.zeros(0)
         self.conductance_sum = np.zeros(0)
-        self.cumulative = {"wall_heat": 0.0, "source_heat": 0.0, "fixed_absorbed": 0.0}
+        self.cumulative = {
+            "wall_heat": 0.0,
+            "source_heat": 0.0,
+            "fixed_absorbed": 0.0,
+            "inserted_heat": 0.0,
+            "fixed_reset": 0.0,
+        }
         self.limit = math.inf
         self.limit_particle = -1
         self.substeps = 1 if settings.substeps == "auto" else int(settings.substeps)
         self.thermal_steps = 0
         self.next_step = 0
+        self.fresh = False
         self._warned = False
         self.initial_energy = 0.0
 
@@ -217,7 +224,6 @@ class ThermalEngine:
         if self.fixed.shape[0] != p.count:
             self.fixed = np.zeros(p.count, np.bool_)
             self.source = np.zeros(p.count)
-            self.conductance_sum = np.zeros(p.count)
         fixed, source = self.fixed, self.source
         if not (s.fixed_temperature or s.heat_flux or s.volumetric_source or s.external_source):
             return fixed, source
@@ -226,7 +232,10 @@ class ThermalEngine:
         for f in s.fixed_temperature:
             mask = self._select(f.select)
             fixed |= mask
+            before = self.thermal_energy(mask)
             p.temperature[mask] = f.temperature
+            # a particle that becomes fixed is set to the bath temperature: ledgered
+            self.cumulative["fixed_reset"] += self.thermal_energy(mask) - before
         for h in s.heat_flux:
             mask = self._select(h.select)
             source[mask] += h.flux * 4.0 * np.pi * p.radius[mask] ** 2
@@ -270,49 +279,96 @@ class ThermalEngine:
             self.wall_conductance = np.zeros(sim.walls.capacity)
             self.wall_heat = np.zeros(sim.walls.capacity)
 
-    def compute_rates(self, time: float) -> np.ndarray:
-        """Heat rates of the current state (fills particles.heat_rate and by_mechanism).
-
-        Returns the fixed-temperature mask.
-        """
+    def prepare(self, time: float) -> None:
+        """Buffers, wall temperatures at ``time`` and k(T), ρc(T) arrays for a conduction pass."""
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
         self._buffers()
         self._update_walls(time)
-        fixed, source = self._fixed_and_sources(time)
-        k_p = rhoc_p = k_w = rhoc_w = self._empty
+        # fixed-temperature particles take their temperature before any conduction pass sees it
+        self._fixed_and_sources(time)
+        self.k_p = self.rhoc_p = self.k_w = self.rhoc_w = self._empty
         if self.override:
-            k_p = self._interp(self.k_t, self.k_v, self.k_n, p.type_id, p.temperature)
+            self.k_p = self._interp(self.k_t, self.k_v, self.k_n, p.type_id, p.temperature)
             c_p = self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
-            rhoc_p = self.density_by_type[p.type_id] * c_p
+            self.rhoc_p = self.density_by_type[p.type_id] * c_p
             wt = sim.wall_rows[:, WL.COL_TEMPERATURE]
-            k_w = self._interp(self.k_t, self.k_v, self.k_n, sim.wall_material, wt)
-            rhoc_w = self.density_by_type[sim.wall_material] * self._interp(
+            self.k_w = self._interp(self.k_t, self.k_v, self.k_n, sim.wall_material, wt)
+            self.rhoc_w = self.density_by_type[sim.wall_material] * self._interp(
                 self.c_t, self.c_v, self.c_n, sim.wall_material, wt
             )
-            rows = max(pb.count, wb.count) // K.CHUNK + 1
-            if self.scratch.shape[0] < rows:
-                self.scratch = np.zeros((rows, 16))
+        rows = max(pb.count, wb.count) // K.CHUNK + 1
+        if self.scratch.shape[0] < rows:
+            self.scratch = np.zeros((rows, 16))
+
+    def pair_heat_args(self) -> tuple:
+        """Arguments of the fused contact pass (particle pairs) that switch conduction on."""
+        return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
+                self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
+                self.scratch, self.pair_conductance, self.pair_heat)  # fmt: skip
+
+    def wall_heat_args(self) -> tuple:
+        """Arguments of the fused contact pass (wall pairs) that switch conduction on."""
+        return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
+                self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
+                self.k_w, self.rhoc_w, self.scratch, self.wall_conductance,
+                self.wall_heat)  # fmt: skip
+
+    def reduce_heat_args(self) -> tuple:
+        """Arguments of the fused per-particle reduction that sum the pair heat."""
+        p = self.sim.particles
+        if self.conductance_sum.shape[0] != p.count:
+            self.conductance_sum = np.zeros(p.count)
+        return (True, self.pair_conductance, self.pair_heat, self.wall_conductance,
+                self.wall_heat, p.heat_rate_by_mechanism, self.conductance_sum)  # fmt: skip
+
+    def conduction_passes(self) -> None:
+        """Heat-only conduction passes over the current pair lists (frozen mechanics, init)."""
+        sim = self.sim
+        p = sim.particles
+        pb, wb = sim.pairs, sim.walls
         K.conduction_pair_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
             pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
             self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
-            self.override, k_p, rhoc_p, self.scratch, self.pair_conductance, self.pair_heat,
+            self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
+            self.pair_heat,
         )  # fmt: skip
         K.conduction_wall_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
             wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
             sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
-            self.conduction_table, self.override, k_p, rhoc_p, k_w, rhoc_w, self.scratch,
-            self.wall_conductance, self.wall_heat,
+            self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w, self.rhoc_w,
+            self.scratch, self.wall_conductance, self.wall_heat,
         )  # fmt: skip
+
+    def gather(self, time: float, reduced: bool = False) -> np.ndarray:
+        """Per-particle heat rates from the pair heat arrays and the sources; returns the
+        fixed-temperature mask. ``reduced``: the fused reduction already summed the pairs."""
+        sim = self.sim
+        p = sim.particles
+        fixed, source = self._fixed_and_sources(time)
+        if reduced:
+            K.finish_heat(source, p.heat_rate, p.heat_rate_by_mechanism)
+            return fixed
+        if self.conductance_sum.shape[0] != p.count:
+            self.conductance_sum = np.zeros(p.count)
         K.heat_gather(
             sim.row_start, sim.entries, self.pair_conductance, self.pair_heat,
             sim.wall_row_start, self.wall_conductance, self.wall_heat, source, p.heat_rate,
             p.heat_rate_by_mechanism, self.conductance_sum,
         )  # fmt: skip
         return fixed
+
+    def compute_rates(self, time: float) -> np.ndarray:
+        """Heat rates of the current state (fills particles.heat_rate and by_mechanism).
+
+        Returns the fixed-temperature mask.
+        """
+        self.prepare(time)
+        self.conduction_passes()
+        return self.gather(time)
 
     def specific_heat(self) -> np.ndarray:
         """c(T) of every particle [J/(kg K)]."""
@@ -325,12 +381,29 @@ class ThermalEngine:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler)."""
         sim = self.sim
         p = sim.particles
-        fixed = self.compute_rates(time)
-        c = self.specific_heat()
-        self.limit, where = K.stability_limit(p.mass, c, self.conductance_sum, fixed)
+        if self.fresh:  # the fused contact pass already computed the pair heat at this state
+            fixed, source = self._fixed_and_sources(time)
+        else:
+            fixed = self.compute_rates(time)
+            source = self.source
+        self.fresh = False
+        if self.has_c_table:
+            K.finish_heat(source, p.heat_rate, p.heat_rate_by_mechanism)
+            c = self.specific_heat()
+            self.limit, where = K.stability_limit(p.mass, c, self.conductance_sum, fixed)
+            wall_q = float(np.sum(p.heat_rate_by_mechanism[:, K.M_WALL]))
+            source_q = float(np.sum(source))
+            absorbed, bad = K.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
+                                                    p.type_id, self.c_t, self.c_v, self.c_n,
+                                                    fixed, dt)  # fmt: skip
+        else:
+            # one fused pass: heat rate, Euler limit, update and the ledger sums
+            self.limit, where, wall_q, source_q, absorbed, bad = K.euler_step(
+                p.temperature, p.heat_rate, p.heat_rate_by_mechanism, source, p.mass,
+                p.type_id, self.specific_heat_by_type, self.conductance_sum, fixed, dt,
+            )  # fmt: skip
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
-        stab = self.settings.stability
-        if dt > self.limit and not stab.allow_unstable:
+        if dt > self.limit and not self.settings.stability.allow_unstable:
             raise SimulationError(
                 f"thermal time step {dt:.4g} s exceeds the explicit Euler limit m c / ΣH = "
                 f"{self.limit:.4g} s of particle {self.limit_particle} at step "
@@ -340,14 +413,6 @@ class ThermalEngine:
                 time,
                 self.limit_particle,
             )
-        wall_q = float(np.sum(p.heat_rate_by_mechanism[:, K.M_WALL]))
-        source_q = float(np.sum(self.source))
-        if self.has_c_table:
-            absorbed, bad = K.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
-                                                    p.type_id, self.c_t, self.c_v, self.c_n,
-                                                    fixed, dt)  # fmt: skip
-        else:
-            absorbed, bad = K.euler_update(p.temperature, p.heat_rate, p.mass, c, fixed, dt)
         self.cumulative["wall_heat"] += wall_q * dt
         self.cumulative["source_heat"] += source_q * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
@@ -367,19 +432,31 @@ class ThermalEngine:
             self.substeps = min(max(n, 1), self.settings.max_substeps)
 
     # ---------------------------------------------------------------------------- ledger
-    def thermal_energy(self) -> float:
-        """Σ m c T over all particles [J] (Σ m h(T) with a temperature-dependent c)."""
+    def thermal_energy(self, mask: np.ndarray | None = None) -> float:
+        """Σ m c T over all particles (or ``mask``) [J] (Σ m h(T) with a tabulated c)."""
         p = self.sim.particles
+        t, m, ty = p.temperature, p.mass, p.type_id
+        if mask is not None:
+            t, m, ty = t[mask], m[mask], ty[mask]
         if self.has_c_table:
-            return K.total_enthalpy(p.temperature, p.mass, p.type_id, self.c_t, self.c_v,
-                                    self.c_n)  # fmt: skip
-        return float(np.sum(p.mass * self.specific_heat() * p.temperature))
+            return K.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
+        return float(np.sum(m * self.specific_heat_by_type[ty] * t))
+
+    def inserted(self, temperature: np.ndarray, mass: np.ndarray, type_id: np.ndarray) -> None:
+        """Ledger the thermal energy that inserted particles bring in."""
+        if self.has_c_table:
+            e = K.total_enthalpy(temperature, mass, type_id, self.c_t, self.c_v, self.c_n)
+        else:
+            e = float(np.sum(mass * self.specific_heat_by_type[type_id] * temperature))
+        self.cumulative["inserted_heat"] += e
 
     def balance_error(self) -> float:
-        """U(t) - U(0) - wall heat - sources + heat absorbed by fixed particles [J]; ~0."""
+        """U(t) - U(0) - wall heat - sources + heat absorbed by fixed particles - heat of
+        inserted particles - resets of newly fixed particles [J]; round-off."""
         cum = self.cumulative
         return (self.thermal_energy() - self.initial_energy - cum["wall_heat"]
-                - cum["source_heat"] + cum["fixed_absorbed"])  # fmt: skip
+                - cum["source_heat"] + cum["fixed_absorbed"] - cum["inserted_heat"]
+                - cum["fixed_reset"])  # fmt: skip
 
     def summary(self) -> dict[str, float]:
         """Temperature statistics, heat by mechanism [W] and the heat ledger [J]."""

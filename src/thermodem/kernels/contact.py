@@ -18,7 +18,15 @@ import math
 
 from numba import njit, prange
 
-from thermodem.geometry.wall_layout import COL_AXIS, COL_OMEGA, COL_POINT, COL_VELOCITY
+from thermodem.geometry.wall_layout import (
+    COL_AXIS,
+    COL_OMEGA,
+    COL_POINT,
+    COL_TEMPERATURE,
+    COL_THERMAL_KIND,
+    COL_VELOCITY,
+)
+from thermodem.kernels.conduction import pair_conductance
 from thermodem.kernels.neighbors import minimum_image, wall_distance
 from thermodem.models.mechanics.dispatch import (
     normal_dispatch,
@@ -253,6 +261,49 @@ def _clear_contact(
     out_normal_force[k] = 0.0
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _pp_conductance(
+    k, i, j, ri, rj, dist, overlap, mass, type_id, history, normal_force, radius_id,
+    radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, srow,
+):  # fmt: skip
+    ti = type_id[i]
+    tj = type_id[j]
+    ki = kj = ci = cj = 0.0
+    if override > 0:
+        ki = k_particle[i]
+        kj = k_particle[j]
+        if override > 1:
+            ci = rhoc_particle[i]
+            cj = rhoc_particle[j]
+    return pair_conductance(
+        ri, rj, dist, overlap, mass[i] * mass[j] / (mass[i] + mass[j]), normal_force[k],
+        history[k, H_DURATION], history[k, H_IMPACT_VELOCITY], radius_id, radius_table[ti, tj],
+        conduction_id, conduction_table[ti, tj], override, ki, kj, ci, cj, srow,
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _pw_conductance(
+    k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force, radius_id,
+    radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall,
+    rhoc_wall, srow,
+):  # fmt: skip
+    ti = type_id[i]
+    tw = wall_material[w]
+    ki = kw = ci = cw = 0.0
+    if override > 0:
+        ki = k_particle[i]
+        kw = k_wall[w]
+        if override > 1:
+            ci = rhoc_particle[i]
+            cw = rhoc_wall[w]
+    return pair_conductance(
+        ri, math.inf, d, overlap, mass[i], normal_force[k], history[k, H_DURATION],
+        history[k, H_IMPACT_VELOCITY], radius_id, radius_table[ti, tw], conduction_id,
+        conduction_table[ti, tw], override, ki, kw, ci, cw, srow,
+    )  # fmt: skip
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def particle_pair_pass(
     position,
@@ -284,11 +335,29 @@ def particle_pair_pass(
     out_normal_force,
     out_state,
     chunk_ledger,
+    heat_on,
+    temperature,
+    radius_id,
+    radius_table,
+    conduction_id,
+    conduction_table,
+    override,
+    k_particle,
+    rhoc_particle,
+    scratch,
+    out_conductance,
+    out_heat,
 ):
-    """Contact forces of every listed particle pair (see module docstring)."""
+    """Contact forces of every listed particle pair (see module docstring).
+
+    With ``heat_on`` the same pass evaluates the conduction of every touching and near pair
+    (see :func:`thermodem.kernels.conduction.pair_conductance`) into ``out_conductance`` and
+    ``out_heat`` (heat rate into i), with the temperatures of this moment.
+    """
     length = upper - lower
     nchunks = (npairs + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
+        srow = scratch[c]
         row = chunk_ledger[c]
         for q in range(row.shape[0]):
             row[q] = 0.0
@@ -318,6 +387,16 @@ def particle_pair_pass(
                         out_diss[k, q] = 0.0
                     out_normal_force[k] = 0.0
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
+                if heat_on:
+                    h = 0.0
+                    if out_state[k] == STATE_NEAR:
+                        h = _pp_conductance(
+                            k, i, j, ri, rj, dist, overlap, mass, type_id, history,
+                            out_normal_force, radius_id, radius_table, conduction_id,
+                            conduction_table, override, k_particle, rhoc_particle, srow,
+                        )  # fmt: skip
+                    out_conductance[k] = h
+                    out_heat[k] = h * (temperature[j] - temperature[i])
                 continue
             out_state[k] = STATE_TOUCHING
             nx = dx / dist
@@ -376,6 +455,14 @@ def particle_pair_pass(
             ratio = overlap / min(ri, rj)
             if ratio > row[L_MAX_OVERLAP_RATIO]:
                 row[L_MAX_OVERLAP_RATIO] = ratio
+            if heat_on:
+                h = _pp_conductance(
+                    k, i, j, ri, rj, dist, overlap, mass, type_id, history, out_normal_force,
+                    radius_id, radius_table, conduction_id, conduction_table, override,
+                    k_particle, rhoc_particle, srow,
+                )  # fmt: skip
+                out_conductance[k] = h
+                out_heat[k] = h * (temperature[j] - temperature[i])
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -409,10 +496,28 @@ def wall_pair_pass(
     out_normal_force,
     out_state,
     chunk_ledger,
+    heat_on,
+    temperature,
+    radius_id,
+    radius_table,
+    conduction_id,
+    conduction_table,
+    override,
+    k_particle,
+    rhoc_particle,
+    k_wall,
+    rhoc_wall,
+    scratch,
+    out_conductance,
+    out_heat,
 ):
-    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass)."""
+    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass).
+
+    With ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero).
+    """
     nchunks = (nwpairs + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
+        srow = scratch[c]
         row = chunk_ledger[c]
         for q in range(row.shape[0]):
             row[q] = 0.0
@@ -439,6 +544,17 @@ def wall_pair_pass(
                         out_diss[k, q] = 0.0
                     out_normal_force[k] = 0.0
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
+                if heat_on:
+                    h = 0.0
+                    if out_state[k] == STATE_NEAR and wrow[COL_THERMAL_KIND] != 0.0:
+                        h = _pw_conductance(
+                            k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
+                            out_normal_force, radius_id, radius_table, conduction_id,
+                            conduction_table, override, k_particle, rhoc_particle, k_wall,
+                            rhoc_wall, srow,
+                        )  # fmt: skip
+                    out_conductance[k] = h
+                    out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
                 continue
             out_state[k] = STATE_TOUCHING
             # n from the particle towards the wall
@@ -503,3 +619,14 @@ def wall_pair_pass(
             ratio = overlap / ri
             if ratio > row[L_MAX_OVERLAP_RATIO]:
                 row[L_MAX_OVERLAP_RATIO] = ratio
+            if heat_on:
+                h = 0.0
+                if wrow[COL_THERMAL_KIND] != 0.0:
+                    h = _pw_conductance(
+                        k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
+                        out_normal_force, radius_id, radius_table, conduction_id,
+                        conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
+                        srow,
+                    )  # fmt: skip
+                out_conductance[k] = h
+                out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])

@@ -111,9 +111,21 @@ def reduce_and_kick(
     wall_lever,
     wall_roll,
     kick,
+    heat_on,
+    pair_conductance,
+    pair_heat,
+    wall_conductance,
+    wall_heat,
+    by_mechanism,
+    conductance_sum,
 ):
     """Sum each particle's pair and wall contributions in a fixed order, add gravity, and
-    (if ``kick``) apply the second half kick."""
+    (if ``kick``) apply the second half kick.
+
+    With ``heat_on`` the same traversal sums the pair heat rates (column 0 of
+    ``by_mechanism``, direct conduction), the wall heat rates (column 6) and the conductances
+    of each particle (``conductance_sum``, for the explicit Euler limit).
+    """
     n = radius.shape[0]
     has_roll = pair_roll.shape[0] > 0
     has_wall_roll = wall_roll.shape[0] > 0
@@ -126,8 +138,15 @@ def reduce_and_kick(
         tx = 0.0
         ty = 0.0
         tz = 0.0
+        q_direct = 0.0
+        q_wall = 0.0
+        h_sum = 0.0
         for q in range(row_start[i], row_start[i + 1]):
             e = entries[q]
+            if heat_on:
+                kk = e if e >= 0 else -e - 1
+                h_sum += pair_conductance[kk]
+                q_direct += pair_heat[kk] if e >= 0 else -pair_heat[kk]
             if e >= 0:
                 fx += pair_force[e, 0]
                 fy += pair_force[e, 1]
@@ -152,6 +171,9 @@ def reduce_and_kick(
                     ty -= pair_roll[k, 1]
                     tz -= pair_roll[k, 2]
         for k in range(wall_row_start[i], wall_row_start[i + 1]):
+            if heat_on:
+                h_sum += wall_conductance[k]
+                q_wall += wall_heat[k]
             fx += wall_force[k, 0]
             fy += wall_force[k, 1]
             fz += wall_force[k, 2]
@@ -162,6 +184,10 @@ def reduce_and_kick(
                 tx += wall_roll[k, 0]
                 ty += wall_roll[k, 1]
                 tz += wall_roll[k, 2]
+        if heat_on:
+            by_mechanism[i, 0] = q_direct
+            by_mechanism[i, 6] = q_wall
+            conductance_sum[i] = h_sum
         force[i, 0] = fx
         force[i, 1] = fy
         force[i, 2] = fz

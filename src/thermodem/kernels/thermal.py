@@ -14,10 +14,8 @@ import math
 from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
-from thermodem.kernels.contact import CHUNK, H_DURATION, H_IMPACT_VELOCITY, STATE_FAR
+from thermodem.kernels.contact import CHUNK, STATE_FAR, _pp_conductance, _pw_conductance
 from thermodem.kernels.neighbors import minimum_image, wall_distance
-from thermodem.models.thermal.contact_radius import contact_radius_dispatch
-from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch
 
 # per-particle mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
 M_DIRECT = 0
@@ -55,50 +53,11 @@ def conduction_pair_pass(
             ri = radius[i]
             rj = radius[j]
             overlap = ri + rj - dist
-            m_eff = mass[i] * mass[j] / (mass[i] + mass[j])
-            ti = type_id[i]
-            tj = type_id[j]
-            duration = history[k, H_DURATION]
-            v_imp = history[k, H_IMPACT_VELOCITY]
-            r_c = 0.0
-            if overlap > 0.0:
-                r_c = contact_radius_dispatch(
-                    radius_id,
-                    radius_table[ti, tj],
-                    ri,
-                    rj,
-                    dist,
-                    overlap,
-                    normal_force[k],
-                    duration,
-                    v_imp,
-                    m_eff,
-                )
-            p = conduction_table[ti, tj]
-            if override > 0:
-                for q in range(p.shape[0]):
-                    row[q] = p[q]
-                row[0] = k_particle[i]
-                row[1] = k_particle[j]
-                if override > 1:
-                    row[2] = rhoc_particle[i]
-                    row[3] = rhoc_particle[j]
-                p = row
-            h = direct_conduction_dispatch(
-                conduction_id,
-                p,
-                0.0,
-                1.0,
-                ri,
-                rj,
-                dist,
-                overlap,
-                r_c,
-                normal_force[k],
-                duration,
-                v_imp,
-                m_eff,
-            )
+            h = _pp_conductance(
+                k, i, j, ri, rj, dist, overlap, mass, type_id, history, normal_force, radius_id,
+                radius_table, conduction_id, conduction_table, override, k_particle,
+                rhoc_particle, row,
+            )  # fmt: skip
             out_conductance[k] = h
             out_heat[k] = h * (temperature[j] - temperature[i])
 
@@ -129,49 +88,11 @@ def conduction_wall_pass(
             d = wall_distance(wall_kind[w], wrow, position[i])[0]
             ri = radius[i]
             overlap = ri - d
-            ti = type_id[i]
-            tw = wall_material[w]
-            duration = history[k, H_DURATION]
-            v_imp = history[k, H_IMPACT_VELOCITY]
-            r_c = 0.0
-            if overlap > 0.0:
-                r_c = contact_radius_dispatch(
-                    radius_id,
-                    radius_table[ti, tw],
-                    ri,
-                    math.inf,
-                    d,
-                    overlap,
-                    normal_force[k],
-                    duration,
-                    v_imp,
-                    mass[i],
-                )
-            p = conduction_table[ti, tw]
-            if override > 0:
-                for q in range(p.shape[0]):
-                    row[q] = p[q]
-                row[0] = k_particle[i]
-                row[1] = k_wall[w]
-                if override > 1:
-                    row[2] = rhoc_particle[i]
-                    row[3] = rhoc_wall[w]
-                p = row
-            h = direct_conduction_dispatch(
-                conduction_id,
-                p,
-                0.0,
-                1.0,
-                ri,
-                math.inf,
-                d,
-                overlap,
-                r_c,
-                normal_force[k],
-                duration,
-                v_imp,
-                mass[i],
-            )
+            h = _pw_conductance(
+                k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force,
+                radius_id, radius_table, conduction_id, conduction_table, override, k_particle,
+                rhoc_particle, k_wall, rhoc_wall, row,
+            )  # fmt: skip
             out_conductance[k] = h
             out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
 
@@ -312,3 +233,49 @@ def total_enthalpy(temperature, mass, type_id, table_t, table_c, table_n):
         m = type_id[i]
         total += mass[i] * enthalpy(temperature[i], table_t[m], table_c[m], table_n[m])
     return total
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def finish_heat(source, heat_rate, by_mechanism):
+    """Source column and total heat rate after the fused reduction filled columns 0 and 6."""
+    for i in prange(heat_rate.shape[0]):
+        by_mechanism[i, M_SOURCE] = source[i]
+        heat_rate[i] = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
+
+
+@njit(cache=True, error_model="numpy")
+def euler_step(temperature, heat_rate, by_mechanism, source, mass, type_id, c_by_type,
+               conductance_sum, fixed, dt):  # fmt: skip
+    """One fused per-particle thermal update with constant specific heats (fixed order).
+
+    Fills the source column and the total heat rate, finds the explicit Euler limit
+    min m c / ΣH over free particles, applies T += dt Q / (m c) to free particles, and sums the
+    wall heat, source heat and heat absorbed by fixed particles [W].
+    Returns (limit, limit index, wall heat, source heat, absorbed, first bad index or -1).
+    """
+    limit = math.inf
+    where = -1
+    wall_q = 0.0
+    source_q = 0.0
+    absorbed = 0.0
+    bad = -1
+    for i in range(temperature.shape[0]):
+        by_mechanism[i, M_SOURCE] = source[i]
+        q = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
+        heat_rate[i] = q
+        wall_q += by_mechanism[i, M_WALL]
+        source_q += source[i]
+        if fixed[i]:
+            absorbed += q
+            continue
+        mc = mass[i] * c_by_type[type_id[i]]
+        if conductance_sum[i] > 0.0:
+            lim = mc / conductance_sum[i]
+            if lim < limit:
+                limit = lim
+                where = i
+        t = temperature[i] + dt * q / mc
+        temperature[i] = t
+        if bad < 0 and not (t > 0.0 and math.isfinite(t)):
+            bad = i
+    return limit, where, wall_q, source_q, absorbed, bad

@@ -314,7 +314,7 @@ def morris2016_area_time_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_im
 
 
 # ---------------------------------------------------------------------------- dispatcher
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def contact_radius_dispatch(model_id, p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     """Contact radius of model ``model_id`` (NaN for an unknown id, caught by the NaN flag)."""
     if model_id == GEOMETRIC:

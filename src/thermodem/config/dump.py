@@ -1,0 +1,39 @@
+"""A validated case back to plain data / YAML, with every default filled in.
+
+Model choices (``contact.normal``, ``thermal.direct_conduction``, ...) become
+``{model: NAME, <every parameter>}``, the form the case file accepts, so
+``case_from_dict(yaml.safe_load(resolved_case_yaml(case)))`` gives the same case back.
+Floats are written exactly (YAML uses ``repr``), including ``.inf``.
+"""
+
+from __future__ import annotations
+
+from pathlib import PurePath
+from typing import Any
+
+import yaml
+from pydantic import BaseModel
+
+
+def case_to_dict(value: Any) -> Any:
+    """Plain data (dicts, lists, scalars) of a case or any part of it."""
+    from thermodem.config.schema import ModelChoice
+
+    if isinstance(value, ModelChoice):
+        return {"model": value.model, **case_to_dict(value.params)}
+    if isinstance(value, BaseModel):
+        return {name: case_to_dict(getattr(value, name)) for name in type(value).model_fields}
+    if isinstance(value, dict):
+        return {str(k): case_to_dict(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [case_to_dict(v) for v in value]
+    if isinstance(value, PurePath):
+        return str(value)
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    return str(value)
+
+
+def resolved_case_yaml(case: BaseModel) -> str:
+    """The case with every default filled in, as YAML."""
+    return yaml.safe_dump(case_to_dict(case), sort_keys=False, allow_unicode=True)

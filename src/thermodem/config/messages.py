@@ -1,0 +1,266 @@
+"""Validation layer 1: pydantic errors rewritten as ``key.path: what is wrong (got X); allowed``.
+
+Every line names the dotted key path of the bad key as written in the case file (list indices
+included, discriminated-union tags such as ``box`` removed), the bad value and what is
+allowed: the bounds pydantic reports, the allowed kinds of a ``kind:`` key, the allowed keys of
+a section for an unknown key, and a "did you mean" for misspelt keys, kinds and names.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+import types
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
+
+from pydantic import BaseModel, ValidationError
+
+from thermodem.models import registry
+
+
+def suggest(name: str, choices: list[str]) -> str | None:
+    """The closest choice to ``name`` (spelling, or a choice starting with it), if any."""
+    close = difflib.get_close_matches(str(name), choices, n=1, cutoff=0.6)
+    if close:
+        return close[0]
+    starts = [c for c in choices if c.startswith(str(name)) or str(name).startswith(c)]
+    return starts[0] if len(starts) == 1 else None
+
+
+def _hint(name: str, choices: list[str]) -> str:
+    best = suggest(name, choices)
+    return f" (did you mean {best!r}?)" if best else ""
+
+
+# ---------------------------------------------------------------- types along a key path
+def _unwrap(tp: Any) -> Any:
+    while get_origin(tp) is Annotated:
+        tp = get_args(tp)[0]
+    return tp
+
+
+def _is_model(tp: Any) -> bool:
+    return isinstance(tp, type) and issubclass(tp, BaseModel)
+
+
+def _members(tp: Any) -> list[Any]:
+    """Non-None members of a union (or [tp])."""
+    tp = _unwrap(tp)
+    if get_origin(tp) in (Union, types.UnionType):
+        out: list[Any] = []
+        for arg in get_args(tp):
+            if arg is type(None):
+                continue
+            out += _members(arg)
+        return out
+    return [tp]
+
+
+def _kinds(model: type[BaseModel]) -> list[str]:
+    field = model.model_fields.get("kind")
+    if field is None:
+        return []
+    ann = _unwrap(field.annotation)
+    return [str(a) for a in get_args(ann)] if get_origin(ann) is Literal else []
+
+
+def _tagged(members: list[Any]) -> dict[str, type[BaseModel]]:
+    """kind value -> model for a union of models with a ``kind`` literal."""
+    table: dict[str, type[BaseModel]] = {}
+    for m in members:
+        if _is_model(m):
+            for k in _kinds(m):
+                table[k] = m
+    return table
+
+
+def _choice_params(family: str, value: Any) -> type[BaseModel] | None:
+    name = value.get("model") if isinstance(value, dict) else value
+    if not isinstance(name, str):
+        return None
+    try:
+        return registry.get(family, name).params
+    except KeyError:
+        return None
+
+
+class _Where:
+    """What the walk knows at one point of the key path."""
+
+    def __init__(self, tp: Any, value: Any, family: str | None = None) -> None:
+        self.tp = tp
+        self.value = value
+        self.family = family  # set when tp is a model choice of this registry family
+
+
+def walk(loc: tuple[Any, ...], data: Any) -> tuple[list[str], _Where | None]:
+    """(display path, type information at the end of ``loc``) for an error location.
+
+    Drops pydantic's union tags and ``function-...`` entries from the path. The type
+    information is None where the walk cannot follow (then only the path is used).
+    """
+    from thermodem.config.schema import Case, ModelChoice
+
+    path: list[str] = []
+    where: _Where | None = _Where(Case, data)
+    for elem in loc:
+        if isinstance(elem, str) and elem.startswith("function-"):
+            continue
+        if where is None:
+            path.append(str(elem))
+            continue
+        tp, value = where.tp, where.value
+        members = _members(tp)
+        tags = _tagged(members)
+        if len(tags) > 1:
+            if (
+                isinstance(elem, str)
+                and elem in tags
+                and not (isinstance(value, dict) and elem in value)
+            ):
+                where = _Where(tags[elem], value)  # a union tag: not part of the case file
+                continue
+            kind = value.get("kind") if isinstance(value, dict) else None
+            tp = tags.get(kind) if isinstance(kind, str) else None
+        elif members:
+            tp = members[0]
+        path.append(str(elem))
+        child = None
+        if isinstance(value, dict):
+            child = value.get(elem)
+        elif isinstance(value, list | tuple) and isinstance(elem, int) and elem < len(value):
+            child = value[elem]
+        if where.family is not None:
+            params = _choice_params(where.family, value)
+            field = params.model_fields.get(elem) if params is not None else None
+            where = _Where(field.annotation, child) if field is not None else None
+            continue
+        if tp is ModelChoice or (isinstance(elem, str) and elem in registry.FAMILIES):
+            where = _Where(None, child, family=str(elem))
+            continue
+        if _is_model(tp):
+            field = tp.model_fields.get(str(elem))
+            where = _Where(field.annotation, child) if field is not None else None
+            if field is not None and str(elem) in registry.FAMILIES:
+                where.family = str(elem)
+            continue
+        origin = get_origin(_unwrap(tp))
+        args = get_args(_unwrap(tp))
+        if origin is dict and len(args) == 2:
+            where = _Where(args[1], child)
+        elif origin is list and args:
+            where = _Where(args[0], child)
+        elif origin is tuple and args:
+            if len(args) == 2 and args[1] is Ellipsis:
+                where = _Where(args[0], child)
+            elif isinstance(elem, int) and elem < len(args):
+                where = _Where(args[elem], child)
+            else:
+                where = None
+        else:
+            where = None
+    return path, where
+
+
+def _allowed_keys(where: _Where | None) -> list[str] | None:
+    if where is None:
+        return None
+    if where.family is not None:
+        params = _choice_params(where.family, where.value)
+        return None if params is None else ["model", *params.model_fields]
+    members = _members(where.tp)
+    tags = _tagged(members)
+    if len(tags) > 1 and isinstance(where.value, dict):
+        model = tags.get(where.value.get("kind"))
+        return list(model.model_fields) if model else None
+    if len(members) == 1 and _is_model(members[0]):
+        return list(members[0].model_fields)
+    return None
+
+
+def _kinds_at(where: _Where | None) -> list[str]:
+    if where is None:
+        return []
+    return list(_tagged(_members(where.tp)))
+
+
+# ------------------------------------------------------------------------------ messages
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+_UNKNOWN_NAME = re.compile(
+    r"unknown (?:[\w ]+ )?'([^']*)'(?:; did you mean '[^']*'\?)?[;,]? allowed: (.*)$"
+)
+
+
+def _improve_named(msg: str) -> str:
+    """'unknown X 'n' allowed: a, b' -> '...; allowed: a, b' plus a did-you-mean when missing."""
+    msg = re.sub(r"'( allowed: )", r"';\1", msg)
+    m = _UNKNOWN_NAME.search(msg)
+    if m and "did you mean" not in msg:
+        choices = [c.strip() for c in m.group(2).split(",")]
+        best = suggest(m.group(1), choices)
+        if best:
+            msg += f" (did you mean {best!r}?)"
+    return msg
+
+
+def format_error(err: dict[str, Any], data: Any) -> str:
+    """One line for one pydantic error."""
+    loc = tuple(err["loc"])
+    kind = err["type"]
+    msg = err["msg"].removeprefix("Value error, ").removeprefix("Assertion failed, ")
+    value = err.get("input")
+    ctx = err.get("ctx") or {}
+    path, where = walk(loc, data)
+    dotted = ".".join(path)
+    if kind == "extra_forbidden":
+        key = path[-1] if path else "?"
+        parent_path, parent = walk(loc[:-1], data)
+        allowed = _allowed_keys(parent)
+        text = f"{dotted}: unknown key"
+        if allowed:
+            text += f"{_hint(key, allowed)}; allowed keys: {', '.join(allowed)}"
+        return text
+    if kind == "union_tag_invalid":
+        expected = re.findall(r"'([^']*)'", str(ctx.get("expected_tags", "")))
+        tag = str(ctx.get("tag", ""))
+        return (
+            f"{dotted}.kind: unknown kind {tag!r}{_hint(tag, expected)}; allowed: "
+            f"{', '.join(expected)}"
+        )
+    if kind == "union_tag_not_found":
+        allowed = _kinds_at(walk(loc, data)[1])
+        extra = f"; allowed: {', '.join(allowed)}" if allowed else ""
+        return f"{dotted}.kind: missing (it selects the type of this entry){extra}"
+    if kind == "missing":
+        if path and path[-1].isdigit():
+            parent = ".".join(path[:-1])
+            return f"{parent}: too few values, item {path[-1]} is missing (got {_shown(value)})"
+        return f"{dotted}: required key is missing"
+    if kind == "literal_error":
+        expected = re.findall(r"'([^']*)'", str(ctx.get("expected", "")))
+        best = suggest(str(value), expected) if expected else None
+        hint = f"; did you mean {best!r}?" if best else ""
+        return f"{dotted}: {msg} (got {_shown(value)}{hint})"
+    if kind == "too_long" and "max_length" in ctx:
+        return f"{dotted}: at most {ctx['max_length']} values allowed (got {_shown(value)})"
+    if kind == "too_short" and "min_length" in ctx:
+        return f"{dotted}: at least {ctx['min_length']} values needed (got {_shown(value)})"
+    msg = _improve_named(msg)
+    # messages raised by model validators carry their own key path ('walls.0.material: ...')
+    own = re.match(r"^([A-Za-z_][\w]*(?:\.[\w]+)*): ", msg)
+    if own and "." in own.group(1) and (not dotted or own.group(1).startswith(dotted)):
+        return msg
+    shown = (
+        "" if isinstance(value, dict | list) or repr(value) in msg else f" (got {_shown(value)})"
+    )
+    return f"{dotted}: {msg}{shown}" if dotted else f"{msg}{shown}"
+
+
+def format_validation_error(exc: ValidationError, data: Any = None) -> str:
+    """All errors of ``exc``, one line each (``data``: the input, for exact key paths)."""
+    lines = [format_error(err, data) for err in exc.errors()]
+    return "\n".join(dict.fromkeys(lines))

@@ -1,0 +1,295 @@
+"""The complete restart state of a :class:`~thermodem.engine.simulation.Simulation`.
+
+:func:`capture` returns everything a simulation needs to continue exactly where it stopped;
+:func:`restore` puts it into a simulation built from the same case with
+``insert_particles=False``. A run stopped at step k, restored in a new process and continued is
+bit-identical to the uninterrupted run (``tests/unit/test_checkpoint.py``).
+
+The state is a plain nested dict, which :mod:`thermodem.io.checkpoint` writes to HDF5::
+
+    {
+      "scalars":   {time, step_count, next_global_id, skin, moved, rebuild_count,
+                    _needs_rebuild, initial_energy, max_overlap_ratio, contact_count,
+                    ledger_cumulative, rng (the bit generator state), pourers (state dicts),
+                    material_names, history_width, pair_capacity, wall_pair_capacity},
+      "particles": {every Particles array, in the current memory order},
+      "pairs":     {i, j, history, force, lever, roll, dissipation, normal_force, state,
+                    key_a, key_b, lookup_order: the first `count` rows},
+      "walls":     {the same for particle-wall pairs},
+      "arrays":    {row_start, entries, wall_row_start, lookup_start, wall_lookup_start,
+                    reference, wall_reference, wall_rows, elastic},
+      "thermal":   {"scalars": {...}, "arrays": {...}}   (only with a thermal engine)
+    }
+
+Everything else on a Simulation is rebuilt from the case (tables, domain, wall geometry) or is
+scratch space that the next step overwrites (:data:`DERIVED`). ``tests/unit/test_checkpoint.py``
+fails when a new attribute appears on Simulation that is in neither list, so new state cannot be
+forgotten silently.
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermodem.errors import ConfigError
+from thermodem.state.particles import Particles
+
+if TYPE_CHECKING:
+    from thermodem.engine.simulation import Simulation
+
+#: Scalar attributes of Simulation that are state.
+SCALARS: tuple[str, ...] = (
+    "time",
+    "step_count",
+    "next_global_id",
+    "skin",
+    "moved",
+    "rebuild_count",
+    "_needs_rebuild",
+    "initial_energy",
+    "max_overlap_ratio",
+    "contact_count",
+)
+#: Array attributes of Simulation that are state (saved whole).
+ARRAYS: tuple[str, ...] = (
+    "row_start",
+    "entries",
+    "wall_row_start",
+    "lookup_start",
+    "wall_lookup_start",
+    "reference",
+    "wall_reference",
+    "wall_rows",
+    "elastic",
+)
+#: Per-pair arrays of a pair buffer that are state (the first ``count`` rows).
+PAIR_ARRAYS: tuple[str, ...] = (
+    "i",
+    "j",
+    "history",
+    "force",
+    "lever",
+    "roll",
+    "dissipation",
+    "normal_force",
+    "state",
+    "key_a",
+    "key_b",
+    "lookup_order",
+)
+#: Attributes handled by name in capture/restore (containers of state).
+CONTAINERS: tuple[str, ...] = (
+    "particles",
+    "pairs",
+    "walls",
+    "rng",
+    "pourers",
+    "ledger_cumulative",
+    "thermal",
+)
+#: Attributes rebuilt from the case, or scratch overwritten before it is read.
+DERIVED: tuple[str, ...] = (
+    "case",
+    "dt",
+    "gravity",
+    "material_names",
+    "material_index",
+    "density",
+    "model_ids",
+    "normal_table",
+    "tangential_table",
+    "rolling_table",
+    "lower",
+    "upper",
+    "periodic",
+    "wall_kind",
+    "wall_labels",
+    "wall_material",
+    "extra",
+    "rebuild_every_step",
+    "callbacks",
+    "chunk_check",
+    "_no_heat",
+    "_no_reduce_heat",
+)
+#: Attributes of the thermal engine that are never saved (objects, back references).
+THERMAL_SKIP: tuple[str, ...] = ("sim", "settings", "wall_functions")
+
+
+def _plain(value: Any) -> Any:
+    """NumPy scalars to Python scalars (for JSON)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _is_scalar(value: Any) -> bool:
+    return value is None or isinstance(value, bool | int | float | str | np.generic)
+
+
+def _object_state(obj: Any, skip: tuple[str, ...]) -> dict[str, Any]:
+    """Scalars, flat containers of scalars and arrays among an object's attributes."""
+    scalars: dict[str, Any] = {}
+    arrays: dict[str, np.ndarray] = {}
+    for name, value in vars(obj).items():
+        if name in skip:
+            continue
+        if isinstance(value, np.ndarray):
+            arrays[name] = value.copy()
+        elif _is_scalar(value):
+            scalars[name] = _plain(value)
+        elif isinstance(value, dict) and all(_is_scalar(v) for v in value.values()):
+            scalars[name] = {str(k): _plain(v) for k, v in value.items()}
+        elif isinstance(value, list | tuple) and all(_is_scalar(v) for v in value):
+            scalars[name] = [_plain(v) for v in value]
+    return {"scalars": scalars, "arrays": arrays}
+
+
+def _pair_state(buf: Any) -> dict[str, np.ndarray]:
+    n = buf.count
+    return {name: getattr(buf, name)[:n].copy() for name in PAIR_ARRAYS}
+
+
+def capture(sim: Simulation) -> dict[str, Any]:
+    """The complete restart state of ``sim`` (copies; the simulation can go on)."""
+    scalars: dict[str, Any] = {name: _plain(getattr(sim, name)) for name in SCALARS}
+    scalars["ledger_cumulative"] = {k: float(v) for k, v in sim.ledger_cumulative.items()}
+    scalars["rng"] = sim.rng.bit_generator.state
+    scalars["pourers"] = [p.state_dict() for p in sim.pourers]
+    scalars["material_names"] = list(sim.material_names)
+    scalars["history_width"] = sim.pairs.history_width
+    scalars["pair_capacity"] = sim.pairs.capacity
+    scalars["wall_pair_capacity"] = sim.walls.capacity
+    scalars["pair_count"] = sim.pairs.count
+    scalars["wall_pair_count"] = sim.walls.count
+    scalars["step_length"] = step_length(sim)
+    state: dict[str, Any] = {
+        "scalars": scalars,
+        "particles": {k: v.copy() for k, v in sim.particles.arrays().items()},
+        "pairs": _pair_state(sim.pairs),
+        "walls": _pair_state(sim.walls),
+        "arrays": {name: np.array(getattr(sim, name)) for name in ARRAYS},
+    }
+    th = sim.thermal
+    if th is not None:
+        if hasattr(th, "state_dict"):
+            state["thermal"] = th.state_dict()
+        else:
+            state["thermal"] = _object_state(th, THERMAL_SKIP)
+    return state
+
+
+def _mismatch(what: str, saved: Any, now: Any) -> ConfigError:
+    return ConfigError(
+        f"checkpoint does not fit this case: {what} is {saved!r} in the checkpoint and "
+        f"{now!r} in the case"
+    )
+
+
+def _load_pairs(buf: Any, arrays: dict[str, np.ndarray], count: int, capacity: int) -> None:
+    buf.allocate(max(capacity, count))
+    for name in PAIR_ARRAYS:
+        target = getattr(buf, name)
+        source = np.asarray(arrays[name])
+        if source.shape[1:] != target.shape[1:]:
+            raise _mismatch(f"pair array {name!r} shape", source.shape[1:], target.shape[1:])
+        target[:count] = source[:count]
+    buf.count = count
+
+
+def restore(sim: Simulation, state: dict[str, Any]) -> None:
+    """Load ``state`` (from :func:`capture`) into ``sim``, built from the same case."""
+    s = state["scalars"]
+    if list(s["material_names"]) != list(sim.material_names):
+        raise _mismatch("the list of materials", list(s["material_names"]), sim.material_names)
+    if int(s["history_width"]) != sim.pairs.history_width:
+        raise _mismatch(
+            "the contact history width (rolling model)",
+            int(s["history_width"]),
+            sim.pairs.history_width,
+        )
+    saved_rows = np.asarray(state["arrays"]["wall_rows"])
+    if saved_rows.shape != sim.wall_rows.shape:
+        raise _mismatch("the number of wall rows", saved_rows.shape[0], sim.wall_rows.shape[0])
+    if len(s["pourers"]) != len(sim.pourers):
+        raise _mismatch("the number of pour entries", len(s["pourers"]), len(sim.pourers))
+    names = {f.name for f in fields(Particles)}
+    if set(state["particles"]) != names:
+        raise ConfigError(
+            f"checkpoint particle arrays {sorted(state['particles'])} differ from this "
+            f"version's {sorted(names)}"
+        )
+    sim.particles = Particles(
+        **{k: np.ascontiguousarray(state["particles"][k]) for k in sorted(names)}
+    )
+    for name in SCALARS:
+        value = s[name]
+        if name in ("step_count", "next_global_id", "rebuild_count", "contact_count"):
+            value = int(value)
+        elif name == "_needs_rebuild":
+            value = bool(value)
+        elif value is not None:
+            value = float(value)
+        setattr(sim, name, value)
+    sim.ledger_cumulative = {k: float(v) for k, v in s["ledger_cumulative"].items()}
+    _load_pairs(sim.pairs, state["pairs"], int(s["pair_count"]), int(s["pair_capacity"]))
+    _load_pairs(sim.walls, state["walls"], int(s["wall_pair_count"]), int(s["wall_pair_capacity"]))
+    for name in ARRAYS:
+        setattr(sim, name, np.array(state["arrays"][name], copy=True))
+    # the pourers hold a reference to this generator: set its state in place
+    sim.rng.bit_generator.state = s["rng"]
+    for pourer, ps in zip(sim.pourers, s["pourers"], strict=True):
+        pourer.load_state_dict(dict(ps))
+    th = sim.thermal
+    if th is not None:
+        if "thermal" not in state:
+            raise ConfigError("checkpoint has no thermal state but the case has a thermal section")
+        if hasattr(th, "load_state_dict"):
+            th.load_state_dict(state["thermal"])
+        else:
+            for name, value in state["thermal"]["scalars"].items():
+                current = getattr(th, name, None)
+                if isinstance(current, float) and value is not None:
+                    value = float(value)
+                setattr(th, name, value)
+            for name, value in state["thermal"]["arrays"].items():
+                setattr(th, name, np.array(value, copy=True))
+    elif "thermal" in state:
+        raise ConfigError("checkpoint has thermal state but the case has no thermal section")
+    _adapt_step_length(sim, float(s.get("step_length", step_length(sim))))
+
+
+def step_length(sim: Simulation) -> float:
+    """The time one step advances (the thermal time step with frozen mechanics) [s]."""
+    th = sim.thermal
+    if th is not None and th.settings.frozen_mechanics:
+        return float(th.settings.time_step)
+    return float(sim.dt)
+
+
+def _adapt_step_length(sim: Simulation, saved: float) -> None:
+    """A case with another time step continues at the same time: the step counter is
+    renumbered so that ``step_count × Δt`` is the checkpoint time (which must be a whole
+    number of new steps), and heat is solved again at the next step."""
+    now = step_length(sim)
+    if now == saved:
+        return
+    steps = sim.time / now
+    k = int(round(steps))
+    if abs(steps - k) > 1e-6 * max(1.0, steps):
+        raise ConfigError(
+            f"the checkpoint time {sim.time:.9g} s is not a whole number of steps of the new "
+            f"time step {now:g} s ({steps:.6g} steps); choose a time step that divides it"
+        )
+    sim.step_count = k
+    if sim.thermal is not None and hasattr(sim.thermal, "next_step"):
+        sim.thermal.next_step = k
+
+
+def check_complete(sim: Simulation) -> list[str]:
+    """Attributes of ``sim`` that are neither saved nor declared derived (should be empty)."""
+    known = set(SCALARS) | set(ARRAYS) | set(CONTAINERS) | set(DERIVED)
+    return sorted(name for name in vars(sim) if name not in known)

@@ -1,0 +1,259 @@
+"""Validation layers 2 and 3 (layer 1, the schema, is :mod:`thermodem.config.load`).
+
+2. **Completeness**, when the simulation is built (:func:`check_completeness`): every selected
+   model's ``requires`` (registry) names material properties; each must be set for every
+   material that can meet that model. Mechanical models meet the materials of the particles
+   (every insertion entry) and of the walls; thermal models meet the particle materials and the
+   materials of walls with a thermal condition. With a thermal section every particle material
+   also needs ``specific_heat``.
+3. **Physics sanity**, before the run: the time step checks of :mod:`thermodem.engine.checks`
+   and the estimated memory and run time (:func:`estimate_resources`); the run is refused
+   when the estimated memory exceeds the physical memory of the machine.
+
+:func:`validate_case` runs all three for ``thermodem validate``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from pydantic import BaseModel
+
+from thermodem.errors import ConfigError
+
+if TYPE_CHECKING:
+    from thermodem.config.schema import Case
+    from thermodem.engine.simulation import Simulation
+
+MECHANICAL_FAMILIES = ("normal", "tangential", "rolling")
+
+#: Nominal throughput for the run time estimate: particle-steps per second per thread, and
+#: the cost of a step that does not grow with the particle count [s] (kernel launches, Python).
+#: Measured on 2 threads: 1.04e6 particle-steps/s for the 50,000-sphere packed bed of
+#: bench/bench_packed_bed.py (Hertz-Mindlin), ~0.4 ms per step for a few hundred particles.
+PARTICLE_STEPS_PER_THREAD = 5.0e5
+SECONDS_PER_STEP = 4.0e-4
+#: Memory model: bytes per particle (state arrays, neighbour index, copies while sorting) and
+#: per listed pair (indices, history, forces, keys, CSR entries; ×1.25 growth margin), and
+#: pairs per particle in a dense bed (3.6 measured in the benchmark bed, plus near pairs).
+BYTES_PER_PARTICLE = 400.0
+PAIRS_PER_PARTICLE = 4.5
+BASELINE_BYTES = 250e6
+
+
+def model_choices(case: Case) -> list[tuple[str, Any]]:
+    """Every model choice in the case with its key path ('contact.normal', ...)."""
+    from thermodem.config.schema import ModelChoice
+
+    found: list[tuple[str, Any]] = []
+
+    def walk(value: Any, path: str) -> None:
+        if isinstance(value, ModelChoice):
+            found.append((path, value))
+        elif isinstance(value, BaseModel):
+            for name in type(value).model_fields:
+                walk(getattr(value, name), f"{path}.{name}" if path else name)
+
+    walk(case, "")
+    return found
+
+
+def meeting_materials(case: Case) -> tuple[set[str], set[str], set[str]]:
+    """(particle materials, wall materials, wall materials with a thermal condition)."""
+    particles = {e.material for e in case.insertion}
+    walls = {w.material for w in case.walls}
+    thermal = getattr(case, "thermal", None)
+    hot = {
+        w.material
+        for w in case.walls
+        if getattr(getattr(w, "thermal", None), "kind", "adiabatic") != "adiabatic"
+    }
+    return particles, walls, hot if thermal is not None else set()
+
+
+def check_completeness(case: Case) -> None:
+    """Raise ConfigError naming ``materials.NAME.PROPERTY`` for each missing property."""
+    particles, walls, hot = meeting_materials(case)
+    problems: list[str] = []
+    for path, choice in model_choices(case):
+        spec = choice.spec
+        if choice.family in MECHANICAL_FAMILIES:
+            meets = sorted(particles | (walls if particles else set()))
+        else:
+            meets = sorted(particles | (hot if particles else set()))
+        for name in meets:
+            material = case.materials[name]
+            for prop in spec.requires:
+                if getattr(material, prop, None) is None:
+                    role = "particles" if name in particles else "walls"
+                    problems.append(
+                        f"materials.{name}.{prop}: missing; required by {path} = "
+                        f"{choice.model!r} ({name} is a material of {role} that meet it)"
+                    )
+    if getattr(case, "thermal", None) is not None:
+        for name in sorted(particles):
+            if case.materials[name].specific_heat is None:
+                problems.append(
+                    f"materials.{name}.specific_heat: missing; required by the thermal "
+                    f"section for particles of {name} [J/(kg K), > 0]"
+                )
+    if problems:
+        unique = list(dict.fromkeys(problems))
+        raise ConfigError("incomplete case:\n" + "\n".join(unique))
+
+
+# ----------------------------------------------------------------------------- resources
+def physical_memory() -> tuple[float, float]:
+    """(total, available) physical memory [bytes]; NaN where unknown."""
+    total = avail = math.nan
+    try:
+        text = Path("/proc/meminfo").read_text()
+        values = {line.split(":")[0]: float(line.split()[1]) * 1024.0 for line in text.splitlines()}
+        total = values.get("MemTotal", math.nan)
+        avail = values.get("MemAvailable", math.nan)
+    except (OSError, ValueError, IndexError):
+        try:
+            total = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+        except (ValueError, OSError, AttributeError):
+            pass
+    return total, avail
+
+
+def poured_particles(entry: Any, start: float, end: float) -> tuple[float, float]:
+    """(particles a pour entry adds between ``start`` and ``end``, their particle-seconds
+    until ``end``)."""
+    t0 = max(float(entry.start_time), start)
+    t1 = min(float(entry.end_time) if entry.end_time is not None else end, end)
+    if t1 <= t0:
+        return 0.0, 0.0
+    count = entry.rate * (t1 - t0)
+    return count, entry.rate * (0.5 * (t1 - t0) ** 2 + (t1 - t0) * (end - t1))
+
+
+@dataclass
+class ResourceEstimate:
+    particles_now: int
+    particles_final: int
+    steps: int
+    particle_steps: float
+    memory_bytes: float
+    run_seconds: float
+    threads: int
+    memory_total: float
+    memory_available: float
+
+    def lines(self) -> list[str]:
+        def gb(x: float) -> str:
+            return "unknown" if not math.isfinite(x) else f"{x / 1e9:.3g} GB"
+
+        return [
+            f"particles: {self.particles_now} now, about {self.particles_final} at the end",
+            f"steps: {self.steps} ({self.particle_steps:.3g} particle-steps)",
+            f"estimated memory: {gb(self.memory_bytes)} (physical memory {gb(self.memory_total)}, "
+            f"available {gb(self.memory_available)})",
+            f"estimated run time: {format_duration(self.run_seconds)} on {self.threads} "
+            f"thread(s) (nominal {PARTICLE_STEPS_PER_THREAD:.2g} particle-steps/s per thread)",
+        ]
+
+
+def format_duration(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "unknown"
+    seconds = int(round(seconds))
+    h, rem = divmod(seconds, 3600)
+    m, s = divmod(rem, 60)
+    if h:
+        return f"{h} h {m:02d} min"
+    if m:
+        return f"{m} min {s:02d} s"
+    return f"{s} s"
+
+
+def total_steps(sim: Simulation, end_time: float | None = None) -> int:
+    """Steps from t = 0 to end_time (thermal steps with frozen mechanics)."""
+    end = sim.case.simulation.end_time if end_time is None else end_time
+    dt = sim.dt
+    th = sim.thermal
+    if th is not None and th.settings.frozen_mechanics:
+        dt = th.settings.time_step
+    return int(round(end / dt))
+
+
+def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceEstimate:
+    """Rough memory and run time of running ``sim`` from its current step to end_time."""
+    import numba
+
+    threads = int(threads or numba.get_num_threads())
+    end = sim.case.simulation.end_time
+    steps = max(0, total_steps(sim) - sim.step_count)
+    dt_run = end / max(total_steps(sim), 1)
+    n_now = sim.particles.count
+    final = float(n_now)
+    particle_seconds = n_now * max(0.0, end - sim.time)
+    for pourer in sim.pourers:
+        count, seconds = poured_particles(pourer.entry, sim.time, end)
+        final += count
+        particle_seconds += seconds
+    particle_steps = particle_seconds / dt_run
+    width = sim.pairs.history_width
+    pair_bytes = 1.25 * (8 + 8 * width + 72 + 32 + 9 + 24 + 16)
+    if sim.thermal is not None:
+        pair_bytes += 32
+    memory = BASELINE_BYTES + final * (BYTES_PER_PARTICLE + PAIRS_PER_PARTICLE * pair_bytes)
+    seconds = steps * SECONDS_PER_STEP + particle_steps / (PARTICLE_STEPS_PER_THREAD * threads)
+    total, avail = physical_memory()
+    return ResourceEstimate(
+        particles_now=n_now,
+        particles_final=int(round(final)),
+        steps=steps,
+        particle_steps=particle_steps,
+        memory_bytes=memory,
+        run_seconds=seconds,
+        threads=threads,
+        memory_total=total,
+        memory_available=avail,
+    )
+
+
+def check_resources(estimate: ResourceEstimate) -> list[str]:
+    """Warnings; ConfigError when the estimated memory exceeds the physical memory."""
+    mem, total, avail = estimate.memory_bytes, estimate.memory_total, estimate.memory_available
+    if math.isfinite(total) and mem > total:
+        raise ConfigError(
+            f"estimated memory {mem / 1e9:.3g} GB for about {estimate.particles_final} "
+            f"particles exceeds the physical memory {total / 1e9:.3g} GB of this machine"
+        )
+    warnings = []
+    if math.isfinite(avail) and mem > 0.8 * avail:
+        warnings.append(
+            f"estimated memory {mem / 1e9:.3g} GB is more than 80 % of the available "
+            f"{avail / 1e9:.3g} GB"
+        )
+    return warnings
+
+
+@dataclass
+class Validation:
+    case: Case
+    simulation: Simulation
+    warnings: list[str]
+    estimate: ResourceEstimate
+
+
+def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> Validation:
+    """Layers 1-3 for a case file; raises ConfigError at the first layer that fails."""
+    from thermodem.config.load import load_case
+    from thermodem.engine.checks import check_simulation_time_step
+    from thermodem.engine.simulation import Simulation
+
+    case = load_case(path)
+    check_completeness(case)
+    sim = Simulation(case)
+    warnings = check_simulation_time_step(sim)
+    estimate = estimate_resources(sim, threads)
+    warnings += check_resources(estimate)
+    return Validation(case, sim, warnings, estimate)

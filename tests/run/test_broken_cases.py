@@ -1,0 +1,70 @@
+"""The broken-case corpus: every file in tests/cases/broken gives exit status 2 and a message
+containing each ``# expect:`` line of its header (the key path, the bad value, what is
+allowed), never a traceback. Also: missing file, empty file, directory, unreadable input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from thermodem.cli import app
+
+BROKEN = sorted((Path(__file__).parents[1] / "cases" / "broken").glob("*.yaml"))
+
+
+def expectations(path: Path) -> list[str]:
+    out = []
+    for line in path.read_text().splitlines():
+        if not line.startswith("# expect:"):
+            break
+        out.append(line.removeprefix("# expect:").strip())
+    return out
+
+
+def test_the_corpus_is_large_enough() -> None:
+    assert len(BROKEN) >= 20
+    assert all(expectations(p) for p in BROKEN)
+
+
+@pytest.mark.parametrize("path", BROKEN, ids=[p.stem for p in BROKEN])
+def test_broken_case(path: Path) -> None:
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert result.output.startswith("error: ")
+    for expected in expectations(path):
+        assert expected in result.output, f"{expected!r} not in:\n{result.output}"
+
+
+def test_broken_case_refused_by_run_too(tmp_path: Path) -> None:
+    path = next(p for p in BROKEN if p.stem == "missing_thermal_conductivity")
+    result = CliRunner().invoke(app, ["run", str(path), "--output", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert "materials.glass.thermal_conductivity" in result.output
+
+
+def _file(directory: Path, name: str, content: bytes) -> Path:
+    path = directory / name
+    path.write_bytes(content)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("make", "expected"),
+    [
+        (lambda d: d / "missing.yaml", "does not exist"),
+        (lambda d: d, "is a directory"),
+        (lambda d: _file(d, "empty.yaml", b""), "is empty"),
+        (lambda d: _file(d, "blank.yaml", b"\n  \n# only a comment\n"), "is empty"),
+        (lambda d: _file(d, "binary.yaml", b"\xff\xfe\x00x"), "not UTF-8"),
+    ],
+    ids=["missing", "directory", "empty", "blank", "binary"],
+)
+def test_bad_files_give_one_line(tmp_path: Path, make, expected: str) -> None:  # noqa: ANN001
+    path = make(tmp_path)
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2
+    assert expected in result.output
+    assert len(result.output.strip().splitlines()) == 1, result.output

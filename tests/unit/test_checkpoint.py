@@ -1,0 +1,266 @@
+"""Checkpoints: a run stopped, written to HDF5, restored in a new Simulation and continued is
+bit-identical to the uninterrupted run (pouring, rotating and translating walls, rolling
+history, periodic axes, the thermal engine)."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from thermodem.config.dump import resolved_case_yaml
+from thermodem.config.load import case_from_dict, load_case
+from thermodem.engine.restart import check_complete
+from thermodem.engine.simulation import Simulation
+from thermodem.errors import ConfigError
+from thermodem.io.checkpoint import (
+    checkpoint_name,
+    list_checkpoints,
+    read_checkpoint,
+    write_checkpoint,
+)
+
+EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.yaml"))
+
+GLASS = {
+    "density": 2500.0,
+    "youngs_modulus": 1.0e7,
+    "poisson_ratio": 0.3,
+    "restitution": 0.6,
+    "sliding_friction": 0.4,
+    "rolling_friction": 0.05,
+    "thermal_conductivity": 1.0,
+    "specific_heat": 800.0,
+}
+
+
+def drum_case() -> dict:
+    """Particles and a pour in a rotating drum with end caps, EPSD rolling, a moving lid."""
+    return {
+        "simulation": {"time_step": 5.0e-6, "end_time": 1.0, "seed": 7},
+        "domain": {"lower": [-0.012, -0.012, -0.012], "upper": [0.012, 0.012, 0.012]},
+        "materials": {"glass": dict(GLASS), "steel": dict(GLASS, restitution=0.5)},
+        "contact": {"normal": "hertz", "tangential": "mindlin", "rolling": "epsd"},
+        "walls": [
+            {
+                "kind": "cylinder",
+                "center": [0, 0, 0],
+                "axis": [1, 0, 0],
+                "radius": 0.01,
+                "length": 0.016,
+                "angular_velocity": 20.0,
+                "material": "steel",
+            },
+            {"kind": "plane", "point": [-0.008, 0, 0], "normal": [1, 0, 0], "material": "steel"},
+            {"kind": "plane", "point": [0.008, 0, 0], "normal": [-1, 0, 0], "material": "steel"},
+            {
+                "kind": "rectangle",
+                "center": [0, 0, 0.0099],
+                "normal": [0, 0, -1],
+                "u_axis": [1, 0, 0],
+                "half_extents": [0.004, 0.004],
+                "velocity": [0, 0, -0.01],
+                "material": "steel",
+            },
+        ],
+        "insertion": [
+            {
+                "kind": "random_cylinder",
+                "material": "glass",
+                "distribution": {"kind": "uniform", "min_radius": 0.0008, "max_radius": 0.0011},
+                "base_centre": [-0.007, 0, 0],
+                "axis": [1, 0, 0],
+                "radius": 0.008,
+                "length": 0.014,
+                "count": 80,
+                "velocity": [0.4, 0.1, -0.4],
+            },
+            {  # a second set moving the other way: particle-particle collisions at once
+                "kind": "random_cylinder",
+                "material": "glass",
+                "distribution": {"kind": "mono", "radius": 0.0009},
+                "base_centre": [-0.007, 0, 0],
+                "axis": [1, 0, 0],
+                "radius": 0.008,
+                "length": 0.014,
+                "count": 60,
+                "velocity": [-0.4, -0.1, 0.4],
+            },
+            {
+                "kind": "pour",
+                "material": "glass",
+                "distribution": {"kind": "mono", "radius": 0.0009},
+                "region": {
+                    "kind": "box",
+                    "lower": [-0.006, -0.004, -0.004],
+                    "upper": [0.006, 0.004, 0.004],
+                },
+                "rate": 4000.0,
+                "interval": 0.0005,
+                "end_time": 0.003,
+                "velocity": [0, 0, -0.2],
+            },
+        ],
+    }
+
+
+def periodic_thermal_case() -> dict:
+    """A periodic shear-free bed with heat conduction and a fixed-temperature floor."""
+    return {
+        "simulation": {"time_step": 5.0e-6, "end_time": 1.0, "seed": 3},
+        "domain": {
+            "lower": [0, 0, 0],
+            "upper": [0.008, 0.008, 0.01],
+            "periodic": [True, True, False],
+        },
+        "materials": {"glass": dict(GLASS), "steel": dict(GLASS, thermal_conductivity=20.0)},
+        "contact": {"rolling": "constant_torque"},
+        "walls": [
+            {
+                "kind": "plane",
+                "point": [0, 0, 0],
+                "normal": [0, 0, 1],
+                "material": "steel",
+                "thermal": {"kind": "fixed", "temperature": 350.0},
+            }
+        ],
+        "insertion": [
+            {
+                "kind": "lattice",
+                "material": "glass",
+                "distribution": {"kind": "mono", "radius": 0.0009},
+                "lower": [0, 0, 0.0],
+                "upper": [0.008, 0.008, 0.008],
+                "spacing": 0.002,
+                "jitter": 0.0001,
+                "velocity": [0.05, 0.02, -0.2],
+            }
+        ],
+        "thermal": {"direct_conduction": "batchelor_obrien_simple", "substeps": 3},
+    }
+
+
+def _assert_same(a: Simulation, b: Simulation) -> None:
+    for name, arr in a.particles.arrays().items():
+        assert np.array_equal(arr, getattr(b.particles, name)), name
+    for buf in ("pairs", "walls"):
+        pa, pb = getattr(a, buf), getattr(b, buf)
+        assert pa.count == pb.count
+        for name in ("i", "j", "history", "force", "key_a", "key_b"):
+            assert np.array_equal(getattr(pa, name)[: pa.count], getattr(pb, name)[: pb.count])
+    assert np.array_equal(a.wall_rows, b.wall_rows)
+    assert a.energies() == b.energies()
+    assert a.energy_balance_error() == b.energy_balance_error()
+    assert a.report() == b.report()
+    assert (a.time, a.step_count, a.rebuild_count) == (b.time, b.step_count, b.rebuild_count)
+    assert a.rng.bit_generator.state == b.rng.bit_generator.state
+
+
+@pytest.mark.parametrize(
+    ("make", "stop", "total"),
+    [(drum_case, 230, 700), (periodic_thermal_case, 101, 400)],
+    ids=["drum-pour-epsd-moving-wall", "periodic-thermal"],
+)
+def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -> None:
+    case = case_from_dict(make())
+    reference = Simulation(case)
+    reference.run(steps=total)
+    assert reference.particles.count > 0
+    assert reference.contact_count > 0
+
+    first = Simulation(case_from_dict(make()))
+    first.run(steps=stop)
+    path = write_checkpoint(first, tmp_path / checkpoint_name(first.step_count))
+    del first
+    second = Simulation.from_checkpoint(path)
+    assert second.step_count == stop
+    second.run(steps=total - stop)
+    _assert_same(reference, second)
+
+
+def test_drum_case_exercises_pouring_and_rolling_history() -> None:
+    sim = Simulation(case_from_dict(drum_case()))
+    n0 = sim.particles.count
+    sim.run(steps=700)
+    assert sim.particles.count > n0  # pour batches arrived, one of them after step 230
+    assert sim.pourers[0].inserted > 0
+    touching = sim.pairs.history[: sim.pairs.count, 6:9]
+    assert np.any(touching != 0.0)  # rolling springs carry history
+    assert sim.wall_rows[3, 2] < 0.0099  # the lid moved
+
+
+def test_every_simulation_attribute_is_saved_or_declared_derived() -> None:
+    sim = Simulation(case_from_dict(periodic_thermal_case()))
+    sim.run(steps=5)
+    assert check_complete(sim) == []
+
+
+def test_checkpoint_file_contents_and_atomic_write(tmp_path: Path) -> None:
+    sim = Simulation(case_from_dict(drum_case()))
+    sim.run(steps=20)
+    path = write_checkpoint(sim, tmp_path / "c" / checkpoint_name(20), kind="interrupted")
+    assert not list(path.parent.glob("*.tmp"))
+    ckpt = read_checkpoint(path)
+    assert (ckpt.kind, ckpt.step, ckpt.time) == ("interrupted", 20, sim.time)
+    assert ckpt.case() == sim.case
+    assert np.array_equal(ckpt.state["particles"]["global_id"], sim.particles.global_id)
+    assert list_checkpoints(path.parent) == [path]
+    # a failed-state file is for inspection only
+    failed = write_checkpoint(sim, tmp_path / "failed.h5", kind="failed")
+    with pytest.raises(ConfigError, match="cannot be continued"):
+        Simulation.from_checkpoint(failed)
+
+
+def test_bad_checkpoint_files_give_one_line_errors(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="does not exist"):
+        read_checkpoint(tmp_path / "missing.h5")
+    junk = tmp_path / "junk.h5"
+    junk.write_text("not hdf5")
+    with pytest.raises(ConfigError, match="not a readable HDF5"):
+        read_checkpoint(junk)
+
+
+def test_checkpoint_refuses_an_incompatible_case(tmp_path: Path) -> None:
+    sim = Simulation(case_from_dict(drum_case()))
+    path = write_checkpoint(sim, tmp_path / "c.h5")
+    other = drum_case()
+    other["contact"]["rolling"] = "none"
+    with pytest.raises(ConfigError, match="history width"):
+        Simulation.from_checkpoint(path, case=case_from_dict(other))
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_resolved_case_round_trips(path: Path) -> None:
+    case = load_case(path)
+    text = resolved_case_yaml(case)
+    again = case_from_dict(yaml.safe_load(text))
+    assert again == case
+    assert resolved_case_yaml(again) == text
+
+
+def test_resolved_case_round_trips_thermal_and_model_parameters() -> None:
+    data = copy.deepcopy(periodic_thermal_case())
+    data["contact"]["rolling"] = {"model": "epsd", "damping_ratio": 0.25}
+    case = case_from_dict(data)
+    text = resolved_case_yaml(case)
+    assert "damping_ratio: 0.25" in text
+    assert case_from_dict(yaml.safe_load(text)) == case
+
+
+def test_restore_with_another_time_step_keeps_the_time(tmp_path: Path) -> None:
+    sim = Simulation(case_from_dict(drum_case()))
+    sim.run(steps=230)
+    path = write_checkpoint(sim, tmp_path / "c.h5")
+    half = drum_case()
+    half["simulation"]["time_step"] = 2.5e-6
+    again = Simulation.from_checkpoint(path, case=case_from_dict(half))
+    assert again.step_count == 460 and again.time == sim.time
+    again.run(steps=10)
+    assert again.time == pytest.approx(sim.time + 10 * 2.5e-6, rel=1e-12)
+    odd = drum_case()
+    odd["simulation"]["time_step"] = 3.0e-6
+    with pytest.raises(ConfigError, match="not a whole number of steps"):
+        Simulation.from_checkpoint(path, case=case_from_dict(odd))
