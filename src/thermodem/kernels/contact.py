@@ -241,15 +241,19 @@ def contact_response(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _clear_contact(
+def _open_contact(
     k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, ledger_row
 ):
-    # energy left in springs when a contact opens is released as friction (documented)
-    ledger_row[L_SLIDING_FRICTION] += history[k, H_SPRING_ENERGY]
-    if history.shape[1] >= HISTORY_WIDTH_ROLLING:
-        ledger_row[L_ROLLING_FRICTION] += history[k, H_ROLL_ENERGY]
-    for c in range(history.shape[1]):
-        history[k, c] = 0.0
+    """Outputs of a pair that does not touch; a contact that just opened is cleared.
+
+    The energy left in its springs when a contact opens is counted as friction (documented).
+    """
+    if history[k, H_DURATION] != 0.0:
+        ledger_row[L_SLIDING_FRICTION] += history[k, H_SPRING_ENERGY]
+        if history.shape[1] >= HISTORY_WIDTH_ROLLING:
+            ledger_row[L_ROLLING_FRICTION] += history[k, H_ROLL_ENERGY]
+        for c in range(history.shape[1]):
+            history[k, c] = 0.0
     for c in range(3):
         out_force[k, c] = 0.0
         out_lever[k, c] = 0.0
@@ -372,20 +376,9 @@ def particle_pair_pass(
             rj = radius[j]
             overlap = ri + rj - dist
             if overlap <= 0.0 or dist == 0.0:
-                if history[k, H_DURATION] != 0.0:
-                    _clear_contact(
-                        k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
-                    )
-                else:
-                    for q in range(3):
-                        out_force[k, q] = 0.0
-                        out_lever[k, q] = 0.0
-                    if out_roll.shape[0] > k:
-                        for q in range(3):
-                            out_roll[k, q] = 0.0
-                    for q in range(out_diss.shape[1]):
-                        out_diss[k, q] = 0.0
-                    out_normal_force[k] = 0.0
+                _open_contact(
+                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
+                )
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 if heat_on:
                     h = 0.0
@@ -529,20 +522,9 @@ def wall_pair_pass(
             ri = radius[i]
             overlap = ri - d
             if overlap <= 0.0:
-                if history[k, H_DURATION] != 0.0:
-                    _clear_contact(
-                        k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
-                    )
-                else:
-                    for q in range(3):
-                        out_force[k, q] = 0.0
-                        out_lever[k, q] = 0.0
-                    if out_roll.shape[0] > k:
-                        for q in range(3):
-                            out_roll[k, q] = 0.0
-                    for q in range(out_diss.shape[1]):
-                        out_diss[k, q] = 0.0
-                    out_normal_force[k] = 0.0
+                _open_contact(
+                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
+                )
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 if heat_on:
                     h = 0.0
