@@ -29,8 +29,6 @@ from __future__ import annotations
 
 import csv
 import datetime as _dt
-import io
-import json
 import math
 import os
 import signal
@@ -40,7 +38,7 @@ import threading
 import time as wallclock
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -49,6 +47,7 @@ import numpy as np
 from thermodem.config.dump import resolved_case_yaml
 from thermodem.config.schema import Case
 from thermodem.engine.checks import check_simulation_time_step
+from thermodem.engine.progress import Progress, _short  # noqa: F401
 from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
     check_completeness,
@@ -64,7 +63,22 @@ from thermodem.io.checkpoint import (
     read_checkpoint,
     write_checkpoint,
 )
-from thermodem.io.vtk import PVDWriter, write_particles_vtu, write_walls_vtu
+from thermodem.io.run_files import (  # noqa: F401 (re-exported)
+    CHECKPOINT_DIR,
+    FAILED_FILE,
+    LOG_FILE,
+    STATUS_FILE,
+    TIMESERIES_FILE,
+    FrameWriter,
+    RunLog,
+    Status,
+    TimeseriesWriter,
+    _atomic_write_text,
+    _cell,
+    prepare_output_dir,
+    read_timeseries,
+)
+from thermodem.io.vtk import PVDWriter
 
 __all__ = [
     "FrameWriter",
@@ -77,341 +91,7 @@ __all__ = [
     "run_from_checkpoint",
 ]
 
-CHECKPOINT_DIR = "checkpoints"
-STATUS_FILE = "status.json"
-TIMESERIES_FILE = "timeseries.csv"
-LOG_FILE = "run.log"
-FAILED_FILE = "failed.h5"
 
-
-def prepare_output_dir(path: Path, overwrite: bool) -> None:
-    """Refuse an existing non-empty directory unless ``overwrite`` (never silently)."""
-    if path.exists() and not path.is_dir():
-        raise ConfigError(f"--output {str(path)!r} exists and is not a directory")
-    if path.exists() and any(path.iterdir()) and not overwrite:
-        raise ConfigError(
-            f"--output {str(path)!r} exists and is not empty; choose another "
-            "directory or pass --overwrite"
-        )
-    path.mkdir(parents=True, exist_ok=True)
-
-
-def _atomic_write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
-# ------------------------------------------------------------------------------------ log
-class RunLog:
-    """Messages to the console and to ``run.log`` (``file_only`` lines go to the file only)."""
-
-    def __init__(
-        self, path: Path | None, console: TextIO | None = None, append: bool = False
-    ) -> None:
-        self.console = console
-        self.file = open(path, "a" if append else "w", encoding="utf-8") if path else None  # noqa: SIM115
-
-    def _stamp(self) -> str:
-        return _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
-
-    def info(self, message: str) -> None:
-        if self.console is not None:
-            print(message, file=self.console, flush=True)
-        self.file_only(message)
-
-    def warn(self, message: str) -> None:
-        self.info(f"warning: {message}")
-
-    def file_only(self, message: str) -> None:
-        if self.file is not None:
-            self.file.write(f"[{self._stamp()}] {message}\n")
-            self.file.flush()
-
-    def close(self) -> None:
-        if self.file is not None:
-            self.file.close()
-            self.file = None
-
-
-# --------------------------------------------------------------------------------- frames
-class FrameWriter:
-    """Writes particle and wall frames and keeps the PVD indices valid after every frame."""
-
-    def __init__(self, out: Path, wall_extent: float, resume_time: float | None = None) -> None:
-        self.out = out
-        (out / "vtk").mkdir(parents=True, exist_ok=True)
-        if resume_time is None:
-            self.particles_pvd = PVDWriter(out / "particles.pvd")
-            self.walls_pvd = PVDWriter(out / "walls.pvd")
-        else:
-            self.particles_pvd = PVDWriter.resume(out / "particles.pvd", resume_time)
-            self.walls_pvd = PVDWriter.resume(out / "walls.pvd", resume_time)
-        self.wall_extent = wall_extent
-        self.frames = len(self.particles_pvd.entries)
-        self.last_step = -1
-
-    def write(self, sim: Simulation) -> None:
-        p = sim.particles
-        name = f"particles_{sim.step_count:09d}.vtu"
-        fields = {
-            "global_id": p.global_id,
-            "type_id": p.type_id,
-            "radius": p.radius,
-            "mass": p.mass,
-            "velocity": p.velocity,
-            "angular_velocity": p.angular_velocity,
-            "force": p.force,
-            "torque": p.torque,
-            "temperature": p.temperature,
-            "heat_rate": p.heat_rate,
-            "coordination_number": sim.coordination_number().astype(np.int32),
-        }
-        if sim.thermal is not None:
-            from thermodem.state.particles import HEAT_MECHANISMS
-
-            for k, mech in enumerate(HEAT_MECHANISMS):
-                col = p.heat_rate_by_mechanism[:, k]
-                if np.any(col):
-                    fields[f"heat_rate_{mech}"] = np.ascontiguousarray(col)
-        write_particles_vtu(self.out / "vtk" / name, p.position, fields)
-        self.particles_pvd.add(sim.time, f"vtk/{name}")
-        if sim.wall_rows.shape[0]:
-            wname = f"walls_{sim.step_count:09d}.vtu"
-            write_walls_vtu(
-                self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows, None, self.wall_extent
-            )
-            self.walls_pvd.add(sim.time, f"vtk/{wname}")
-        self.frames = len(self.particles_pvd.entries)
-        self.last_step = sim.step_count
-
-
-# ----------------------------------------------------------------------------- time series
-def _cell(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, bool | np.bool_):
-        return str(int(value))
-    if isinstance(value, int | np.integer):
-        return str(int(value))
-    if isinstance(value, float | np.floating):
-        return repr(float(value))
-    return str(value)
-
-
-class TimeseriesWriter:
-    """``timeseries.csv``: ``time``, ``step`` and every key of ``sim.report()`` as columns.
-
-    Values are written exactly (``repr`` of the float). Columns come from what the engine
-    reports: when a later row has a key the header does not have yet (a heat mechanism that
-    became active), the file is rewritten with the new column, earlier rows left empty there.
-    With ``resume_step`` the rows after that step are dropped first (a restart).
-    """
-
-    def __init__(self, path: Path, resume_step: int | None = None) -> None:
-        self.path = path
-        self.columns: list[str] = []
-        self.rows = 0
-        self.last_step = -1
-        if resume_step is not None and path.exists():
-            with path.open(newline="") as f:
-                reader = csv.reader(f)
-                header = next(reader, None)
-                kept = [r for r in reader if r and int(r[1]) <= resume_step] if header else []
-            self.columns = list(header or [])
-            self._rewrite(kept)
-            self.rows = len(kept)
-            if kept:
-                self.last_step = int(kept[-1][1])
-        elif path.exists():
-            path.unlink()
-
-    def _rewrite(self, rows: list[list[str]]) -> None:
-        buf = io.StringIO()
-        writer = csv.writer(buf, lineterminator="\n")
-        if self.columns:
-            writer.writerow(self.columns)
-        for r in rows:
-            writer.writerow(r + [""] * (len(self.columns) - len(r)))
-        _atomic_write_text(self.path, buf.getvalue())
-
-    def write(self, sim: Simulation) -> None:
-        row: dict[str, Any] = {"time": sim.time, "step": sim.step_count}
-        row.update(sim.report())
-        new = [k for k in row if k not in self.columns]
-        if new:
-            old_rows: list[list[str]] = []
-            if self.path.exists() and self.columns:
-                with self.path.open(newline="") as f:
-                    old_rows = list(csv.reader(f))[1:]
-            self.columns += new
-            self._rewrite(old_rows)
-        with self.path.open("a", newline="") as f:
-            csv.writer(f, lineterminator="\n").writerow([_cell(row.get(c)) for c in self.columns])
-        self.rows += 1
-        self.last_step = sim.step_count
-
-
-def read_timeseries(path: Path) -> dict[str, np.ndarray]:
-    """Columns of a ``timeseries.csv`` as float arrays (empty cells are NaN)."""
-    with Path(path).open(newline="") as f:
-        reader = csv.reader(f)
-        header = next(reader, [])
-        rows = [r for r in reader if r]
-    out = {}
-    for k, name in enumerate(header):
-        out[name] = np.array([float(r[k]) if k < len(r) and r[k] != "" else math.nan for r in rows])
-    return out
-
-
-# --------------------------------------------------------------------------------- status
-@dataclass
-class Status:
-    """``status.json``: what ``thermodem info`` reports about a running or finished run."""
-
-    path: Path
-    data: dict[str, Any] = field(default_factory=dict)
-
-    def update(self, **values: Any) -> None:
-        self.data.update(values)
-        self.data["updated"] = _dt.datetime.now().isoformat(timespec="seconds")
-        _atomic_write_text(self.path, json.dumps(self.data, indent=2) + "\n")
-
-    @staticmethod
-    def read(directory: Path) -> dict[str, Any]:
-        path = Path(directory) / STATUS_FILE
-        if not path.exists():
-            return {}
-        try:
-            return json.loads(path.read_text())
-        except (OSError, ValueError):
-            return {}
-
-
-# ------------------------------------------------------------------------------- progress
-def _short(x: float) -> str:
-    """3 significant digits with k / M / G: 3.21k, 205k, 1.1M."""
-    for factor, suffix in ((1e9, "G"), (1e6, "M"), (1e3, "k")):
-        if abs(x) >= factor:
-            return f"{x / factor:.3g}{suffix}"
-    return f"{x:.3g}"
-
-
-class Progress:
-    """A rich progress bar on a terminal; plain log lines every ``interval`` s otherwise.
-
-    Both show simulated time and fraction done, steps/s, particle-steps/s, the ETA and the
-    particle and contact counts; ``run.log`` always receives the plain lines.
-    """
-
-    def __init__(
-        self, log: RunLog, sim: Simulation, total: int, interval: float, bar: bool | None
-    ) -> None:
-        self.log = log
-        self.total = total
-        self.end_time = sim.case.simulation.end_time
-        self.start_step = sim.step_count
-        self.interval = interval
-        self.start = wallclock.perf_counter()
-        self.last_line = self.start
-        self.last_bar = 0.0
-        self.particle_steps = 0.0
-        self._bar = None
-        self._task = None
-        if bar is None:
-            bar = log.console is not None and log.console.isatty()
-        if bar and log.console is not None:
-            from rich.console import Console
-            from rich.progress import (
-                BarColumn,
-                TaskProgressColumn,
-                TextColumn,
-                TimeElapsedColumn,
-                TimeRemainingColumn,
-            )
-            from rich.progress import Progress as RichProgress
-
-            self._bar = RichProgress(
-                TextColumn("t {task.fields[t]}/{task.fields[end]} s"),
-                BarColumn(bar_width=16),
-                TaskProgressColumn(),
-                TextColumn("{task.fields[rates]}"),
-                TimeElapsedColumn(),
-                TextColumn("ETA"),
-                TimeRemainingColumn(),
-                TextColumn("{task.fields[counts]}"),
-                console=Console(file=log.console),
-                transient=False,
-            )
-        self._sim: Simulation | None = None
-
-    def __enter__(self) -> Progress:
-        if self._bar is not None:
-            self._bar.start()
-            self._task = self._bar.add_task(
-                "run",
-                total=self.total,
-                completed=self.start_step,
-                t="0",
-                end=f"{self.end_time:g}",
-                rates="",
-                counts="",
-            )
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self._bar is not None:
-            if self._sim is not None:
-                self._refresh(self._sim, wallclock.perf_counter())
-            self._bar.stop()
-
-    def _refresh(self, sim: Simulation, now: float) -> None:
-        self.last_bar = now
-        n = self._numbers(sim, now)
-        self._bar.update(
-            self._task,
-            completed=sim.step_count,
-            t=f"{sim.time:.4g}",
-            rates=f"{_short(n['sps'])} steps/s {_short(n['psps'])} particle-steps/s",
-            counts=f"{sim.particles.count} particles {sim.contact_count} contacts",
-        )
-
-    def _numbers(self, sim: Simulation, now: float) -> dict[str, Any]:
-        elapsed = max(now - self.start, 1e-9)
-        steps = sim.step_count - self.start_step
-        sps = steps / elapsed
-        remaining = (self.total - sim.step_count) / sps if sps > 0 else math.inf
-        return {
-            "sps": sps,
-            "psps": self.particle_steps / elapsed,
-            "eta": remaining,
-            "fraction": sim.step_count / max(self.total, 1),
-        }
-
-    def line(self, sim: Simulation, now: float | None = None) -> str:
-        n = self._numbers(sim, wallclock.perf_counter() if now is None else now)
-        return (
-            f"t = {sim.time:.6g} / {self.end_time:g} s ({100 * n['fraction']:.1f} %), step "
-            f"{sim.step_count}/{self.total}, {n['sps']:.3g} steps/s, {n['psps']:.3g} "
-            f"particle-steps/s, ETA {format_duration(n['eta'])}, {sim.particles.count} "
-            f"particles, {sim.contact_count} contacts"
-        )
-
-    def update(self, sim: Simulation) -> None:
-        self.particle_steps += sim.particles.count
-        now = wallclock.perf_counter()
-        self._sim = sim
-        if self._bar is not None and now - self.last_bar > 0.2:
-            self._refresh(sim, now)
-        if now - self.last_line >= self.interval:
-            self.last_line = now
-            if self._bar is None:
-                self.log.info(self.line(sim, now))
-            else:
-                self.log.file_only(self.line(sim, now))
-
-
-# -------------------------------------------------------------------------------- signals
 class _StopRequest:
     """SIGINT/SIGTERM handler: the first signal asks the loop to stop after the current step,
     a second one aborts at once (KeyboardInterrupt)."""

@@ -23,7 +23,6 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -44,6 +43,13 @@ from thermodem.config.insertion import (
     TruncatedNormalRadius,
     UniformRadius,
 )
+from thermodem.io.particle_file import (  # noqa: F401 (re-exported)
+    FILE_OPTIONAL_COLUMNS,
+    FILE_REQUIRED_COLUMNS,
+    _parse_particle_file,
+    load_particle_file,
+    save_particle_file,
+)
 
 WallsOk = Callable[[np.ndarray, np.ndarray], np.ndarray]
 """Predicate ``walls_ok(positions (n, 3), radii (n,)) -> bool (n,)``: True where a sphere is
@@ -52,9 +58,6 @@ acceptable (e.g. it does not cut through a wall). Candidates for which it is Fal
 
 _AXES = ("x", "y", "z")
 _CANDIDATE_BATCH = 16384  # candidate positions drawn per round of random sequential addition
-
-FILE_REQUIRED_COLUMNS = ("x", "y", "z", "radius")
-FILE_OPTIONAL_COLUMNS = ("vx", "vy", "vz", "temperature")
 
 
 @dataclass
@@ -761,129 +764,6 @@ class Pourer:
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass
-class _ParsedFile:
-    particles: InsertedParticles
-    line_numbers: np.ndarray
-    has_velocity: bool
-    has_temperature: bool
-
-
-def _parse_particle_file(path: str | Path, material: str = "") -> _ParsedFile:
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ValueError(f"cannot read particle file {str(path)!r}: {exc}") from exc
-    allowed = FILE_REQUIRED_COLUMNS + FILE_OPTIONAL_COLUMNS
-    header: list[str] | None = None
-    header_line = 0
-    rows: list[list[str]] = []
-    line_numbers: list[int] = []
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = raw.strip()
-        if not line:
-            continue
-        if header is None:
-            header = line.lstrip("#").replace(",", " ").lower().split()
-            header_line = lineno
-            continue
-        if line.startswith("#"):
-            continue
-        rows.append(line.replace(",", " ").split())
-        line_numbers.append(lineno)
-    where = f"particle file {str(path)!r}"
-    if not header:
-        raise ValueError(
-            f"{where} is empty: the first line must be a header naming the columns "
-            f"({' '.join(FILE_REQUIRED_COLUMNS)} required; {' '.join(FILE_OPTIONAL_COLUMNS)} "
-            "optional)"
-        )
-    for name in header:
-        if name not in allowed:
-            raise ValueError(
-                f"{where}, line {header_line}: unknown column {name!r} in the header; allowed "
-                f"columns are {', '.join(allowed)} (the first line must be the header)"
-            )
-    duplicated = sorted({name for name in header if header.count(name) > 1})
-    if duplicated:
-        raise ValueError(f"{where}, line {header_line}: column(s) {duplicated} appear twice")
-    missing = [name for name in FILE_REQUIRED_COLUMNS if name not in header]
-    if missing:
-        raise ValueError(
-            f"{where}, line {header_line}: the header lacks required column(s) "
-            f"{', '.join(missing)}; it must name x, y, z and radius"
-        )
-    vel_cols = [name for name in ("vx", "vy", "vz") if name in header]
-    if vel_cols and len(vel_cols) != 3:
-        raise ValueError(
-            f"{where}, line {header_line}: give all of vx, vy, vz or none, got only "
-            f"{', '.join(vel_cols)}"
-        )
-    ncol = len(header)
-    lines = np.asarray(line_numbers, dtype=np.int64)
-    widths = np.fromiter((len(r) for r in rows), dtype=np.int64, count=len(rows))
-    bad = np.flatnonzero(widths != ncol)
-    if bad.size:
-        i = int(bad[0])
-        raise ValueError(
-            f"{where}, line {lines[i]}: expected {ncol} values ({' '.join(header)}), "
-            f"found {widths[i]}"
-        )
-    try:
-        data = np.array(rows, dtype=np.float64).reshape(len(rows), ncol)
-    except ValueError:
-        for i, row in enumerate(rows):
-            for j, token in enumerate(row):
-                try:
-                    float(token)
-                except ValueError:
-                    raise ValueError(
-                        f"{where}, line {lines[i]}, column {header[j]!r}: {token!r} is not a number"
-                    ) from None
-        raise
-    col = {name: j for j, name in enumerate(header)}
-    nonfinite = np.argwhere(~np.isfinite(data))
-    if nonfinite.size:
-        i, j = (int(v) for v in nonfinite[0])
-        raise ValueError(
-            f"{where}, line {lines[i]}, column {header[j]!r}: value {data[i, j]!r} is not finite"
-        )
-    for name in ("radius", "temperature"):
-        if name in col:
-            bad = np.flatnonzero(data[:, col[name]] <= 0.0)
-            if bad.size:
-                i = int(bad[0])
-                raise ValueError(
-                    f"{where}, line {lines[i]}, column {name!r}: value {data[i, col[name]]!r} "
-                    "must be > 0"
-                )
-    n = data.shape[0]
-    velocity = data[:, [col["vx"], col["vy"], col["vz"]]] if vel_cols else np.zeros((n, 3))
-    particles = InsertedParticles(
-        position=np.ascontiguousarray(data[:, [col["x"], col["y"], col["z"]]]),
-        radius=np.ascontiguousarray(data[:, col["radius"]]),
-        velocity=np.ascontiguousarray(velocity),
-        temperature=np.ascontiguousarray(data[:, col["temperature"]])
-        if "temperature" in col
-        else None,
-        material=material,
-    )
-    return _ParsedFile(particles, lines, bool(vel_cols), "temperature" in col)
-
-
-def load_particle_file(path: str | Path, material: str = "") -> InsertedParticles:
-    """Read particles from a whitespace- or comma-separated text file.
-
-    The first non-blank line is the header naming the columns (a leading ``#`` is allowed):
-    ``x y z radius`` are required, ``vx vy vz`` (all three) and ``temperature`` are optional;
-    columns may come in any order. Blank lines and later lines starting with ``#`` are ignored.
-    Missing velocity columns give zero velocities; a missing temperature column gives
-    ``temperature=None``. Errors name the file, the line number and the column.
-    """
-    return _parse_particle_file(path, material).particles
-
-
 def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None) -> InsertedParticles:
     parsed = _parse_particle_file(entry.path, entry.material)
     p = parsed.particles
@@ -901,30 +781,3 @@ def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None) -> InsertedPart
                 f"outside a wall, the first on line {parsed.line_numbers[bad[0]]}"
             )
     return p
-
-
-def save_particle_file(path: str | Path, particles: InsertedParticles) -> None:
-    """Write particles in the format read by :func:`load_particle_file` (whitespace separated).
-
-    Velocities are always written; temperatures when present.
-    """
-    columns = ["x", "y", "z", "radius", "vx", "vy", "vz"]
-    blocks = [particles.position, particles.radius[:, None], particles.velocity]
-    if particles.temperature is not None:
-        columns.append("temperature")
-        blocks.append(particles.temperature[:, None])
-    np.savetxt(path, np.hstack(blocks), fmt="%.17g", header=" ".join(columns), comments="")
-
-
-__all__ = [
-    "FILE_OPTIONAL_COLUMNS",
-    "FILE_REQUIRED_COLUMNS",
-    "InsertedParticles",
-    "Pourer",
-    "WallsOk",
-    "insert",
-    "lattice_sites",
-    "load_particle_file",
-    "sample_radii",
-    "save_particle_file",
-]

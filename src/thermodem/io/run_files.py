@@ -1,0 +1,232 @@
+"""Files of a run directory: run.log, frames (VTU/PVD), timeseries.csv, status.json."""
+
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import io
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+
+from thermodem.engine.simulation import Simulation
+from thermodem.errors import ConfigError
+from thermodem.io.vtk import PVDWriter, write_particles_vtu, write_walls_vtu
+
+CHECKPOINT_DIR = "checkpoints"
+STATUS_FILE = "status.json"
+TIMESERIES_FILE = "timeseries.csv"
+LOG_FILE = "run.log"
+FAILED_FILE = "failed.h5"
+
+
+def prepare_output_dir(path: Path, overwrite: bool) -> None:
+    """Refuse an existing non-empty directory unless ``overwrite`` (never silently)."""
+    if path.exists() and not path.is_dir():
+        raise ConfigError(f"--output {str(path)!r} exists and is not a directory")
+    if path.exists() and any(path.iterdir()) and not overwrite:
+        raise ConfigError(
+            f"--output {str(path)!r} exists and is not empty; choose another "
+            "directory or pass --overwrite"
+        )
+    path.mkdir(parents=True, exist_ok=True)
+
+
+def _atomic_write_text(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+# ------------------------------------------------------------------------------------ log
+class RunLog:
+    """Messages to the console and to ``run.log`` (``file_only`` lines go to the file only)."""
+
+    def __init__(
+        self, path: Path | None, console: TextIO | None = None, append: bool = False
+    ) -> None:
+        self.console = console
+        self.file = open(path, "a" if append else "w", encoding="utf-8") if path else None  # noqa: SIM115
+
+    def _stamp(self) -> str:
+        return _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
+
+    def info(self, message: str) -> None:
+        if self.console is not None:
+            print(message, file=self.console, flush=True)
+        self.file_only(message)
+
+    def warn(self, message: str) -> None:
+        self.info(f"warning: {message}")
+
+    def file_only(self, message: str) -> None:
+        if self.file is not None:
+            self.file.write(f"[{self._stamp()}] {message}\n")
+            self.file.flush()
+
+    def close(self) -> None:
+        if self.file is not None:
+            self.file.close()
+            self.file = None
+
+
+# --------------------------------------------------------------------------------- frames
+class FrameWriter:
+    """Writes particle and wall frames and keeps the PVD indices valid after every frame."""
+
+    def __init__(self, out: Path, wall_extent: float, resume_time: float | None = None) -> None:
+        self.out = out
+        (out / "vtk").mkdir(parents=True, exist_ok=True)
+        if resume_time is None:
+            self.particles_pvd = PVDWriter(out / "particles.pvd")
+            self.walls_pvd = PVDWriter(out / "walls.pvd")
+        else:
+            self.particles_pvd = PVDWriter.resume(out / "particles.pvd", resume_time)
+            self.walls_pvd = PVDWriter.resume(out / "walls.pvd", resume_time)
+        self.wall_extent = wall_extent
+        self.frames = len(self.particles_pvd.entries)
+        self.last_step = -1
+
+    def write(self, sim: Simulation) -> None:
+        p = sim.particles
+        name = f"particles_{sim.step_count:09d}.vtu"
+        fields = {
+            "global_id": p.global_id,
+            "type_id": p.type_id,
+            "radius": p.radius,
+            "mass": p.mass,
+            "velocity": p.velocity,
+            "angular_velocity": p.angular_velocity,
+            "force": p.force,
+            "torque": p.torque,
+            "temperature": p.temperature,
+            "heat_rate": p.heat_rate,
+            "coordination_number": sim.coordination_number().astype(np.int32),
+        }
+        if sim.thermal is not None:
+            from thermodem.state.particles import HEAT_MECHANISMS
+
+            for k, mech in enumerate(HEAT_MECHANISMS):
+                col = p.heat_rate_by_mechanism[:, k]
+                if np.any(col):
+                    fields[f"heat_rate_{mech}"] = np.ascontiguousarray(col)
+        write_particles_vtu(self.out / "vtk" / name, p.position, fields)
+        self.particles_pvd.add(sim.time, f"vtk/{name}")
+        if sim.wall_rows.shape[0]:
+            wname = f"walls_{sim.step_count:09d}.vtu"
+            write_walls_vtu(
+                self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows, None, self.wall_extent
+            )
+            self.walls_pvd.add(sim.time, f"vtk/{wname}")
+        self.frames = len(self.particles_pvd.entries)
+        self.last_step = sim.step_count
+
+
+# ----------------------------------------------------------------------------- time series
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool | np.bool_):
+        return str(int(value))
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    if isinstance(value, float | np.floating):
+        return repr(float(value))
+    return str(value)
+
+
+class TimeseriesWriter:
+    """``timeseries.csv``: ``time``, ``step`` and every key of ``sim.report()`` as columns.
+
+    Values are written exactly (``repr`` of the float). Columns come from what the engine
+    reports: when a later row has a key the header does not have yet (a heat mechanism that
+    became active), the file is rewritten with the new column, earlier rows left empty there.
+    With ``resume_step`` the rows after that step are dropped first (a restart).
+    """
+
+    def __init__(self, path: Path, resume_step: int | None = None) -> None:
+        self.path = path
+        self.columns: list[str] = []
+        self.rows = 0
+        self.last_step = -1
+        if resume_step is not None and path.exists():
+            with path.open(newline="") as f:
+                reader = csv.reader(f)
+                header = next(reader, None)
+                kept = [r for r in reader if r and int(r[1]) <= resume_step] if header else []
+            self.columns = list(header or [])
+            self._rewrite(kept)
+            self.rows = len(kept)
+            if kept:
+                self.last_step = int(kept[-1][1])
+        elif path.exists():
+            path.unlink()
+
+    def _rewrite(self, rows: list[list[str]]) -> None:
+        buf = io.StringIO()
+        writer = csv.writer(buf, lineterminator="\n")
+        if self.columns:
+            writer.writerow(self.columns)
+        for r in rows:
+            writer.writerow(r + [""] * (len(self.columns) - len(r)))
+        _atomic_write_text(self.path, buf.getvalue())
+
+    def write(self, sim: Simulation) -> None:
+        row: dict[str, Any] = {"time": sim.time, "step": sim.step_count}
+        row.update(sim.report())
+        new = [k for k in row if k not in self.columns]
+        if new:
+            old_rows: list[list[str]] = []
+            if self.path.exists() and self.columns:
+                with self.path.open(newline="") as f:
+                    old_rows = list(csv.reader(f))[1:]
+            self.columns += new
+            self._rewrite(old_rows)
+        with self.path.open("a", newline="") as f:
+            csv.writer(f, lineterminator="\n").writerow([_cell(row.get(c)) for c in self.columns])
+        self.rows += 1
+        self.last_step = sim.step_count
+
+
+def read_timeseries(path: Path) -> dict[str, np.ndarray]:
+    """Columns of a ``timeseries.csv`` as float arrays (empty cells are NaN)."""
+    with Path(path).open(newline="") as f:
+        reader = csv.reader(f)
+        header = next(reader, [])
+        rows = [r for r in reader if r]
+    out = {}
+    for k, name in enumerate(header):
+        out[name] = np.array([float(r[k]) if k < len(r) and r[k] != "" else math.nan for r in rows])
+    return out
+
+
+# --------------------------------------------------------------------------------- status
+@dataclass
+class Status:
+    """``status.json``: what ``thermodem info`` reports about a running or finished run."""
+
+    path: Path
+    data: dict[str, Any] = field(default_factory=dict)
+
+    def update(self, **values: Any) -> None:
+        self.data.update(values)
+        self.data["updated"] = _dt.datetime.now().isoformat(timespec="seconds")
+        _atomic_write_text(self.path, json.dumps(self.data, indent=2) + "\n")
+
+    @staticmethod
+    def read(directory: Path) -> dict[str, Any]:
+        path = Path(directory) / STATUS_FILE
+        if not path.exists():
+            return {}
+        try:
+            return json.loads(path.read_text())
+        except (OSError, ValueError):
+            return {}
+
+
+# ------------------------------------------------------------------------------- progress
