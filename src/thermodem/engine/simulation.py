@@ -24,7 +24,7 @@ from collections.abc import Callable
 import numba
 import numpy as np
 
-from thermodem.config.schema import Case, ModelChoice
+from thermodem.config.schema import Case
 from thermodem.engine import diagnostics as D
 from thermodem.engine.validation import check_completeness
 from thermodem.errors import SimulationError
@@ -41,8 +41,8 @@ from thermodem.kernels.integrate import (
     reduce_checks,
     sum_rows,
 )
-from thermodem.models import registry
-from thermodem.state.materials import resolve_pair
+from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
+from thermodem.state.pairs import PairBuffers
 from thermodem.state.particles import Particles
 
 LEDGER_DISSIPATION = (
@@ -51,60 +51,6 @@ LEDGER_DISSIPATION = (
     "sliding_friction",
     "rolling_friction",
 )
-
-
-def pair_table(choice: ModelChoice, case: Case, names: list[str]) -> np.ndarray:
-    """[nmat, nmat, PARAM_WIDTH] parameter rows of one model for every material pair."""
-    spec = choice.spec
-    n = len(names)
-    table = np.zeros((n, n, registry.PARAM_WIDTH))
-    overrides = {frozenset(o.materials): o for o in case.interactions}
-    for a in range(n):
-        for b in range(n):
-            ma = case.materials[names[a]]
-            mb = case.materials[names[b]]
-            pair = resolve_pair(ma, mb, overrides.get(frozenset((names[a], names[b]))))
-            table[a, b] = spec.pack(choice.params, pair)
-    return table
-
-
-class _PairBuffers:
-    """Pair-list arrays with a capacity; grown (never shrunk) when a rebuild needs more."""
-
-    def __init__(self, capacity: int, history_width: int, with_roll: bool) -> None:
-        self.count = 0
-        self.history_width = history_width
-        self.with_roll = with_roll
-        self.allocate(capacity)
-
-    def allocate(self, capacity: int) -> None:
-        capacity = max(int(capacity), 16)
-        self.capacity = capacity
-        self.i = np.zeros(capacity, np.int32)
-        self.j = np.zeros(capacity, np.int32)
-        self.history = np.zeros((capacity, self.history_width))
-        self.spare_history = np.zeros((capacity, self.history_width))
-        self.force = np.zeros((capacity, 3))
-        self.lever = np.zeros((capacity, 3))
-        self.roll = np.zeros((capacity if self.with_roll else 0, 3))
-        self.dissipation = np.zeros((capacity, 4))
-        self.normal_force = np.zeros(capacity)
-        self.state = np.zeros(capacity, np.int8)
-        self.key_a = np.zeros(capacity, np.int64)
-        self.key_b = np.zeros(capacity, np.int64)
-        self.lookup_order = np.zeros(capacity, np.int64)
-        self.chunk_ledger = np.zeros((capacity // C.CHUNK + 2, C.LEDGER_WIDTH))
-
-    def grow_keep_history(self, capacity: int) -> None:
-        """Grow while keeping the current keys and history (for lookups after the rebuild)."""
-        old = (self.history, self.key_a, self.key_b, self.lookup_order, self.count)
-        self.allocate(capacity)
-        history, key_a, key_b, order, count = old
-        self.history[:count] = history[:count]
-        self.key_a[:count] = key_a[:count]
-        self.key_b[:count] = key_b[:count]
-        self.lookup_order[:count] = order[:count]
-        self.count = count
 
 
 class Simulation:
@@ -179,8 +125,8 @@ class Simulation:
         self.extra = float(nb.extra_distance)
         self.skin = nb.skin
         self.rebuild_every_step = nb.rebuild_every_step
-        self.pairs = _PairBuffers(1024, history_width, with_roll)
-        self.walls = _PairBuffers(64, history_width, with_roll)
+        self.pairs = PairBuffers(1024, history_width, with_roll)
+        self.walls = PairBuffers(64, history_width, with_roll)
         self.row_start = np.zeros(1, np.int64)
         self.entries = np.zeros(16, np.int64)
         self.wall_row_start = np.zeros(1, np.int64)
@@ -338,7 +284,7 @@ class Simulation:
         self._needs_rebuild = False
 
     def _carry(
-        self, buf: _PairBuffers, count: int, new_a: np.ndarray, new_b: np.ndarray, lookup_attr: str
+        self, buf: PairBuffers, count: int, new_a: np.ndarray, new_b: np.ndarray, lookup_attr: str
     ) -> None:
         old_start = getattr(self, lookup_attr)
         NB.carry_history(
