@@ -13,11 +13,11 @@ The state is a plain nested dict, which :mod:`thermodem.io.checkpoint` writes to
                     ledger_cumulative, rng (the bit generator state), pourers (state dicts),
                     material_names, history_width, pair_capacity, wall_pair_capacity},
       "particles": {every Particles array, in the current memory order},
-      "pairs":     {i, j, history, force, lever, roll, dissipation, normal_force, state,
-                    key_a, key_b, lookup_order: the first `count` rows},
+      "pairs":     {i, j, history, force, lever, roll, dissipation, normal_force, state:
+                    the first `count` rows},
       "walls":     {the same for particle-wall pairs},
-      "arrays":    {row_start, entries, wall_row_start, lookup_start, wall_lookup_start,
-                    reference, wall_reference, wall_rows, elastic},
+      "arrays":    {row_start, entries, wall_row_start, reference, wall_reference, wall_rows,
+                    elastic},
       "thermal":   {"scalars": {...}, "arrays": {...}}   (only with a thermal engine)
     }
 
@@ -58,8 +58,6 @@ ARRAYS: tuple[str, ...] = (
     "row_start",
     "entries",
     "wall_row_start",
-    "lookup_start",
-    "wall_lookup_start",
     "reference",
     "wall_reference",
     "wall_rows",
@@ -76,9 +74,6 @@ PAIR_ARRAYS: tuple[str, ...] = (
     "dissipation",
     "normal_force",
     "state",
-    "key_a",
-    "key_b",
-    "lookup_order",
 )
 #: Attributes handled by name in capture/restore (containers of state).
 CONTAINERS: tuple[str, ...] = (

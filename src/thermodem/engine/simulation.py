@@ -128,10 +128,8 @@ class Simulation:
         self.pairs = PairBuffers(1024, history_width, with_roll)
         self.walls = PairBuffers(64, history_width, with_roll)
         self.row_start = np.zeros(1, np.int64)
-        self.entries = np.zeros(16, np.int64)
+        self.entries = np.zeros(16, np.int32)
         self.wall_row_start = np.zeros(1, np.int64)
-        self.lookup_start = np.zeros(1, np.int64)
-        self.wall_lookup_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
         self.chunk_check = np.zeros((1, 3))
         self.moved = 0.0
@@ -219,7 +217,6 @@ class Simulation:
                     self.step_count,
                     self.time,
                 )
-        # old keys (global ids) before particles move in memory
         pb, wb = self.pairs, self.walls
         dims, edge = NB.cell_grid(self.lower, self.upper, cell, self.periodic)
         ncell = int(dims[0] * dims[1] * dims[2])
@@ -227,7 +224,13 @@ class Simulation:
         cell_start = np.zeros(ncell + 1, np.int64)
         NB.sort_by_cell(p.position, self.lower, edge, dims, order, cell_start)
         p.permute(order)
-        # particle pairs
+        new_index = np.empty(n, np.int32)  # old particle index -> index after the sort
+        new_index[order] = np.arange(n, dtype=np.int32)
+        del order
+        # particle pairs: list into fresh index arrays, then carry the history
+        old_i, old_j, old_history, old_count = pb.i, pb.j, pb.history, pb.count
+        new_i = np.empty(pb.capacity, np.int32)
+        new_j = np.empty(pb.capacity, np.int32)
         while True:
             count = NB.build_pairs(
                 p.position,
@@ -241,21 +244,34 @@ class Simulation:
                 cell_start,
                 self.extra,
                 self.skin,
-                pb.i,
-                pb.j,
+                new_i,
+                new_j,
             )
-            if count <= pb.capacity:
+            if count <= new_i.shape[0]:
                 break
-            pb.grow_keep_history(int(count * 1.25) + 16)
-        self._carry(pb, count, p.global_id[pb.i[:count]], p.global_id[pb.j[:count]], "lookup_start")
+            new_i = np.empty(PairBuffers.grown(pb.capacity, count), np.int32)
+            new_j = np.empty_like(new_i)
+        if new_i.shape[0] > pb.capacity:
+            pb.allocate(new_i.shape[0])  # old_* still hold the previous list
+        pb.i, pb.j, pb.count = new_i, new_j, count
         if self.row_start.shape[0] != n + 1:
             self.row_start = np.zeros(n + 1, np.int64)
         if self.entries.shape[0] < 2 * pb.capacity:
-            self.entries = np.zeros(2 * pb.capacity, np.int64)
+            self.entries = np.zeros(2 * pb.capacity, np.int32)
         NB.particle_pair_csr(pb.i, pb.j, count, p.global_id, n, self.row_start, self.entries)
+        spare = pb.spare_history()
+        NB.carry_pair_history(
+            old_i, old_j, old_count, old_history, new_index, self.row_start, self.entries,
+            pb.j, spare, count,
+        )  # fmt: skip
+        pb.swap_history()  # (after a growth too: old_history is then the previous array)
+        del old_i, old_j, old_history
         # wall pairs
         if self.wall_row_start.shape[0] != n + 1:
             self.wall_row_start = np.zeros(n + 1, np.int64)
+        old_i, old_w, old_history, old_count = wb.i, wb.j, wb.history, wb.count
+        new_i = np.empty(wb.capacity, np.int32)
+        new_w = np.empty(wb.capacity, np.int32)
         while True:
             wcount = NB.build_wall_pairs(
                 p.position,
@@ -264,48 +280,26 @@ class Simulation:
                 self.wall_rows,
                 self.extra,
                 self.skin,
-                wb.i,
-                wb.j,
+                new_i,
+                new_w,
                 self.wall_row_start,
             )
-            if wcount <= wb.capacity:
+            if wcount <= new_i.shape[0]:
                 break
-            wb.grow_keep_history(int(wcount * 1.25) + 16)
-        self._carry(
-            wb,
-            wcount,
-            p.global_id[wb.i[:wcount]],
-            wb.j[:wcount].astype(np.int64),
-            "wall_lookup_start",
-        )
+            new_i = np.empty(PairBuffers.grown(wb.capacity, wcount), np.int32)
+            new_w = np.empty_like(new_i)
+        if new_i.shape[0] > wb.capacity:
+            wb.allocate(new_i.shape[0])
+        wb.i, wb.j, wb.count = new_i, new_w, wcount
+        NB.carry_wall_history(
+            old_i, old_w, old_count, old_history, new_index, self.wall_row_start, wb.j,
+            wb.spare_history(), wcount,
+        )  # fmt: skip
+        wb.swap_history()
         self.reference = p.position.copy()
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         self.rebuild_count += 1
         self._needs_rebuild = False
-
-    def _carry(
-        self, buf: PairBuffers, count: int, new_a: np.ndarray, new_b: np.ndarray, lookup_attr: str
-    ) -> None:
-        old_start = getattr(self, lookup_attr)
-        NB.carry_history(
-            new_a,
-            new_b,
-            count,
-            buf.key_a,
-            buf.key_b,
-            old_start,
-            buf.lookup_order,
-            buf.history,
-            buf.spare_history,
-        )
-        buf.history, buf.spare_history = buf.spare_history, buf.history
-        buf.key_a[:count] = new_a
-        buf.key_b[:count] = new_b
-        buf.count = count
-        nkeys = self.next_global_id
-        new_start = np.zeros(nkeys + 1, np.int64)
-        NB.index_by_first_key(buf.key_a, count, nkeys, new_start, buf.lookup_order)
-        setattr(self, lookup_attr, new_start)
 
     def _rebuild_due(self) -> bool:
         if self._needs_rebuild or self.rebuild_every_step:

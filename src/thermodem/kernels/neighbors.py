@@ -3,9 +3,9 @@
 At each rebuild the particles are sorted by cell (a counting sort, so particles that are close
 in space are close in memory), then every pair closer than ``R_i + R_j + extra + skin`` is
 listed once. A pair is stored oriented so that ``global_id[i] < global_id[j]``; its history row
-is looked up by the key (gid_i, gid_j) in the previous list and copied, so a run that rebuilds
-every step and a run with a skin carry identical history. ``extra`` is the interaction distance
-beyond contact needed by gap models (near, non-touching pairs).
+is carried to the new list by particle identity (old index -> index after the sort), so a run
+that rebuilds every step and a run with a skin carry identical history. ``extra`` is the
+interaction distance beyond contact needed by gap models (near, non-touching pairs).
 
 All kernels write into preallocated buffers and report the count they needed; when a buffer is
 too small they return the needed size and the caller grows it and calls again.
@@ -285,48 +285,66 @@ def build_wall_pairs(
     return count
 
 
-@njit(cache=True, error_model="numpy")
-def index_by_first_key(key_a, count, nkeys, start, order):
-    """Group entries by ``key_a`` (a counting sort): ``start`` has nkeys + 1 offsets."""
-    start[:] = 0
-    for k in range(count):
-        start[key_a[k] + 1] += 1
-    for g in range(nkeys):
-        start[g + 1] += start[g]
-    fill = start[:nkeys].copy()
-    for k in range(count):
-        g = key_a[k]
-        order[fill[g]] = k
-        fill[g] += 1
+@njit(cache=True, inline="always", error_model="numpy")
+def _copy_nonzero_row(old_history, k, new_history, m):
+    for c in range(old_history.shape[1]):
+        new_history[m, c] = old_history[k, c]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _row_is_zero(history, k):
+    for c in range(history.shape[1]):
+        if history[k, c] != 0.0:
+            return False
+    return True
 
 
 @njit(cache=True, error_model="numpy")
-def carry_history(
-    new_a, new_b, new_count, old_a, old_b, old_start, old_order, old_history, new_history
-):
-    """Copy each new pair's history row from the old pair with the same key (a, b), or zero.
+def carry_pair_history(
+    old_i, old_j, old_count, old_history, new_index, row_start, entries, new_j, new_history,
+    new_count,
+):  # fmt: skip
+    """Copy each old pair's history row to the new pair of the same two particles.
 
-    ``old_start``/``old_order`` group the old pairs by key a (:func:`index_by_first_key`).
-    Keys are global ids (or (global id, wall index) for wall pairs).
+    ``new_index[old particle index]`` is its index after the rebuild's sort. Pairs keep their
+    orientation (the smaller global id is i), so the new pair of an old pair (a, b) is the entry
+    of row a of the new per-particle list (``row_start``/``entries``, see
+    :func:`particle_pair_csr`) that has a as i and b as j. Rows of new pairs without an old
+    pair are zero; an all-zero old row (a pair that does not touch) needs no copy.
     """
-    width = new_history.shape[1]
-    nkeys = old_start.shape[0] - 1
-    for k in range(new_count):
-        a = new_a[k]
-        b = new_b[k]
-        found = -1
-        if a < nkeys:
-            for q in range(old_start[a], old_start[a + 1]):
-                m = old_order[q]
-                if old_b[m] == b:
-                    found = m
-                    break
-        if found >= 0:
-            for c in range(width):
-                new_history[k, c] = old_history[found, c]
-        else:
-            for c in range(width):
-                new_history[k, c] = 0.0
+    for m in range(new_count):
+        for c in range(new_history.shape[1]):
+            new_history[m, c] = 0.0
+    for k in range(old_count):
+        if _row_is_zero(old_history, k):
+            continue
+        a = new_index[old_i[k]]
+        b = new_index[old_j[k]]
+        for q in range(row_start[a], row_start[a + 1]):
+            e = entries[q]
+            if e >= 0 and new_j[e] == b:
+                _copy_nonzero_row(old_history, k, new_history, e)
+                break
+
+
+@njit(cache=True, error_model="numpy")
+def carry_wall_history(
+    old_i, old_w, old_count, old_history, new_index, wall_row_start, new_w, new_history,
+    new_count,
+):  # fmt: skip
+    """Copy each old particle-wall pair's history to the new pair of the same particle and
+    wall (new wall pairs are grouped by particle, ``wall_row_start``); other rows zero."""
+    for m in range(new_count):
+        for c in range(new_history.shape[1]):
+            new_history[m, c] = 0.0
+    for k in range(old_count):
+        if _row_is_zero(old_history, k):
+            continue
+        a = new_index[old_i[k]]
+        for m in range(wall_row_start[a], wall_row_start[a + 1]):
+            if new_w[m] == old_w[k]:
+                _copy_nonzero_row(old_history, k, new_history, m)
+                break
 
 
 @njit(cache=True, error_model="numpy")
