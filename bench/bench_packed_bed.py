@@ -51,8 +51,9 @@ THERMAL_PROPERTIES = {
     "surface_roughness": 1e-6, "surface_slope": 0.1, "thermal_accommodation": 0.8,
     "youngs_modulus_real": 7e10,
 }  # fmt: skip
-HEAT_PARAMS = {"batchelor_obrien_complete": {"fluid_conductivity": 0.026},
-               "batchelor_obrien_modified": {"fluid_conductivity": 0.026}}  # fmt: skip
+# thermal.gas of the runs with these models (the others use the default, air at 300 K)
+HEAT_GAS = {"batchelor_obrien_complete": {"thermal_conductivity": 0.026},
+            "batchelor_obrien_modified": {"thermal_conductivity": 0.026}}  # fmt: skip
 
 
 def case_dict(
@@ -90,7 +91,8 @@ def case_dict(
     if heat is not None:
         material.update(THERMAL_PROPERTIES)
         case["thermal"] = {
-            "direct_conduction": {"model": heat, **HEAT_PARAMS.get(heat, {})},
+            "direct_conduction": heat,
+            "gas": HEAT_GAS.get(heat, {}),
             "contact_radius": "geometric",
             "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * z"},
         }

@@ -110,7 +110,7 @@ def validate(
 ) -> None:
     """Check a case (schema, completeness, time step, resources); print it resolved."""
     from thermodem.config.dump import resolved_case_yaml
-    from thermodem.engine.validation import validate_case
+    from thermodem.engine.validation import gas_note, validate_case
 
     result = _guarded(validate_case, case, threads)
     for w in result.warnings:
@@ -118,6 +118,9 @@ def validate(
     typer.echo(f"# {case}: valid (schema, completeness, time step, resources)")
     for line in result.estimate.lines():
         typer.echo(f"# {line}")
+    note = gas_note(result.case)
+    if note:
+        typer.echo(f"# {note}")
     typer.echo(resolved_case_yaml(result.case))
 
 
@@ -184,6 +187,8 @@ def models(
             typer.echo(f"  {fam}.{spec.name}: {spec.summary}")
             if spec.requires:
                 typer.echo(f"    requires materials.*: {', '.join(spec.requires)}")
+            if spec.uses_gas:
+                typer.echo(f"    reads thermal.gas: {', '.join(spec.uses_gas)}")
             fields = spec.params.model_fields
             if not fields:
                 typer.echo("    parameters: none")

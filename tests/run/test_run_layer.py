@@ -214,6 +214,7 @@ def test_thermal_columns_and_plots(tmp_path: Path) -> None:
     assert info.exit_code == 0
     for text in ("status: finished", "time: 0.006 s of 0.006 s", "frames: 7", "temperature_mean"):
         assert text in info.output, text
+    assert "gas (thermal.gas): k_g = 0.0263 W/(m K)" in info.output  # the default, air
 
 
 def test_timeseries_gains_columns_when_the_engine_reports_more(tmp_path: Path) -> None:

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from thermodem.models import registry
 from thermodem.models.thermal import direct_conduction as dc
 from thermodem.models.thermal.contact_radius import geometric_contact_radius
+from thermodem.state.gas import GasProperties
 from thermodem.state.materials import Material, resolve_pair
 
 INF = np.inf
@@ -30,9 +31,11 @@ MAT_A = material(thermal_conductivity=2.0)
 MAT_B = material(thermal_conductivity=6.0, density=7800.0, specific_heat=460.0)
 
 
-def row(model: str, mi=MAT_A, mj=MAT_B, is_wall=False, **params) -> np.ndarray:
+def row(model: str, mi=MAT_A, mj=MAT_B, is_wall=False, k_f=None, **params) -> np.ndarray:
+    """The packed row; ``k_f``: the conductivity of the case's gas (None: default air)."""
     spec = registry.get("direct_conduction", model)
-    return spec.pack(spec.params(**params), resolve_pair(mi, mj, is_wall=is_wall))
+    gas = None if k_f is None else GasProperties(thermal_conductivity=k_f)
+    return spec.pack(spec.params(**params), resolve_pair(mi, mj, is_wall=is_wall, gas=gas))
 
 
 def rate(model, p, t_i, t_j, r_i, r_j, overlap, r_c, f_n=0.0, t_contact=0.0, v=0.0, m=0.0):
@@ -58,7 +61,7 @@ KPF = 1.0e4  # k_p = 1000, k_f = 0.1; η = k_pf R_c / (2 R*) = 1e7 R_c
 
 
 def bob_row(**kw):
-    return row("batchelor_obrien_complete", K_HIGH, K_HIGH, fluid_conductivity=0.1, **kw)
+    return row("batchelor_obrien_complete", K_HIGH, K_HIGH, k_f=0.1, **kw)
 
 
 @pytest.mark.parametrize(
@@ -113,7 +116,7 @@ def test_bob_modified_series_network_by_hand():
     h_t = (1 - w) * 0.17 * eta**2 + w * (2 * eta / PI - 2 * math.log(eta))
     h_bob = 2 * PI * r_eff * k_f * (h_t + math.log((k_p / k_f) ** 2))
     for option, r_bar in [(2.0, 2.0 * r_eff), ("dai2019", 1.3121 * (k_p / k_f) ** -0.19 * r_i)]:
-        p = row("batchelor_obrien_modified", fluid_conductivity=k_f, cylinder_radius=option)
+        p = row("batchelor_obrien_modified", k_f=k_f, cylinder_radius=option)
         h_i, h_j = 2.0 * PI * r_bar**2 / r_i, 6.0 * PI * r_bar**2 / r_j
         expected = 10.0 / (1 / h_i + 1 / h_j + 1 / h_bob)
         q = rate("batchelor_obrien_modified", p, 300.0, 310.0, r_i, r_j, 1e-6, r_c)
@@ -131,7 +134,7 @@ def test_bob_modified_series_network_by_hand():
 
 def test_bob_pack_checks():
     with pytest.raises(ValueError, match="k_p/k_f > 1"):
-        row("batchelor_obrien_complete", fluid_conductivity=5.0)
+        row("batchelor_obrien_complete", k_f=5.0)
     with pytest.raises(ValueError, match="thermal_conductivity"):
         row("batchelor_obrien_simple", MAT_A, material(thermal_conductivity=None))
     with pytest.raises(ValueError, match="specific_heat"):

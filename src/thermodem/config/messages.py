@@ -3,7 +3,8 @@
 Every line names the dotted key path of the bad key as written in the case file (list indices
 included, discriminated-union tags such as ``box`` removed), the bad value and what is
 allowed: the bounds pydantic reports, the allowed kinds of a ``kind:`` key, the allowed keys of
-a section for an unknown key, and a "did you mean" for misspelt keys, kinds and names.
+a section for an unknown key, and a "did you mean" for misspelt keys, kinds and names. A key
+that has moved to another section (:data:`MOVED_KEYS`) is told where it goes now.
 """
 
 from __future__ import annotations
@@ -30,6 +31,35 @@ def suggest(name: str, choices: list[str]) -> str | None:
 def _hint(name: str, choices: list[str]) -> str:
     best = suggest(name, choices)
     return f" (did you mean {best!r}?)" if best else ""
+
+
+_GAS_KEYS = "thermal_conductivity, specific_heat, dynamic_viscosity, heat_capacity_ratio, "
+_GAS_KEYS += "mean_free_path or pressure, temperature, molecular_diameter"
+
+#: Keys that moved: (where they were given, key) -> where they go now. ``model``: among the
+#: parameters of any model choice (``thermal.direct_conduction: {model: ..., KEY: ...}``);
+#: ``case``: at the top level of the case.
+MOVED_KEYS: dict[tuple[str, str], str] = {
+    ("model", "gas"): "the interstitial gas is no longer a model parameter: give it once for "
+    f"the case in the section thermal.gas ({_GAS_KEYS}), which every model that needs a gas "
+    "reads",
+    ("model", "fluid_conductivity"): "the fluid conductivity is now that of the case's "
+    "interstitial gas: give it as thermal.gas.thermal_conductivity, which every model that "
+    "needs a gas reads",
+    ("case", "gas"): f"the interstitial gas is the section thermal.gas ({_GAS_KEYS})",
+}
+
+
+def _moved(key: str, parent: _Where | None) -> str | None:
+    from thermodem.config.schema import Case
+
+    if parent is None:
+        return None
+    if parent.family is not None:
+        return MOVED_KEYS.get(("model", key))
+    if parent.tp is Case:
+        return MOVED_KEYS.get(("case", key))
+    return None
 
 
 # ---------------------------------------------------------------- types along a key path
@@ -221,6 +251,9 @@ def format_error(err: dict[str, Any], data: Any) -> str:
         parent_path, parent = walk(loc[:-1], data)
         allowed = _allowed_keys(parent)
         text = f"{dotted}: unknown key"
+        moved = _moved(key, parent)
+        if moved:
+            text += f" (got {_shown(value)}): {moved}"
         if allowed:
             text += f"{_hint(key, allowed)}; allowed keys: {', '.join(allowed)}"
         return text

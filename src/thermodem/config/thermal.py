@@ -5,12 +5,17 @@ Example::
     thermal:
       contact_radius: geometric
       direct_conduction: batchelor_obrien_simple
+      gas: {thermal_conductivity: 0.0263}   # the interstitial gas (default: air, 300 K, 1 atm)
       substeps: 1                  # solve heat every n mechanical steps, or "auto"
       initial_temperature: {kind: uniform, value: 293.15}
       fixed_temperature: [{select: {material: heater}, temperature: 400.0}]
       heat_flux: [{select: {region: {lower: [...], upper: [...]}}, flux: 1000.0}]
 
 Walls take part through their own ``thermal`` key (adiabatic by default).
+
+The interstitial gas is one section, ``thermal.gas`` (:class:`thermodem.state.gas.GasProperties`),
+read by every model that needs a gas (through ``PairContext.gas``), not a parameter of those
+models; it is always present, with the defaults of air at 300 K and 101325 Pa.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.models import registry
+from thermodem.state.gas import GasProperties
 
 Vec3 = tuple[float, float, float]
 
@@ -188,6 +194,11 @@ class ThermalSettings(StrictModel):
         default="batchelor_obrien_simple",
         validate_default=True,
         description="direct_conduction model",
+    )
+    gas: GasProperties = Field(
+        default_factory=GasProperties,
+        description="interstitial gas read by every model that needs one; default: air at "
+        "300 K, 101325 Pa",
     )
     substeps: int | Literal["auto"] = Field(
         default=1, description="solve heat every n mechanical steps, or 'auto' from the limit"

@@ -501,6 +501,20 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _gas_line(resolved: Path) -> str | None:
+    """'gas: ...' from the resolved case of a run with a thermal section, else None."""
+    import yaml
+
+    from thermodem.state.gas import GasProperties
+
+    try:
+        data = yaml.safe_load(resolved.read_text())
+        gas = GasProperties(**data["thermal"]["gas"])
+    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError):
+        return None
+    return f"gas (thermal.gas): {gas.summary()}"
+
+
 def output_summary(directory: str | os.PathLike[str]) -> list[str]:
     """Lines describing a finished or running output directory (``thermodem info``)."""
     directory = Path(directory)
@@ -523,6 +537,9 @@ def output_summary(directory: str | os.PathLike[str]) -> list[str]:
         lines.append(f"message: {status['message'].splitlines()[0]}")
     if status.get("case"):
         lines.append(f"case: {status['case']}")
+    gas = _gas_line(resolved)
+    if gas:
+        lines.append(gas)
     if "time" in status:
         end = status.get("end_time") or math.nan
         frac = 100.0 * status["time"] / end if end else math.nan

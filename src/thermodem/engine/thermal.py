@@ -73,6 +73,7 @@ class ThermalEngine:
                     case.materials[na],
                     case.materials[nb],
                     is_wall=nb in hot_walls and nb not in particle_mats,
+                    gas=settings.gas,
                 )
                 for table, choice in (
                     (self.radius_table, settings.contact_radius),

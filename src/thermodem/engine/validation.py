@@ -106,6 +106,18 @@ def check_completeness(case: Case) -> None:
         raise ConfigError("incomplete case:\n" + "\n".join(unique))
 
 
+def gas_note(case: Case) -> str | None:
+    """One line on the case's interstitial gas (``thermal.gas``): given or the air default,
+    which selected models read it, its values with Λ and Pr; None without a thermal section."""
+    thermal = getattr(case, "thermal", None)
+    if thermal is None:
+        return None
+    users = [f"{path} = {c.model!r}" for path, c in model_choices(case) if c.spec.uses_gas]
+    origin = "given" if "gas" in thermal.model_fields_set else "default: air at 300 K, 1 atm"
+    read = f"read by {', '.join(users)}" if users else "not read by the selected models"
+    return f"thermal.gas ({origin}; {read}): {thermal.gas.summary()}"
+
+
 # ----------------------------------------------------------------------------- resources
 def physical_memory() -> tuple[float, float]:
     """(total, available) physical memory [bytes]; NaN where unknown."""

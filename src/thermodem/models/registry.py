@@ -8,7 +8,8 @@ A model is a small Numba-compiled scalar function (its *kernel*) plus:
   row for that type pair (mixing rules are written there, explicitly),
 - metadata: its integer id inside the family (the fused loops switch on it), history width and
   which history entries flip sign when i and j swap, the interaction range beyond contact it
-  needs, the material properties it requires, and the reference.
+  needs, the material properties it requires, the properties of the case's interstitial gas
+  (``thermal.gas``, handed to ``pack`` as ``pair.gas``) it reads, and the reference.
 
 The integer ids are written as constants in the model modules (not assigned at import time) so
 that the compiled dispatchers, which are cached on disk by Numba, never disagree with the
@@ -60,6 +61,7 @@ class ModelSpec:
     requires: tuple[str, ...] = ()
     interaction_range: Callable[..., float] | None = None
     antisymmetric: bool = True
+    uses_gas: tuple[str, ...] = ()
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -81,6 +83,7 @@ def register(
     requires: tuple[str, ...] = (),
     interaction_range: Callable[..., float] | None = None,
     antisymmetric: bool = True,
+    uses_gas: tuple[str, ...] = (),
     **extra: Any,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique."""
@@ -110,6 +113,7 @@ def register(
         requires=tuple(requires),
         interaction_range=interaction_range,
         antisymmetric=antisymmetric,
+        uses_gas=tuple(uses_gas),
         extra=dict(extra),
     )
     models[name] = spec

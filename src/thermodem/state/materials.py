@@ -1,17 +1,19 @@
 """Materials (per type) and the resolved properties of a pair of materials that meet.
 
 A material is a row of properties indexed by ``type_id``; walls have materials too. Every model's
-``pack`` receives a :class:`PairContext`, which holds both materials and the pair-resolved
-mechanical coefficients, and turns them into a float64 parameter row for that type pair.
+``pack`` receives a :class:`PairContext`, which holds both materials, the pair-resolved
+mechanical coefficients and the case's interstitial gas, and turns them into a float64
+parameter row for that type pair.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
+from thermodem.state.gas import GasProperties
 
 
 class Material(StrictModel):
@@ -108,6 +110,9 @@ class PairContext:
     two materials' restitution, sliding and rolling friction coefficients. For a particle-wall
     pair ``mat_j`` is the wall material and ``is_wall`` is true (the wall is a body of infinite
     radius and mass).
+
+    ``gas`` is the case's interstitial gas (``thermal.gas``), the same for every pair; models
+    that need a gas read it here. Default: air at 300 K, 1 atm, as the case-file default.
     """
 
     mat_i: Material
@@ -116,7 +121,7 @@ class PairContext:
     sliding_friction: float
     rolling_friction: float
     is_wall: bool = False
-    gas: object | None = None
+    gas: GasProperties = field(default_factory=GasProperties)
 
     @property
     def effective_youngs_modulus(self) -> float:
@@ -132,9 +137,10 @@ def resolve_pair(
     mj: Material,
     override: InteractionOverride | None = None,
     is_wall: bool = False,
-    gas: object | None = None,
+    gas: GasProperties | None = None,
 ) -> PairContext:
-    """Pair coefficients from the mixing rule, replaced where an override gives them."""
+    """Pair coefficients from the mixing rule, replaced where an override gives them; ``gas``
+    None: the default gas (air at 300 K, 1 atm)."""
 
     def pick(attr: str) -> float:
         if override is not None and getattr(override, attr) is not None:
@@ -148,5 +154,5 @@ def resolve_pair(
         sliding_friction=pick("sliding_friction"),
         rolling_friction=pick("rolling_friction"),
         is_wall=is_wall,
-        gas=gas,
+        gas=gas if gas is not None else GasProperties(),
     )

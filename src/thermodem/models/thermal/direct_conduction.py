@@ -175,8 +175,9 @@ class BatchelorOBrienCompleteParams(StrictModel):
     contact circle and the surrounding fluid, and near (separated) particles (spec 2.3).
 
     Total conduction (direct + through the fluid near the contact): do not combine it with an
-    indirect_conduction model. k_p = 2 k_i k_j/(k_i + k_j) (harmonic mean, so that the large-η
-    limit is batchelor_obrien_simple), k_pf = k_p/k_f must exceed 1. The 1 <= η <= 100 blend
+    indirect_conduction model. k_f is the conductivity of the case's gas (``thermal.gas``,
+    ``pair.gas``). k_p = 2 k_i k_j/(k_i + k_j) (harmonic mean, so that the large-η limit is
+    batchelor_obrien_simple), k_pf = k_p/k_f must exceed 1. The 1 <= η <= 100 blend
     of the spec is not monotonic (see bob_contact_h); ``blend="hermite"`` is a monotonic one.
     Separated pairs conduct up to a gap ``cutoff_gap_ratio`` R* (Yun & Evans 2010: d_s < R̄),
     through a cylinder of radius ``cylinder_radius`` R* (2.0: Dai et al. 2019; for equal
@@ -184,9 +185,6 @@ class BatchelorOBrienCompleteParams(StrictModel):
     Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*].
     """
 
-    fluid_conductivity: float = Field(
-        default=0.0263, gt=0, description="k_f [W/(m K)] of the interstitial fluid (air, 300 K)"
-    )
     blend: Literal[tuple(_BLENDS)] = Field(
         default="spec_linear", description="H̃ for 1 <= η <= 100: spec's blend or monotonic"
     )
@@ -202,16 +200,17 @@ def _check_kpf(k_i: float, k_j: float, k_f: float, model: str) -> None:
     k_p = 2.0 * k_i * k_j / (k_i + k_j)
     if k_p <= k_f:
         raise ValueError(
-            f"{model} needs particle conductivity above the fluid's (k_p/k_f > 1): "
-            f"k_p = {k_p:g} W/(m K), fluid_conductivity = {k_f:g} W/(m K)"
+            f"{model} needs particle conductivity above the gas's (k_p/k_f > 1): "
+            f"k_p = {k_p:g} W/(m K), thermal.gas.thermal_conductivity = {k_f:g} W/(m K)"
         )
 
 
 def pack_bob_complete(params: BatchelorOBrienCompleteParams, pair: PairContext) -> np.ndarray:
     model = "direct_conduction.batchelor_obrien_complete"
     k_i, k_j = _conductivities(pair, model)
-    _check_kpf(k_i, k_j, params.fluid_conductivity, model)
-    values = [params.fluid_conductivity, _BLENDS[params.blend], params.cylinder_radius]
+    k_f = pair.gas.thermal_conductivity
+    _check_kpf(k_i, k_j, k_f, model)
+    values = [k_f, _BLENDS[params.blend], params.cylinder_radius]
     return pad_row([k_i, k_j, 0.0, 0.0, *values, params.cutoff_gap_ratio])
 
 
@@ -248,12 +247,13 @@ class BatchelorOBrienModifiedParams(BatchelorOBrienCompleteParams):
 def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) -> np.ndarray:
     model = "direct_conduction.batchelor_obrien_modified"
     k_i, k_j = _conductivities(pair, model)
-    _check_kpf(k_i, k_j, params.fluid_conductivity, model)
+    k_f = pair.gas.thermal_conductivity
+    _check_kpf(k_i, k_j, k_f, model)
     dai = params.cylinder_radius == "dai2019"
     ratio = 0.0 if dai else float(params.cylinder_radius)
     if not dai and ratio <= 0.0:
         raise ValueError(f"{model}: cylinder_radius must be > 0 or 'dai2019', got {ratio}")
-    values = [params.fluid_conductivity, _BLENDS[params.blend], ratio, params.cutoff_gap_ratio]
+    values = [k_f, _BLENDS[params.blend], ratio, params.cutoff_gap_ratio]
     return pad_row([k_i, k_j, 0.0, 0.0, *values, 1.0 if dai else 0.0])
 
 
@@ -527,6 +527,7 @@ _register(
     "Batchelor & O'Brien contact (η regimes) and separated-particle conduction",
     _BOB + "; Dai, Hanaor & Gan (2019); Moscardini et al. (2018)",
     pack_bob_complete, interaction_range=bob_interaction_range,
+    uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(
     "batchelor_obrien_modified", BATCHELOR_OBRIEN_MODIFIED, bob_modified_rate,
@@ -535,6 +536,7 @@ _register(
     "Yun & Evans (2010) Comput. Geotech. 37, 991-998; Dai, Hanaor & Gan (2019) Int. J. Therm. "
     "Sci. 142, 266-279",
     pack_bob_modified, interaction_range=bob_interaction_range,
+    uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(
     "thermal_pipe", THERMAL_PIPE, thermal_pipe_rate, ThermalPipeParams,

@@ -45,6 +45,7 @@ from thermodem.models.thermal.contact_radius import (
     hertz_radius_from_force,
     require,
 )
+from thermodem.state.gas import GasProperties
 from thermodem.state.materials import PairContext, effective_youngs_modulus
 
 RESISTANCE_NETWORK = 9
@@ -235,46 +236,17 @@ def resistance_network_rate(
 
 
 # --------------------------------------------------------------------------- parameters
-class GasProperties(StrictModel):
-    """Stagnant gas of the resistance network; defaults: air at 300 K and 101325 Pa
-    (Incropera et al. 2006, table A.4; kinetic diameter 0.366 nm).
-
-    The mean free path is ``mean_free_path`` when given, else the kinetic theory value
-    Λ = k_B T / (√2 π d² P) from ``temperature``, ``pressure`` and ``molecular_diameter``.
-    """
-
-    thermal_conductivity: float = Field(default=0.0263, gt=0, description="k_g [W/(m K)]")
-    specific_heat: float = Field(default=1007.0, gt=0, description="c_g [J/(kg K)]")
-    dynamic_viscosity: float = Field(default=1.846e-5, gt=0, description="μ_g [Pa s]")
-    heat_capacity_ratio: float = Field(default=1.4, gt=1, description="γ_g = c_p/c_v [-]")
-    mean_free_path: float | None = Field(default=None, gt=0, description="Λ [m]")
-    pressure: float = Field(default=101325.0, gt=0, description="P [Pa] (for Λ)")
-    temperature: float = Field(default=300.0, gt=0, description="T [K] (for Λ)")
-    molecular_diameter: float = Field(default=3.66e-10, gt=0, description="d [m] (for Λ)")
-
-    def mean_free_path_value(self) -> float:
-        """Λ [m]: the given value, or k_B T / (√2 π d² P)."""
-        if self.mean_free_path is not None:
-            return self.mean_free_path
-        d2 = self.molecular_diameter**2
-        return BOLTZMANN * self.temperature / (math.sqrt(2.0) * math.pi * d2 * self.pressure)
-
-    def prandtl(self) -> float:
-        """Pr = μ_g c_g / k_g [-]."""
-        return self.dynamic_viscosity * self.specific_heat / self.thermal_conductivity
-
-
 class ResistanceNetworkParams(StrictModel):
     """Beaulieu (2020) PhD thesis, Polytechnique Montréal (https://publications.polymtl.ca/
     4757/): contact, microcontact, micro/macrogap gas and solid-layer resistances (spec .rst).
 
     ``packing_constant`` is B/r_h (the spec's B is a length; B = 0 for simple cubic packing,
-    B/r_h in [0, 2)). Gas properties in ``gas``. Materials need thermal_conductivity,
-    microhardness, surface_roughness, surface_slope and thermal_accommodation; a wall material
-    too. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M, B/r_h].
+    B/r_h in [0, 2)). The gas is the case's ``thermal.gas`` (``pair.gas``). Materials need
+    thermal_conductivity, microhardness, surface_roughness, surface_slope and
+    thermal_accommodation; a wall material too. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M,
+    B/r_h].
     """
 
-    gas: GasProperties = Field(default_factory=GasProperties, description="interstitial gas")
     packing_constant: float = Field(
         default=0.0, ge=0, lt=2, description="B / r_h [-] of the macrogap integral (0: cubic)"
     )
@@ -315,8 +287,8 @@ def pack_resistance_network(params: ResistanceNetworkParams, pair: PairContext) 
             2.0 * h_i * h_j / (h_i + h_j),
             math.hypot(s_i, s_j),
             math.hypot(t_i, t_j),
-            params.gas.thermal_conductivity,
-            gas_parameter(a_i, a_j, params.gas),
+            pair.gas.thermal_conductivity,
+            gas_parameter(a_i, a_j, pair.gas),
             params.packing_constant,
         ]
     )
@@ -342,4 +314,12 @@ register(
         "poisson_ratio",
     ),
     swap_pairs=((0, 1), (2, 3)),
+    # thermal.gas read by pack (k_g; M from Λ, Pr = μ c_p / k_g and γ)
+    uses_gas=(
+        "thermal_conductivity",
+        "specific_heat",
+        "dynamic_viscosity",
+        "heat_capacity_ratio",
+        "mean_free_path",
+    ),
 )
