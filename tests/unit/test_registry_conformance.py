@@ -204,7 +204,9 @@ spring = st.floats(-1e-3, 1e-3)
 @SETTINGS
 @given(
     name=st.sampled_from(TANGENTIAL),
-    mu=st.floats(0.0, 2.0),
+    # mu = 0 or a physical value: for mu ~ 1e-164 the capped force components square into the
+    # subnormal range and |F_t| loses its relative precision (seen with mu = 1.3e-164)
+    mu=st.one_of(st.just(0.0), st.floats(1e-6, 2.0)),
     youngs=st.floats(1e5, 1e11),
     ref_stiffness=st.floats(1.0, 1e9),
     normal_damping=st.floats(0.0, 1e4),
