@@ -41,6 +41,28 @@ def test_erfcinv_denormals_and_round_trip():
         assert erfc(rn.erfcinv(x)) == pytest.approx(x, rel=1e-13)
 
 
+def test_erfcinv_at_the_polynomial_interval_edges():
+    """Both sides of each tail interval edge x = exp(-ln 2 · 2^k), and of x = 0.5, 1.5."""
+    edges = [math.exp(-math.log(2.0) * 2.0**k) for k in range(11)]
+    x = np.array([e + i * math.ulp(e) for e in edges for i in range(-3, 4)])
+    x = np.concatenate([x, 2.0 - x[x <= 0.5], [0.5, 0.5 - 2**-54, 1.5, 1.5 + 2**-52]])
+    ours = np.array([rn.erfcinv(v) for v in x])
+    np.testing.assert_allclose(ours, sp_erfcinv(x), rtol=1e-14, atol=0.0)
+
+
+def test_erfcinv_from_the_logarithm_and_the_iterative_reference():
+    # exp(-L) a normal double (denormals have too few bits to check against)
+    big_l = np.concatenate([np.geomspace(math.log(2.0), 708.39, 2000), [math.log(2.0)]])
+    ours = np.array([rn.erfcinv_neg_log(v) for v in big_l])
+    np.testing.assert_allclose(ours, sp_erfcinv(np.exp(-big_l)), rtol=1e-14, atol=0.0)
+    x = np.concatenate([np.logspace(-300, -1, 500), np.linspace(0.0, 2.0, 401)[1:-1]])
+    ours = np.array([rn.erfcinv(v) for v in x])
+    iterative = np.array([rn.erfcinv_iterative(v) for v in x])
+    np.testing.assert_allclose(ours, iterative, rtol=1e-14, atol=0.0)
+    for v in (0.0, 2.0, 1.0, -1.0, 3.0, np.nan):
+        np.testing.assert_equal(rn.erfcinv_iterative(v), rn.erfcinv(v))
+
+
 def test_erfcinv_outside_the_domain():
     assert rn.erfcinv(0.0) == np.inf
     assert rn.erfcinv(2.0) == -np.inf
@@ -134,6 +156,46 @@ def hand_conductance(r_i, r_j, f, *, h_i=5e9, h_j=2e9, c=1.0, b=0.0):
     big_b = b * r_h
     r_big_g = 2 / (PI * k_g * (big_s * math.log((big_s - big_b) / (big_s - big_a)) + big_b - big_a))
     return 1 / (r_l + 1 / (1 / r_s + 1 / r_g)) + 1 / (r_cs + r_big_g)
+
+
+def reference_conductance(k_i, k_j, r_i, r_j, f, e, c, h, sigma, tau, k_g, m, b):
+    """resistance_network_conductance written out term by term (scipy's erfc⁻¹)."""
+    r_eff = r_i if math.isinf(r_j) else r_i * r_j / (r_i + r_j)
+    r_c = c * (0.75 * f * r_eff / e) ** (1 / 3)
+    r_h = 2 * r_eff
+    root = math.sqrt(r_h**2 - r_c**2)
+    big_s = 2 * (r_h - r_c**2 / (2 * r_h)) + m
+    s_minus_a = m + r_c**4 / (r_h * (r_h + root) ** 2)  # S - A without cancellation
+    bracket = big_s * math.log((big_s - b * r_h) / s_minus_a) + b * r_h - 2 * root
+    r_big_g = 2 / (PI * k_g * bracket)
+    r_cs = (PI * r_i / 4) / (k_i * PI * (r_i**2 - r_c**2))
+    if not math.isinf(r_j):
+        r_cs += (PI * r_j / 4) / (k_j * PI * (r_j**2 - r_c**2))
+    k_h = 2 * k_i * k_j / (k_i + k_j)
+    p0 = min(1.5 * f / (PI * r_c**2), h)
+    a1 = float(sp_erfcinv(min(2 * p0 / h, 1.0)))
+    a2 = float(sp_erfcinv(0.03 * p0 / h)) - a1
+    r_l = 1 / (2 * k_h * r_c)
+    r_s = (h / p0) ** 0.96 * 1.184 / (PI * r_c**2 * k_h) * (sigma / tau)
+    r_g = 2 * SQ2 * sigma * a2 / (PI * k_g * r_c**2 * math.log1p(a2 / (a1 + m / (2 * SQ2 * sigma))))
+    return 1 / (r_l + 1 / (1 / r_s + 1 / r_g)) + 1 / (r_cs + r_big_g)
+
+
+@pytest.mark.parametrize(
+    ("r_i", "r_j"), [(1e-4, 1e-4), (1e-3, 3e-3), (1e-2, np.inf), (1e-3, np.inf)]
+)
+@pytest.mark.parametrize("h", [1e5, 1e9])
+@pytest.mark.parametrize(("c", "b"), [(1.0, 0.0), (0.3, 0.5)])
+def test_conductance_equals_the_term_by_term_formulas(r_i, r_j, h, c, b):
+    """From 1e-9 N to r_c = R*/2, both caps of P0 (soft H' = 1e5) and walls, to 1e-13."""
+    args = (2.0, 6.0, r_i, r_j)
+    rest = (1.4e-6, 0.14, 0.0263, 3.4e-7, b)
+    e = 5.5e6
+    r_eff = r_i if math.isinf(r_j) else r_i * r_j / (r_i + r_j)
+    f_max = (0.5 * r_eff / c) ** 3 * e / (0.75 * r_eff)
+    for f in np.geomspace(1e-9, f_max, 60):
+        ours = rn.resistance_network_conductance(*args, f, e, c, h, *rest)
+        assert ours == pytest.approx(reference_conductance(*args, f, e, c, h, *rest), rel=1e-13)
 
 
 def network_row(mi=MAT_I, mj=MAT_J, is_wall=False, **params):
