@@ -108,6 +108,7 @@ DERIVED: tuple[str, ...] = (
     "callbacks",
     "chunk_check",
     "_no_heat",
+    "mechanisms",
     "_no_reduce_heat",
 )
 #: Attributes of the thermal engine that are never saved (objects, back references).

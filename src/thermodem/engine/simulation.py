@@ -43,7 +43,7 @@ from thermodem.kernels.integrate import (
 )
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
 from thermodem.state.pairs import PairBuffers
-from thermodem.state.particles import Particles
+from thermodem.state.particles import HEAT_MECHANISMS, Particles
 
 LEDGER_DISSIPATION = (
     "normal_damping",
@@ -110,7 +110,8 @@ class Simulation:
 
             self.thermal = ThermalEngine(self, case.thermal)
         # particles
-        self.particles = Particles.empty()
+        self.mechanisms = len(HEAT_MECHANISMS) if self.thermal is not None else 0
+        self.particles = Particles.empty(self.mechanisms)
         self.next_global_id = 0
         self.pourers: list[Pourer] = []
         for entry in case.insertion:
@@ -175,6 +176,7 @@ class Simulation:
             gids,
             new.velocity,
             temperature,
+            mechanisms=self.mechanisms,
         )
         if hasattr(self, "ledger_cumulative"):
             self.ledger_cumulative["inserted_energy"] += float(

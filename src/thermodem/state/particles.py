@@ -47,9 +47,14 @@ class Particles:
         return int(self.radius.shape[0])
 
     @classmethod
-    def empty(cls) -> Particles:
+    def empty(cls, mechanisms: int = len(HEAT_MECHANISMS)) -> Particles:
         return cls.create(
-            np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0, np.int32), np.zeros(0, np.int64)
+            np.zeros((0, 3)),
+            np.zeros(0),
+            np.zeros(0),
+            np.zeros(0, np.int32),
+            np.zeros(0, np.int64),
+            mechanisms=mechanisms,
         )
 
     @classmethod
@@ -62,8 +67,13 @@ class Particles:
         global_id: np.ndarray,
         velocity: np.ndarray | None = None,
         temperature: np.ndarray | None = None,
+        mechanisms: int = len(HEAT_MECHANISMS),
     ) -> Particles:
-        """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R²."""
+        """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R².
+
+        ``mechanisms`` is the number of columns of ``heat_rate_by_mechanism``: all of
+        :data:`HEAT_MECHANISMS` with a thermal engine, 0 for mechanics only (56 B/particle less).
+        """
         n = radius.shape[0]
         radius = np.ascontiguousarray(radius, dtype=np.float64)
         mass = np.asarray(density, dtype=np.float64) * (4.0 / 3.0) * np.pi * radius**3
@@ -82,7 +92,7 @@ class Particles:
             if temperature is None
             else np.ascontiguousarray(temperature, dtype=np.float64),
             heat_rate=np.zeros(n),
-            heat_rate_by_mechanism=np.zeros((n, len(HEAT_MECHANISMS))),
+            heat_rate_by_mechanism=np.zeros((n, mechanisms)),
             type_id=np.ascontiguousarray(type_id, dtype=np.int32),
             global_id=np.ascontiguousarray(global_id, dtype=np.int64),
         )
