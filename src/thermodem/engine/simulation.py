@@ -267,6 +267,7 @@ class Simulation:
             pb.j, spare, count,
         )  # fmt: skip
         pb.swap_history()  # (after a growth too: old_history is then the previous array)
+        pb.state[:count] = C.STATE_UNSET  # outputs live in the old history memory now
         del old_i, old_j, old_history
         # wall pairs
         if self.wall_row_start.shape[0] != n + 1:
@@ -298,6 +299,7 @@ class Simulation:
             wb.spare_history(), wcount,
         )  # fmt: skip
         wb.swap_history()
+        wb.state[:wcount] = C.STATE_UNSET
         self.reference = p.position.copy()
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         self.rebuild_count += 1

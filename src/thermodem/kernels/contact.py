@@ -69,6 +69,7 @@ D_ROLLING_FRICTION = 3
 STATE_FAR = 0
 STATE_NEAR = 1
 STATE_TOUCHING = 2
+STATE_UNSET = 3  # listed by a rebuild, not yet evaluated (outputs not written)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -242,12 +243,16 @@ def contact_response(
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _open_contact(
-    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, ledger_row
+    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, out_state, ledger_row
 ):
     """Outputs of a pair that does not touch; a contact that just opened is cleared.
 
     The energy left in its springs when a contact opens is counted as friction (documented).
+    A pair that did not touch at the previous pass already has zero outputs and history: no
+    writes (a rebuild marks every pair STATE_UNSET, so the outputs of a new list are written).
     """
+    if out_state[k] == STATE_NEAR or out_state[k] == STATE_FAR:
+        return
     if history[k, H_DURATION] != 0.0:
         ledger_row[L_SLIDING_FRICTION] += history[k, H_SPRING_ENERGY]
         if history.shape[1] >= HISTORY_WIDTH_ROLLING:
@@ -377,8 +382,9 @@ def particle_pair_pass(
             overlap = ri + rj - dist
             if overlap <= 0.0 or dist == 0.0:
                 _open_contact(
-                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
-                )
+                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
+                    out_state, row,
+                )  # fmt: skip
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 if heat_on:
                     h = 0.0
@@ -410,9 +416,11 @@ def particle_pair_pass(
             vrz = velocity[i, 2] - velocity[j, 2] + sx * ny - sy * nx
             eff_radius = ri * rj / (ri + rj)
             eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
-            ii = inertia[i] + mass[i] * ri * ri
-            ij = inertia[j] + mass[j] * rj * rj
-            rolling_inertia = ii * ij / (ii + ij)
+            rolling_inertia = 0.0  # used by the rolling models only
+            if rolling_id != 0:
+                ii = inertia[i] + mass[i] * ri * ri
+                ij = inertia[j] + mass[j] * rj * rj
+                rolling_inertia = ii * ij / (ii + ij)
             ti = type_id[i]
             tj = type_id[j]
             contact_response(
@@ -445,9 +453,9 @@ def particle_pair_pass(
                 out_normal_force,
                 row,
             )
-            ratio = overlap / min(ri, rj)
-            if ratio > row[L_MAX_OVERLAP_RATIO]:
-                row[L_MAX_OVERLAP_RATIO] = ratio
+            r_min = min(ri, rj)
+            if overlap > row[L_MAX_OVERLAP_RATIO] * r_min:  # (no division per contact)
+                row[L_MAX_OVERLAP_RATIO] = overlap / r_min
             if heat_on:
                 h = _pp_conductance(
                     k, i, j, ri, rj, dist, overlap, mass, type_id, history, out_normal_force,
@@ -523,8 +531,9 @@ def wall_pair_pass(
             overlap = ri - d
             if overlap <= 0.0:
                 _open_contact(
-                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, row
-                )
+                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
+                    out_state, row,
+                )  # fmt: skip
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 if heat_on:
                     h = 0.0

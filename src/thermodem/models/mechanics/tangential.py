@@ -47,10 +47,11 @@ def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy
     fy = -k_t * sy - gamma_t * vty
     fz = -k_t * sz - gamma_t * vtz
     trial_energy = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
-    f_mag = math.sqrt(fx * fx + fy * fy + fz * fz)
+    f_mag2 = fx * fx + fy * fy + fz * fz
     f_cap = mu * max(normal_force, 0.0)
     damping_power = gamma_t * (vtx * vtx + vty * vty + vtz * vtz)
-    if f_mag > f_cap:
+    if f_mag2 > f_cap * f_cap:  # squares: the root is only needed when the cap applies
+        f_mag = math.sqrt(f_mag2)
         scale = f_cap / f_mag if f_mag > 0.0 else 0.0
         fx *= scale
         fy *= scale
