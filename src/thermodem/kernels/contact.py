@@ -272,7 +272,7 @@ def _open_contact(
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _pp_conductance(
-    k, i, j, ri, rj, dist, overlap, mass, type_id, history, normal_force, radius_id,
+    k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history, normal_force, radius_id,
     radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, srow,
 ):  # fmt: skip
     ti = type_id[i]
@@ -285,7 +285,7 @@ def _pp_conductance(
             ci = rhoc_particle[i]
             cj = rhoc_particle[j]
     return pair_conductance(
-        ri, rj, dist, overlap, mass[i] * mass[j] / (mass[i] + mass[j]), normal_force[k],
+        ri, rj, dist, overlap, eff_mass, normal_force[k],
         history[k, H_DURATION], history[k, H_IMPACT_VELOCITY], radius_id, radius_table[ti, tj],
         conduction_id, conduction_table[ti, tj], override, ki, kj, ci, cj, srow,
     )  # fmt: skip
@@ -390,7 +390,8 @@ def particle_pair_pass(
                     h = 0.0
                     if out_state[k] == STATE_NEAR:
                         h = _pp_conductance(
-                            k, i, j, ri, rj, dist, overlap, mass, type_id, history,
+                            k, i, j, ri, rj, dist, overlap,
+                            mass[i] * mass[j] / (mass[i] + mass[j]), type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
                             conduction_table, override, k_particle, rhoc_particle, srow,
                         )  # fmt: skip
@@ -458,7 +459,7 @@ def particle_pair_pass(
                 row[L_MAX_OVERLAP_RATIO] = overlap / r_min
             if heat_on:
                 h = _pp_conductance(
-                    k, i, j, ri, rj, dist, overlap, mass, type_id, history, out_normal_force,
+                    k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history, out_normal_force,
                     radius_id, radius_table, conduction_id, conduction_table, override,
                     k_particle, rhoc_particle, srow,
                 )  # fmt: skip

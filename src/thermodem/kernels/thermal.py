@@ -54,7 +54,8 @@ def conduction_pair_pass(
             rj = radius[j]
             overlap = ri + rj - dist
             h = _pp_conductance(
-                k, i, j, ri, rj, dist, overlap, mass, type_id, history, normal_force, radius_id,
+                k, i, j, ri, rj, dist, overlap, mass[i] * mass[j] / (mass[i] + mass[j]),
+                type_id, history, normal_force, radius_id,
                 radius_table, conduction_id, conduction_table, override, k_particle,
                 rhoc_particle, row,
             )  # fmt: skip

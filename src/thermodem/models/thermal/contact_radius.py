@@ -78,13 +78,15 @@ def geometric_contact_radius(radius_i, radius_j, overlap):
 
     Written with the cap height of sphere i, h_i = δ (2R_j - δ) / (2 d) with d = R_i + R_j - δ,
     and a² = h_i (2R_i - h_i). This equals the spec's form in d_ij but avoids its cancellation
-    for small δ, and dividing by R_j gives the wall limit h_i = δ, a² = δ (2R_i - δ) directly.
-    Equal spheres: a² = Rδ - δ²/4.
+    for small δ (one division, no difference of nearly equal squares). A wall (R_j = inf) has
+    the limit h_i = δ, a² = δ (2R_i - δ). Equal spheres: a² = Rδ - δ²/4.
     """
     if overlap <= 0.0:
         return 0.0
-    s = overlap / radius_j
-    h = overlap * (2.0 - s) / (2.0 * (radius_i / radius_j + 1.0 - s))
+    if radius_j == math.inf:
+        h = overlap
+    else:
+        h = overlap * (2.0 * radius_j - overlap) / (2.0 * (radius_i + radius_j - overlap))
     a2 = h * (2.0 * radius_i - h)
     return math.sqrt(a2) if a2 > 0.0 else 0.0
 
