@@ -5,6 +5,11 @@ gravity, dt = 5e-6 s) are poured into an open box and settled; the settled bed i
 ``bench/.cache``. Then, in a fresh process, S steps are timed on the settled bed.
 
     python bench/bench_packed_bed.py --n 50000 --steps 500 --threads 1 [--json]
+    python bench/bench_packed_bed.py --heat batchelor_obrien_simple [--substeps 1|n|auto]
+
+With ``--heat MODEL`` the bed conducts heat (contact radius: geometric) with that direct
+conduction model, solved every ``--substeps`` mechanical steps (default 1: every step, the
+spec's calculation cycle).
 
 Settling uses the same materials with a softer damping (e = 0.1) and dt = 1e-5 s to get to rest
 faster; the timed run uses exactly the parameters above.
@@ -63,6 +68,7 @@ def case_dict(
     restitution: float,
     end_time: float,
     heat: str | None = None,
+    substeps: str = "1",
 ) -> dict:
     side, height, fill_height, _ = bed_geometry(n)
     material = {
@@ -94,6 +100,7 @@ def case_dict(
             "direct_conduction": heat,
             "gas": HEAT_GAS.get(heat, {}),
             "contact_radius": "geometric",
+            "substeps": substeps if substeps == "auto" else int(substeps),
             "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * z"},
         }
     if positions_file is None:
@@ -163,16 +170,20 @@ def rss_bytes() -> int:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
-def timed(n: int, steps: int, threads: int, heat: str | None) -> dict:
+def timed(n: int, steps: int, threads: int, heat: str | None, substeps: str = "1") -> dict:
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
     bed = settle(n)
     # baseline: interpreter + libraries + compiled kernels on a tiny case
-    tiny = Simulation(case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0, heat)), threads=threads)
+    tiny = Simulation(
+        case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0, heat, substeps)), threads=threads
+    )
     tiny.run(steps=5)
     baseline = rss_bytes()
-    sim = Simulation(case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0, heat)), threads=threads)
+    sim = Simulation(
+        case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0, heat, substeps)), threads=threads
+    )
     sim.run(steps=20)  # warm-up
     r0 = sim.rebuild_count
     t0 = time.perf_counter()
@@ -184,6 +195,7 @@ def timed(n: int, steps: int, threads: int, heat: str | None) -> dict:
         "steps": steps,
         "threads": threads,
         "heat": heat,
+        "substeps": substeps if heat else None,
         "particle_steps_per_s": n * steps / elapsed,
         "seconds": elapsed,
         "rebuilds": sim.rebuild_count - r0,
@@ -201,11 +213,12 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=500)
     ap.add_argument("--threads", type=int, nargs="*", default=[1, 2])
     ap.add_argument("--heat", default=None, help="direct conduction model (thermal issue)")
+    ap.add_argument("--substeps", default="1", help="thermal substeps: an integer or 'auto'")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
-        print(json.dumps(timed(args.n, args.steps, args.threads[0], args.heat)))
+        print(json.dumps(timed(args.n, args.steps, args.threads[0], args.heat, args.substeps)))
         return
     settle(args.n)  # in this process, so the timed child starts from the cached bed
     results = []
@@ -223,13 +236,15 @@ def main() -> None:
             str(th),
         ]
         if args.heat:
-            cmd += ["--heat", args.heat]
+            cmd += ["--heat", args.heat, "--substeps", args.substeps]
         out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
         res = json.loads(out.strip().splitlines()[-1])
         results.append(res)
         if not args.json:
             print(
-                f"N = {res['n']}, threads = {th}: {res['particle_steps_per_s'] / 1e6:.2f} M "
+                f"N = {res['n']}, threads = {th}"
+                + (f", heat {res['heat']} (substeps {res['substeps']})" if res["heat"] else "")
+                + f": {res['particle_steps_per_s'] / 1e6:.2f} M "
                 f"particle-steps/s ({res['steps']} steps, {res['rebuilds']} rebuilds, "
                 f"{res['contacts_per_particle']:.2f} contacts/particle, "
                 f"{res['pairs_per_particle']:.2f} listed pairs/particle); peak RSS "

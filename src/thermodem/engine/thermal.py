@@ -164,6 +164,7 @@ class ThermalEngine:
         self.has_c_table = has_c
         self.override = 2 if (has_c or has_k) and has_c else (1 if has_k else 0)
         self.scratch = np.zeros((1, 16))
+        self.euler_partials = np.zeros((1, 6))
 
     def _interp(
         self,
@@ -399,9 +400,13 @@ class ThermalEngine:
                                                     fixed, dt)  # fmt: skip
         else:
             # one fused pass: heat rate, Euler limit, update and the ledger sums
+            rows = p.count // K.EULER_CHUNK + 1
+            if self.euler_partials.shape[0] < rows:
+                self.euler_partials = np.zeros((rows, 6))
             self.limit, where, wall_q, source_q, absorbed, bad = K.euler_step(
                 p.temperature, p.heat_rate, p.heat_rate_by_mechanism, source, p.mass,
                 p.type_id, self.specific_heat_by_type, self.conductance_sum, fixed, dt,
+                self.euler_partials,
             )  # fmt: skip
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
         if dt > self.limit and not self.settings.stability.allow_unstable:

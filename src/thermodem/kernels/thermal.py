@@ -244,39 +244,69 @@ def finish_heat(source, heat_rate, by_mechanism):
         heat_rate[i] = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
 
 
-@njit(cache=True, error_model="numpy")
+EULER_CHUNK = 4096
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
 def euler_step(temperature, heat_rate, by_mechanism, source, mass, type_id, c_by_type,
-               conductance_sum, fixed, dt):  # fmt: skip
-    """One fused per-particle thermal update with constant specific heats (fixed order).
+               conductance_sum, fixed, dt, part):  # fmt: skip
+    """One fused per-particle thermal update with constant specific heats.
 
     Fills the source column and the total heat rate, finds the explicit Euler limit
     min m c / ΣH over free particles, applies T += dt Q / (m c) to free particles, and sums the
     wall heat, source heat and heat absorbed by fixed particles [W].
     Returns (limit, limit index, wall heat, source heat, absorbed, first bad index or -1).
+    Parallel over fixed chunks of EULER_CHUNK particles whose partial results are combined in
+    chunk order, so the sums do not depend on the number of threads (``part``: at least
+    n // EULER_CHUNK + 1 rows of 6, scratch).
     """
+    n = temperature.shape[0]
+    nchunks = (n + EULER_CHUNK - 1) // EULER_CHUNK
+    for c in prange(nchunks):
+        limit = math.inf
+        where = -1
+        wall_q = 0.0
+        source_q = 0.0
+        absorbed = 0.0
+        bad = -1
+        for i in range(c * EULER_CHUNK, min(n, (c + 1) * EULER_CHUNK)):
+            by_mechanism[i, M_SOURCE] = source[i]
+            q = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
+            heat_rate[i] = q
+            wall_q += by_mechanism[i, M_WALL]
+            source_q += source[i]
+            if fixed[i]:
+                absorbed += q
+                continue
+            mc = mass[i] * c_by_type[type_id[i]]
+            if conductance_sum[i] > 0.0:
+                lim = mc / conductance_sum[i]
+                if lim < limit:
+                    limit = lim
+                    where = i
+            t = temperature[i] + dt * q / mc
+            temperature[i] = t
+            if bad < 0 and not (t > 0.0 and math.isfinite(t)):
+                bad = i
+        part[c, 0] = limit
+        part[c, 1] = where
+        part[c, 2] = wall_q
+        part[c, 3] = source_q
+        part[c, 4] = absorbed
+        part[c, 5] = bad
     limit = math.inf
     where = -1
     wall_q = 0.0
     source_q = 0.0
     absorbed = 0.0
     bad = -1
-    for i in range(temperature.shape[0]):
-        by_mechanism[i, M_SOURCE] = source[i]
-        q = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
-        heat_rate[i] = q
-        wall_q += by_mechanism[i, M_WALL]
-        source_q += source[i]
-        if fixed[i]:
-            absorbed += q
-            continue
-        mc = mass[i] * c_by_type[type_id[i]]
-        if conductance_sum[i] > 0.0:
-            lim = mc / conductance_sum[i]
-            if lim < limit:
-                limit = lim
-                where = i
-        t = temperature[i] + dt * q / mc
-        temperature[i] = t
-        if bad < 0 and not (t > 0.0 and math.isfinite(t)):
-            bad = i
+    for c in range(nchunks):
+        if part[c, 0] < limit:
+            limit = part[c, 0]
+            where = int(part[c, 1])
+        wall_q += part[c, 2]
+        source_q += part[c, 3]
+        absorbed += part[c, 4]
+        if bad < 0 and part[c, 5] >= 0:
+            bad = int(part[c, 5])
     return limit, where, wall_q, source_q, absorbed, bad
