@@ -26,13 +26,14 @@ import numpy as np
 
 from thermodem.config.schema import Case
 from thermodem.engine import diagnostics as D
+from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
 from thermodem.engine.validation import check_completeness
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
 from thermodem.geometry.insertion import InsertedParticles, Pourer, insert
 from thermodem.geometry.walls import wall_rows
 from thermodem.kernels import contact as C
-from thermodem.kernels import neighbors as NB
+from thermodem.kernels import pair_pass as PP
 from thermodem.kernels.integrate import (
     CHECK_CHUNK,
     kick_drift,
@@ -191,129 +192,9 @@ class Simulation:
         self._needs_rebuild = True
 
     # ------------------------------------------------------------------------- neighbours
-    def _cell_size(self) -> float:
-        r_max = float(self.particles.radius.max()) if self.particles.count else 0.0
-        if self.skin is None and r_max > 0:
-            self.skin = 0.2 * r_max
-        return 2.0 * r_max + self.extra + (self.skin or 0.0)
-
     def rebuild(self) -> None:
         """Sort particles by cell, list pairs and wall pairs, carry history by key."""
-        p = self.particles
-        n = p.count
-        cell = self._cell_size()
-        if n == 0:
-            self.pairs.count = 0
-            self.walls.count = 0
-            self.row_start = np.zeros(1, np.int64)
-            self.wall_row_start = np.zeros(1, np.int64)
-            self.reference = p.position.copy()
-            return
-        length = self.upper - self.lower
-        for a in range(3):
-            if self.periodic[a] and length[a] < 2.0 * cell:
-                raise SimulationError(
-                    f"periodic axis {'xyz'[a]}: domain length {length[a]:.6g} m is shorter than "
-                    f"twice the interaction cut-off {cell:.6g} m (minimum image needs >= "
-                    f"{2 * cell:.6g} m)",
-                    self.step_count,
-                    self.time,
-                )
-        pb, wb = self.pairs, self.walls
-        dims, edge = NB.cell_grid(self.lower, self.upper, cell, self.periodic)
-        ncell = int(dims[0] * dims[1] * dims[2])
-        order = np.empty(n, np.int64)
-        cell_start = np.zeros(ncell + 1, np.int64)
-        NB.sort_by_cell(p.position, self.lower, edge, dims, order, cell_start)
-        p.permute(order)
-        new_index = np.empty(n, np.int32)  # old particle index -> index after the sort
-        new_index[order] = np.arange(n, dtype=np.int32)
-        del order
-        # particle pairs: list into fresh index arrays, then carry the history
-        old_i, old_j, old_history, old_count = pb.i, pb.j, pb.history, pb.count
-        new_i = np.empty(pb.capacity, np.int32)
-        new_j = np.empty(pb.capacity, np.int32)
-        while True:
-            count = NB.build_pairs(
-                p.position,
-                p.radius,
-                p.global_id,
-                self.lower,
-                self.upper,
-                self.periodic,
-                dims,
-                edge,
-                cell_start,
-                self.extra,
-                self.skin,
-                new_i,
-                new_j,
-            )
-            if count <= new_i.shape[0]:
-                break
-            new_i = np.empty(PairBuffers.grown(pb.capacity, count), np.int32)
-            new_j = np.empty_like(new_i)
-        if new_i.shape[0] > pb.capacity:
-            pb.allocate(new_i.shape[0])  # old_* still hold the previous list
-        pb.i, pb.j, pb.count = new_i, new_j, count
-        if self.row_start.shape[0] != n + 1:
-            self.row_start = np.zeros(n + 1, np.int64)
-        if self.entries.shape[0] < 2 * pb.capacity:
-            self.entries = np.zeros(2 * pb.capacity, np.int32)
-        NB.particle_pair_csr(pb.i, pb.j, count, p.global_id, n, self.row_start, self.entries)
-        spare = pb.spare_history()
-        NB.carry_pair_history(
-            old_i, old_j, old_count, old_history, new_index, self.row_start, self.entries,
-            pb.j, spare, count,
-        )  # fmt: skip
-        pb.swap_history()  # (after a growth too: old_history is then the previous array)
-        pb.state[:count] = C.STATE_UNSET  # outputs live in the old history memory now
-        del old_i, old_j, old_history
-        # wall pairs
-        if self.wall_row_start.shape[0] != n + 1:
-            self.wall_row_start = np.zeros(n + 1, np.int64)
-        old_i, old_w, old_history, old_count = wb.i, wb.j, wb.history, wb.count
-        new_i = np.empty(wb.capacity, np.int32)
-        new_w = np.empty(wb.capacity, np.int32)
-        while True:
-            wcount = NB.build_wall_pairs(
-                p.position,
-                p.radius,
-                self.wall_kind,
-                self.wall_rows,
-                self.extra,
-                self.skin,
-                new_i,
-                new_w,
-                self.wall_row_start,
-            )
-            if wcount <= new_i.shape[0]:
-                break
-            new_i = np.empty(PairBuffers.grown(wb.capacity, wcount), np.int32)
-            new_w = np.empty_like(new_i)
-        if new_i.shape[0] > wb.capacity:
-            wb.allocate(new_i.shape[0])
-        wb.i, wb.j, wb.count = new_i, new_w, wcount
-        NB.carry_wall_history(
-            old_i, old_w, old_count, old_history, new_index, self.wall_row_start, wb.j,
-            wb.spare_history(), wcount,
-        )  # fmt: skip
-        wb.swap_history()
-        wb.state[:wcount] = C.STATE_UNSET
-        self.reference = p.position.copy()
-        self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
-        self.rebuild_count += 1
-        self._needs_rebuild = False
-
-    def _rebuild_due(self) -> bool:
-        if self._needs_rebuild or self.rebuild_every_step:
-            return True
-        moved = self.moved
-        wall_moved = 0.0
-        if self.wall_rows.shape[0]:
-            shift = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3] - self.wall_reference
-            wall_moved = float(np.sqrt((shift**2).sum(axis=1)).max())
-        return 2.0 * moved > self.skin or moved + wall_moved > self.skin
+        rebuild_lists(self)
 
     # ------------------------------------------------------------------------------ forces
     def _compute_forces(self, kick: bool, contact_dt: float | None = None) -> None:
@@ -323,7 +204,7 @@ class Simulation:
         the force evaluation at t = 0, so that a contact present at the start has not aged).
         """
         dt = self.dt if contact_dt is None else contact_dt
-        if self._rebuild_due():
+        if rebuild_due(self):
             self.rebuild()
         p = self.particles
         pb, wb = self.pairs, self.walls
@@ -338,7 +219,7 @@ class Simulation:
             pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
         else:
             pair_heat, wall_heat = self._no_heat
-        C.particle_pair_pass(
+        PP.particle_pair_pass(
             p.position,
             p.velocity,
             p.angular_velocity,
@@ -370,7 +251,7 @@ class Simulation:
             pb.chunk_ledger,
             *pair_heat,
         )
-        C.wall_pair_pass(
+        PP.wall_pair_pass(
             p.position,
             p.velocity,
             p.angular_velocity,

@@ -14,8 +14,9 @@ import math
 from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
-from thermodem.kernels.contact import CHUNK, STATE_FAR, _pp_conductance, _pw_conductance
+from thermodem.kernels.contact import CHUNK, STATE_FAR
 from thermodem.kernels.neighbors import minimum_image, wall_distance
+from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance
 
 # per-particle mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
 M_DIRECT = 0
