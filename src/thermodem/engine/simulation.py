@@ -217,9 +217,11 @@ class Simulation:
             # conduction evaluated in the contact pass, for the thermal step that follows
             th.prepare(self.time)
             pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+            pair_pass, wall_pass = PP.passes_for(True, th.radius_id, th.conduction_id, th.override)
         else:
             pair_heat, wall_heat = self._no_heat
-        PP.particle_pair_pass(
+            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0)
+        pair_pass(
             p.position,
             p.velocity,
             p.angular_velocity,
@@ -251,7 +253,7 @@ class Simulation:
             pb.chunk_ledger,
             *pair_heat,
         )
-        PP.wall_pair_pass(
+        wall_pass(
             p.position,
             p.velocity,
             p.angular_velocity,
