@@ -91,27 +91,27 @@ _PASSES: dict[tuple[bool, int, int, int], tuple] = {}
 
 
 def passes_for(heat_on: bool, radius_id: int, conduction_id: int, override: int) -> tuple:
-    """(particle_pair_pass, wall_pair_pass) compiled for one model combination.
+    """(particle pair pass, wall pair pass) for one model combination.
 
     The heat switch, the contact radius and direct conduction model ids and the k(T)/ρc(T)
-    override are compile-time constants of the returned kernels, so the compiler drops the
-    code of every other model: one generic loop with the model switches inside costs the
-    simple conduction models ~20 ns per particle more (docs/architecture.md, "Model
-    dispatch"). A mechanics-only run compiles one pair of kernels with no heat code; a thermal
-    run one more pair for its models (their arguments keep the same order and types: the
-    model arguments passed in are ignored). Compiled kernels are cached on disk per
-    combination (Numba keys closures on their constants) and in this process here.
+    override are compile-time constants of the particle pair pass, so the compiler drops the
+    code of every other model: the generic loop with the model switches inside costs the
+    simple conduction models ~20 ns per particle more (docs/architecture.md, "Cost of the
+    generic model switch"). Its arguments keep their order and types; the model arguments
+    passed in are ignored. Each combination in use compiles once (~7 s on a 2-core machine)
+    and is then cached on disk (Numba keys closures on their constants) and in this process.
+    The wall pass, a few percent of the time, is one generic kernel for all combinations.
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
         key = (False, 0, 0, 0)
     if key not in _PASSES:
-        _PASSES[key] = _compile_passes(*key)
+        _PASSES[key] = (_compile_pair_pass(*key), wall_pair_pass)
     return _PASSES[key]
 
 
-def _compile_passes(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int) -> tuple:  # noqa: N803
-    """Define the two pass kernels with the model choice captured as constants."""
+def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
+    """Define the particle pair pass with the model choice captured as constants."""
 
     @njit(cache=True, parallel=True, error_model="numpy")
     def particle_pair_pass(
@@ -271,160 +271,81 @@ def _compile_passes(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE:
                     out_conductance[k] = h
                     out_heat[k] = h * (temperature[j] - temperature[i])
 
-    @njit(cache=True, parallel=True, error_model="numpy")
-    def wall_pair_pass(
-        position,
-        velocity,
-        angular_velocity,
-        radius,
-        mass,
-        inertia,
-        type_id,
-        wall_pair_i,
-        wall_pair_w,
-        nwpairs,
-        history,
-        wall_kind,
-        wall_rows,
-        wall_material,
-        extra,
-        dt,
-        normal_id,
-        normal_table,
-        tangential_id,
-        tangential_table,
-        rolling_id,
-        rolling_table,
-        out_force,
-        out_lever,
-        out_roll,
-        out_diss,
-        out_normal_force,
-        out_state,
-        chunk_ledger,
-        heat_on,
-        temperature,
-        radius_id,
-        radius_table,
-        conduction_id,
-        conduction_table,
-        override,
-        k_particle,
-        rhoc_particle,
-        k_wall,
-        rhoc_wall,
-        scratch,
-        out_conductance,
-        out_heat,
-    ):
-        """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass).
+    return particle_pair_pass
 
-        With ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero).
-        """
-        # the model choice as compile-time constants (see passes_for)
-        heat_on = HEAT_ON
-        radius_id = RADIUS_ID
-        conduction_id = CONDUCTION_ID
-        override = OVERRIDE
-        nchunks = (nwpairs + CHUNK - 1) // CHUNK
-        for c in prange(nchunks):
-            srow = scratch[c]
-            row = chunk_ledger[c]
-            for q in range(row.shape[0]):
-                row[q] = 0.0
-            for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
-                i = wall_pair_i[k]
-                w = wall_pair_w[k]
-                wrow = wall_rows[w]
-                d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
-                ri = radius[i]
-                overlap = ri - d
-                if overlap <= 0.0:
-                    _open_contact(
-                        k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
-                        out_state, row,
-                    )  # fmt: skip
-                    out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
-                    if heat_on:
-                        h = 0.0
-                        if out_state[k] == STATE_NEAR and wrow[COL_THERMAL_KIND] != 0.0:
-                            h = _pw_conductance(
-                                k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
-                                out_normal_force, radius_id, radius_table, conduction_id,
-                                conduction_table, override, k_particle, rhoc_particle, k_wall,
-                                rhoc_wall, srow,
-                            )  # fmt: skip
-                        out_conductance[k] = h
-                        out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
-                    continue
-                out_state[k] = STATE_TOUCHING
-                # n from the particle towards the wall
-                nx = -wnx
-                ny = -wny
-                nz = -wnz
-                # wall surface velocity at q: v_w + Ω a × (q - c)
-                om = wrow[COL_OMEGA]
-                ax = wrow[COL_AXIS] * om
-                ay = wrow[COL_AXIS + 1] * om
-                az = wrow[COL_AXIS + 2] * om
-                rx = qx - wrow[COL_POINT]
-                ry = qy - wrow[COL_POINT + 1]
-                rz = qz - wrow[COL_POINT + 2]
-                vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
-                vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
-                vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
-                wix = angular_velocity[i, 0]
-                wiy = angular_velocity[i, 1]
-                wiz = angular_velocity[i, 2]
-                vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
-                vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
-                vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
-                ti = type_id[i]
-                tw = wall_material[w]
-                rolling_inertia = inertia[i] + mass[i] * ri * ri
-                f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
-                    k,
-                    history,
-                    nx,
-                    ny,
-                    nz,
-                    overlap,
-                    ri,
-                    mass[i],
-                    rolling_inertia,
-                    vrx,
-                    vry,
-                    vrz,
-                    wix - ax,
-                    wiy - ay,
-                    wiz - az,
-                    dt,
-                    normal_id,
-                    normal_table[ti, tw],
-                    tangential_id,
-                    tangential_table[ti, tw],
-                    rolling_id,
-                    rolling_table[ti, tw],
-                    out_force,
-                    out_lever,
-                    out_roll,
-                    out_diss,
-                    out_normal_force,
-                    row,
-                )
-                # work done by the wall on the particle this step
-                fx = -f_n * nx + ftx
-                fy = -f_n * ny + fty
-                fz = -f_n * nz + ftz
-                row[L_WALL_WORK] += (
-                    fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az
-                ) * dt
-                ratio = overlap / ri
-                if ratio > row[L_MAX_OVERLAP_RATIO]:
-                    row[L_MAX_OVERLAP_RATIO] = ratio
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def wall_pair_pass(
+    position,
+    velocity,
+    angular_velocity,
+    radius,
+    mass,
+    inertia,
+    type_id,
+    wall_pair_i,
+    wall_pair_w,
+    nwpairs,
+    history,
+    wall_kind,
+    wall_rows,
+    wall_material,
+    extra,
+    dt,
+    normal_id,
+    normal_table,
+    tangential_id,
+    tangential_table,
+    rolling_id,
+    rolling_table,
+    out_force,
+    out_lever,
+    out_roll,
+    out_diss,
+    out_normal_force,
+    out_state,
+    chunk_ledger,
+    heat_on,
+    temperature,
+    radius_id,
+    radius_table,
+    conduction_id,
+    conduction_table,
+    override,
+    k_particle,
+    rhoc_particle,
+    k_wall,
+    rhoc_wall,
+    scratch,
+    out_conductance,
+    out_heat,
+):
+    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass).
+
+    With ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero).
+    """
+    nchunks = (nwpairs + CHUNK - 1) // CHUNK
+    for c in prange(nchunks):
+        srow = scratch[c]
+        row = chunk_ledger[c]
+        for q in range(row.shape[0]):
+            row[q] = 0.0
+        for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
+            i = wall_pair_i[k]
+            w = wall_pair_w[k]
+            wrow = wall_rows[w]
+            d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
+            ri = radius[i]
+            overlap = ri - d
+            if overlap <= 0.0:
+                _open_contact(
+                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
+                    out_state, row,
+                )  # fmt: skip
+                out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 if heat_on:
                     h = 0.0
-                    if wrow[COL_THERMAL_KIND] != 0.0:
+                    if out_state[k] == STATE_NEAR and wrow[COL_THERMAL_KIND] != 0.0:
                         h = _pw_conductance(
                             k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
@@ -433,5 +354,78 @@ def _compile_passes(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE:
                         )  # fmt: skip
                     out_conductance[k] = h
                     out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
-
-    return particle_pair_pass, wall_pair_pass
+                continue
+            out_state[k] = STATE_TOUCHING
+            # n from the particle towards the wall
+            nx = -wnx
+            ny = -wny
+            nz = -wnz
+            # wall surface velocity at q: v_w + Ω a × (q - c)
+            om = wrow[COL_OMEGA]
+            ax = wrow[COL_AXIS] * om
+            ay = wrow[COL_AXIS + 1] * om
+            az = wrow[COL_AXIS + 2] * om
+            rx = qx - wrow[COL_POINT]
+            ry = qy - wrow[COL_POINT + 1]
+            rz = qz - wrow[COL_POINT + 2]
+            vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
+            vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
+            vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
+            wix = angular_velocity[i, 0]
+            wiy = angular_velocity[i, 1]
+            wiz = angular_velocity[i, 2]
+            vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
+            vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
+            vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
+            ti = type_id[i]
+            tw = wall_material[w]
+            rolling_inertia = inertia[i] + mass[i] * ri * ri
+            f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
+                k,
+                history,
+                nx,
+                ny,
+                nz,
+                overlap,
+                ri,
+                mass[i],
+                rolling_inertia,
+                vrx,
+                vry,
+                vrz,
+                wix - ax,
+                wiy - ay,
+                wiz - az,
+                dt,
+                normal_id,
+                normal_table[ti, tw],
+                tangential_id,
+                tangential_table[ti, tw],
+                rolling_id,
+                rolling_table[ti, tw],
+                out_force,
+                out_lever,
+                out_roll,
+                out_diss,
+                out_normal_force,
+                row,
+            )
+            # work done by the wall on the particle this step
+            fx = -f_n * nx + ftx
+            fy = -f_n * ny + fty
+            fz = -f_n * nz + ftz
+            row[L_WALL_WORK] += (fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az) * dt
+            ratio = overlap / ri
+            if ratio > row[L_MAX_OVERLAP_RATIO]:
+                row[L_MAX_OVERLAP_RATIO] = ratio
+            if heat_on:
+                h = 0.0
+                if wrow[COL_THERMAL_KIND] != 0.0:
+                    h = _pw_conductance(
+                        k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
+                        out_normal_force, radius_id, radius_table, conduction_id,
+                        conduction_table, override, k_particle, rhoc_particle, k_wall,
+                        rhoc_wall, srow,
+                    )  # fmt: skip
+                out_conductance[k] = h
+                out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
