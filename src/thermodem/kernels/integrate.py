@@ -142,34 +142,27 @@ def reduce_and_kick(
         q_wall = 0.0
         h_sum = 0.0
         for q in range(row_start[i], row_start[i + 1]):
+            # entry e >= 0: pair e with i as its first particle, else pair -e-1 with i second;
+            # the sign is exact (±1), so a sum with it equals adding or subtracting
             e = entries[q]
-            if heat_on:
-                kk = e if e >= 0 else -e - 1
-                h_sum += pair_conductance[kk]
-                q_direct += pair_heat[kk] if e >= 0 else -pair_heat[kk]
-            if e >= 0:
-                fx += pair_force[e, 0]
-                fy += pair_force[e, 1]
-                fz += pair_force[e, 2]
-                tx += ri * pair_lever[e, 0]
-                ty += ri * pair_lever[e, 1]
-                tz += ri * pair_lever[e, 2]
-                if has_roll:
-                    tx += pair_roll[e, 0]
-                    ty += pair_roll[e, 1]
-                    tz += pair_roll[e, 2]
-            else:
+            k = e
+            sign = 1.0
+            if e < 0:
                 k = -e - 1
-                fx -= pair_force[k, 0]
-                fy -= pair_force[k, 1]
-                fz -= pair_force[k, 2]
-                tx += ri * pair_lever[k, 0]
-                ty += ri * pair_lever[k, 1]
-                tz += ri * pair_lever[k, 2]
-                if has_roll:
-                    tx -= pair_roll[k, 0]
-                    ty -= pair_roll[k, 1]
-                    tz -= pair_roll[k, 2]
+                sign = -1.0
+            fx += sign * pair_force[k, 0]
+            fy += sign * pair_force[k, 1]
+            fz += sign * pair_force[k, 2]
+            tx += ri * pair_lever[k, 0]
+            ty += ri * pair_lever[k, 1]
+            tz += ri * pair_lever[k, 2]
+            if has_roll:
+                tx += sign * pair_roll[k, 0]
+                ty += sign * pair_roll[k, 1]
+                tz += sign * pair_roll[k, 2]
+            if heat_on:
+                h_sum += pair_conductance[k]
+                q_direct += sign * pair_heat[k]
         for k in range(wall_row_start[i], wall_row_start[i + 1]):
             if heat_on:
                 h_sum += wall_conductance[k]
