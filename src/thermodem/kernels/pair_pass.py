@@ -192,7 +192,6 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     )  # fmt: skip
                     out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                     if heat_on:
-                        h = 0.0
                         if out_state[k] == STATE_NEAR:
                             h = _pp_conductance(
                                 k, i, j, ri, rj, dist, overlap,
@@ -200,8 +199,11 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                                 out_normal_force, radius_id, radius_table, conduction_id,
                                 conduction_table, override, k_particle, rhoc_particle, srow,
                             )  # fmt: skip
-                        out_conductance[k] = h
-                        out_heat[k] = h * (temperature[j] - temperature[i])
+                            out_conductance[k] = h
+                            out_heat[k] = h * (temperature[j] - temperature[i])
+                        else:  # beyond the interaction distance: no exchange
+                            out_conductance[k] = 0.0
+                            out_heat[k] = 0.0
                     continue
                 out_state[k] = STATE_TOUCHING
                 nx = dx / dist
