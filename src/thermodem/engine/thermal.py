@@ -330,7 +330,7 @@ class ThermalEngine:
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
-        K.conduction_pair_pass(
+        K.conduction_pair_pass_for(self.radius_id, self.conduction_id, self.override)(
             p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
             pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
             self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
