@@ -568,6 +568,40 @@ def test_file_round_trip_with_optional_columns(tmp_path):
     assert back.material == "glass"
 
 
+@pytest.mark.parametrize(
+    "text",
+    [
+        "x y z radius vx vy vz temperature\n0.1 0.2 0.3 1e-3 1 2 3 300\n\n"
+        "# comment\n-0.5 0.25 1e3 2.5e-3 -1 -2 -3 310.5\n",
+        "# radius, z, y, x\n0.001, 3.0, 2.0, 1.0\n\n# a comment\n0.002,6,5,4\n",
+        "x,y,z,radius\n1,2,3,0.5\n",
+    ],
+)
+def test_file_fast_parser_equals_the_checked_parser(tmp_path, text):
+    """The NumPy fast path is taken for regular files and gives the checked parser's values
+    and line numbers (the checked parser remains the reference and the error reporter)."""
+    from thermodem.io.particle_file import _parse_checked, _parse_fast
+
+    path = tmp_path / "p.txt"
+    path.write_text(text)
+    fast = _parse_fast(path, "glass")
+    checked = _parse_checked(path, "glass")
+    assert fast is not None
+    for name in ("position", "radius", "velocity"):
+        np.testing.assert_array_equal(
+            getattr(fast.particles, name), getattr(checked.particles, name)
+        )
+    if checked.particles.temperature is None:
+        assert fast.particles.temperature is None
+    else:
+        np.testing.assert_array_equal(fast.particles.temperature, checked.particles.temperature)
+    np.testing.assert_array_equal(fast.line_numbers, checked.line_numbers)
+    assert (fast.has_velocity, fast.has_temperature) == (
+        checked.has_velocity,
+        checked.has_temperature,
+    )
+
+
 def test_file_csv_any_column_order_comments_and_defaults(tmp_path):
     path = tmp_path / "p.csv"
     path.write_text("# radius, z, y, x\n0.001, 3.0, 2.0, 1.0\n\n# a comment\n0.002,6,5,4\n")
