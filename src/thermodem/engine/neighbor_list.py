@@ -2,10 +2,11 @@
 
 :func:`rebuild_lists` sorts the particles by cell, lists the particle pairs and particle-wall
 pairs within the interaction cut-off plus the skin into fresh index arrays, builds the
-per-particle CSR of the pairs and carries the contact history to the new lists by key (the
-kernels are in :mod:`thermodem.kernels.neighbors`). :func:`rebuild_due` decides when: after an
-insertion, at every step with ``rebuild_every_step``, or when a particle moved more than half
-the skin or a particle plus a wall moved more than the skin since the last build.
+per-particle CSR of the pairs and carries the contact history to the new lists by particle
+identity (the kernels are in :mod:`thermodem.kernels.neighbors`). :func:`rebuild_due` decides
+when: after an insertion, at every step with ``rebuild_every_step``, or when a particle moved
+more than half the skin or a particle plus a wall moved more than the skin since the last
+build.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ def cell_size(sim: Simulation) -> float:
 
 
 def rebuild_lists(sim: Simulation) -> None:
-    """Sort particles by cell, list pairs and wall pairs, carry history by key."""
+    """Sort particles by cell, list pairs and wall pairs, carry the history by identity."""
     p = sim.particles
     n = p.count
     cell = cell_size(sim)

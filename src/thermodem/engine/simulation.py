@@ -7,7 +7,7 @@ Order inside one step (``Simulation.step``):
    neighbour build is found; a failed check raises before anything else moves;
 2. walls translate; pouring inserts the particles that are due;
 3. the pair lists are rebuilt if a particle moved more than half the skin, or a particle plus
-   a wall moved more than the skin, or particles were inserted (history carried by key);
+   a wall moved more than the skin, or particles were inserted (history carried by identity);
 4. pair passes: geometry and contact forces of every particle and wall pair, dissipation per
    mechanism, history, ledger rows per chunk;
 5. reduction to per-particle force and torque in a fixed order, with gravity added there
@@ -193,7 +193,7 @@ class Simulation:
 
     # ------------------------------------------------------------------------- neighbours
     def rebuild(self) -> None:
-        """Sort particles by cell, list pairs and wall pairs, carry history by key."""
+        """Sort particles by cell, list pairs and wall pairs, carry the history."""
         rebuild_lists(self)
 
     # ------------------------------------------------------------------------------ forces

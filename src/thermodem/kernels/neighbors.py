@@ -1,4 +1,4 @@
-"""Neighbour search: cell list, Verlet skin, half pair list, history carried by key.
+"""Neighbour search: cell list, Verlet skin, half pair list, history carried by identity.
 
 At each rebuild the particles are sorted by cell (a counting sort, so particles that are close
 in space are close in memory), then every pair closer than ``R_i + R_j + extra + skin`` is
