@@ -277,3 +277,16 @@ def test_conductance_increases_with_force_for_glass_beads_in_air():
     p = network_row()
     q = [heat(p, 1e-3, 2e-3, f) for f in np.logspace(-4, 3, 200)]
     assert np.all(np.diff(q) > 0)
+
+
+def test_solid_layer_beyond_validity_blocks_instead_of_reversing() -> None:
+    """r_c >= r: no cross-section left (infinite resistance, the limit r_c -> r), so the
+    conductance stays positive; the case Hypothesis found: a 0.2 mm sphere on a wall, 3 N."""
+    assert rn.resistance_solid_layer(1.0, 1e-3, 1e-3) == np.inf
+    assert rn.resistance_solid_layer(1.0, 1e-3, 2e-3) == np.inf
+    assert rn.resistance_solid_layer(1.0, 1e-3, 0.999e-3) > 0.0
+    # k_i, k_j, r_i, r_j, F_n, E*, c, H', sigma, tau, k_g, M, B/r_h
+    h = rn.resistance_network_conductance(
+        1.0, 20.0, 2e-4, np.inf, 3.0625, 5e6, 1.0, 3e9, 1e-6, 0.1, 0.0263, 3e-7, 0.0
+    )
+    assert h > 0.0 and np.isfinite(h)

@@ -122,6 +122,10 @@ class ThermalEngine:
         self.thermal_steps = 0
         self.next_step = 0
         self.fresh = False
+        # frozen mechanics: conductances of the first pass are reused (conduction_passes);
+        # reuse_conductance = False re-evaluates them at every thermal step (tests)
+        self.conductance_ready = False
+        self.reuse_conductance = True
         self._warned = False
         self.initial_energy = 0.0
 
@@ -274,6 +278,11 @@ class ThermalEngine:
     # ------------------------------------------------------------------------------ step
     def _buffers(self) -> None:
         sim = self.sim
+        if (
+            self.pair_heat.shape[0] < sim.pairs.capacity
+            or self.wall_heat.shape[0] < sim.walls.capacity
+        ):
+            self.conductance_ready = False
         if self.pair_heat.shape[0] < sim.pairs.capacity:
             self.pair_conductance = np.zeros(sim.pairs.capacity)
             self.pair_heat = np.zeros(sim.pairs.capacity)
@@ -326,10 +335,22 @@ class ThermalEngine:
                 self.wall_heat, p.heat_rate_by_mechanism, self.conductance_sum)  # fmt: skip
 
     def conduction_passes(self) -> None:
-        """Heat-only conduction passes over the current pair lists (frozen mechanics, init)."""
+        """Heat-only conduction passes over the current pair lists (frozen mechanics, init).
+
+        With frozen mechanics and temperature-independent properties the conductances cannot
+        change (same positions, contacts, forces and materials), so after the first pass only
+        the heat rates H (T_j - T_i) are recomputed from them (bit-identical, tested).
+        """
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
+        reuse = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        if reuse and self.conductance_ready:
+            K.heat_from_conductance(
+                pb.i, pb.j, pb.count, wb.i, wb.j, wb.count, sim.wall_rows, p.temperature,
+                self.pair_conductance, self.wall_conductance, self.pair_heat, self.wall_heat,
+            )  # fmt: skip
+            return
         K.conduction_pair_pass_for(self.radius_id, self.conduction_id, self.override)(
             p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
             pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
@@ -344,6 +365,7 @@ class ThermalEngine:
             self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w, self.rhoc_w,
             self.scratch, self.wall_conductance, self.wall_heat,
         )  # fmt: skip
+        self.conductance_ready = reuse
 
     def gather(self, time: float, reduced: bool = False) -> np.ndarray:
         """Per-particle heat rates from the pair heat arrays and the sources; returns the

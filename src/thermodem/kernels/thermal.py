@@ -123,6 +123,25 @@ def conduction_wall_pass(
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
+def heat_from_conductance(
+    pair_i, pair_j, npairs, wall_pair_i, wall_pair_w, nwpairs, wall_rows, temperature,
+    pair_conductance, wall_conductance, out_pair_heat, out_wall_heat,
+):  # fmt: skip
+    """Pair and wall heat rates from conductances already computed for these same contacts:
+    Q = H (T_j - T_i), the expression of the conduction passes, so the result is the same to
+    the bit. Used with frozen mechanics and temperature-independent properties, where nothing
+    that H depends on changes between thermal steps."""
+    for c in prange((npairs + CHUNK - 1) // CHUNK):
+        for k in range(c * CHUNK, min(npairs, (c + 1) * CHUNK)):
+            h = pair_conductance[k]
+            out_pair_heat[k] = h * (temperature[pair_j[k]] - temperature[pair_i[k]]) if h else 0.0
+    for k in range(nwpairs):
+        h = wall_conductance[k]
+        t_wall = wall_rows[wall_pair_w[k], COL_TEMPERATURE]
+        out_wall_heat[k] = h * (t_wall - temperature[wall_pair_i[k]]) if h else 0.0
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
 def heat_gather(
     row_start, entries, pair_conductance, pair_heat, wall_row_start, wall_conductance, wall_heat,
     source, heat_rate, by_mechanism, conductance_sum,

@@ -85,9 +85,14 @@ def resistance_microgap(k_g, r_c, sigma, a1, a2, m_gas):
 def resistance_solid_layer(k, r, r_c):
     """R_c,i = L_i/(k_i A_i), L_i = π r_i/4, A_i = π(r_i² - r_c²) [K/W] (Beaulieu 2020).
 
-    Written as 1/(4 k r (1 - (r_c/r)²)) so that a wall (r = inf) gives 0.
+    Written as 1/(4 k r (1 - (r_c/r)²)) so that a wall (r = inf) gives 0. For r_c >= r (a
+    contact circle as large as the particle: far outside the model's validity) the layer has
+    no cross-section left: infinite resistance, the limit of the formula as r_c -> r (beyond
+    it the printed formula would turn negative and carry heat from cold to hot).
     """
     q = r_c / r
+    if q >= 1.0:
+        return np.inf
     return 0.25 / (k * r * (1.0 - q * q))
 
 
