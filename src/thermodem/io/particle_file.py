@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -31,20 +32,27 @@ class _ParsedFile:
         return self.lines
 
 
+def _content_lines(lines: Iterable[str]) -> Iterator[tuple[int, str, bool]]:
+    """(line number, stripped text, is the header) of the header and of every data line: the
+    header is the first non-blank line (a leading # allowed); blank lines and later # lines
+    are skipped."""
+    header_seen = False
+    for lineno, raw in enumerate(lines, start=1):
+        line = raw.strip()
+        if not line or (header_seen and line.startswith("#")):
+            continue
+        yield lineno, line, not header_seen
+        header_seen = True
+
+
+def _header_names(line: str) -> list[str]:
+    return line.lstrip("#").replace(",", " ").lower().split()
+
+
 def _data_line_numbers(path: Path) -> np.ndarray:
-    """Line numbers of the data lines (after the header; blank and # lines skipped)."""
-    numbers: list[int] = []
-    seen_header = False
+    """Line numbers of the data lines."""
     with path.open() as f:
-        for lineno, raw in enumerate(f, start=1):
-            line = raw.strip()
-            if not line:
-                continue
-            if not seen_header:
-                seen_header = True
-                continue
-            if not line.startswith("#"):
-                numbers.append(lineno)
+        numbers = [n for n, _, is_header in _content_lines(f) if not is_header]
     return np.asarray(numbers, dtype=np.int64)
 
 
@@ -64,14 +72,11 @@ def _parse_fast(path: Path, material: str) -> _ParsedFile | None:
         header_line = 0
         comma = False
         with path.open() as f:
-            for lineno, raw in enumerate(f, start=1):
-                line = raw.strip()
-                if not line:
-                    continue
-                if header is None:
-                    header = line.lstrip("#").replace(",", " ").lower().split()
+            for lineno, line, is_header in _content_lines(f):
+                if is_header:
+                    header = _header_names(line)
                     header_line = lineno
-                elif not line.startswith("#"):
+                else:  # the first data line tells the delimiter
                     comma = "," in line
                     break
         if not header or len(set(header)) != len(header):
@@ -138,15 +143,10 @@ def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
     header_line = 0
     rows: list[list[str]] = []
     line_numbers: list[int] = []
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = raw.strip()
-        if not line:
-            continue
-        if header is None:
-            header = line.lstrip("#").replace(",", " ").lower().split()
+    for lineno, line, is_header in _content_lines(text.splitlines()):
+        if is_header:
+            header = _header_names(line)
             header_line = lineno
-            continue
-        if line.startswith("#"):
             continue
         rows.append(line.replace(",", " ").split())
         line_numbers.append(lineno)

@@ -286,7 +286,7 @@ def build_wall_pairs(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _copy_nonzero_row(old_history, k, new_history, m):
+def _copy_row(old_history, k, new_history, m):
     for c in range(old_history.shape[1]):
         new_history[m, c] = old_history[k, c]
 
@@ -312,9 +312,7 @@ def carry_pair_history(
     :func:`particle_pair_csr`) that has a as i and b as j. Rows of new pairs without an old
     pair are zero; an all-zero old row (a pair that does not touch) needs no copy.
     """
-    for m in range(new_count):
-        for c in range(new_history.shape[1]):
-            new_history[m, c] = 0.0
+    new_history[:new_count] = 0.0
     for k in range(old_count):
         if _row_is_zero(old_history, k):
             continue
@@ -323,7 +321,7 @@ def carry_pair_history(
         for q in range(row_start[a], row_start[a + 1]):
             e = entries[q]
             if e >= 0 and new_j[e] == b:
-                _copy_nonzero_row(old_history, k, new_history, e)
+                _copy_row(old_history, k, new_history, e)
                 break
 
 
@@ -334,16 +332,14 @@ def carry_wall_history(
 ):  # fmt: skip
     """Copy each old particle-wall pair's history to the new pair of the same particle and
     wall (new wall pairs are grouped by particle, ``wall_row_start``); other rows zero."""
-    for m in range(new_count):
-        for c in range(new_history.shape[1]):
-            new_history[m, c] = 0.0
+    new_history[:new_count] = 0.0
     for k in range(old_count):
         if _row_is_zero(old_history, k):
             continue
         a = new_index[old_i[k]]
         for m in range(wall_row_start[a], wall_row_start[a + 1]):
             if new_w[m] == old_w[k]:
-                _copy_nonzero_row(old_history, k, new_history, m)
+                _copy_row(old_history, k, new_history, m)
                 break
 
 
