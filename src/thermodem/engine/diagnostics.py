@@ -12,6 +12,7 @@ import numpy as np
 
 from thermodem.kernels import contact as C
 from thermodem.kernels.neighbors import wall_distance
+from thermodem.kernels.pair_pass import WALL_CHUNK
 
 if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
@@ -85,15 +86,16 @@ def left_domain_cause(sim: Simulation, index: int) -> str:
 def worst_overlap(sim: Simulation) -> tuple[float, int, int, str]:
     """(ratio, global id i, global id j or -1, 'particle' | 'wall LABEL') of the deepest overlap.
 
-    Recomputed from the current positions in the pair-pass chunk that reported the maximum.
+    Recomputed from the current positions in the slab group (particle pairs) and the particle
+    chunk (wall pairs) that reported the maximum.
     """
     p = sim.particles
     best = (0.0, -1, -1, "")
     pb, wb = sim.pairs, sim.walls
-    npc = (pb.count + C.CHUNK - 1) // C.CHUNK
+    npc = pb.ngroups if pb.count else 0
     if npc:
         c = int(np.argmax(pb.chunk_ledger[:npc, C.L_MAX_OVERLAP_RATIO]))
-        lo, hi = c * C.CHUNK, min(pb.count, (c + 1) * C.CHUNK)
+        lo, hi = int(pb.group_start[c]), int(pb.group_start[c + 1])
         i, j = pb.i[lo:hi], pb.j[lo:hi]
         d = p.position[j] - p.position[i]
         length = sim.upper - sim.lower
@@ -111,10 +113,12 @@ def worst_overlap(sim: Simulation) -> tuple[float, int, int, str]:
                 int(p.global_id[j[k]]),
                 "particle",
             )
-    nwc = (wb.count + C.CHUNK - 1) // C.CHUNK
+    n = p.count
+    nwc = (n + WALL_CHUNK - 1) // WALL_CHUNK if wb.count else 0
     if nwc:
         c = int(np.argmax(wb.chunk_ledger[:nwc, C.L_MAX_OVERLAP_RATIO]))
-        for k in range(c * C.CHUNK, min(wb.count, (c + 1) * C.CHUNK)):
+        rs = sim.wall_row_start
+        for k in range(int(rs[c * WALL_CHUNK]), int(rs[min(n, (c + 1) * WALL_CHUNK)])):
             i, w = int(wb.i[k]), int(wb.j[k])
             dist = wall_distance(sim.wall_kind[w], sim.wall_rows[w], p.position[i])[0]
             ratio = (p.radius[i] - dist) / p.radius[i]

@@ -1,9 +1,10 @@
 """The neighbour lists of a :class:`~thermodem.engine.simulation.Simulation`.
 
-:func:`rebuild_lists` sorts the particles by cell, lists the particle pairs and particle-wall
-pairs within the interaction cut-off plus the skin into fresh index arrays, builds the
-per-particle CSR of the pairs and carries the contact history to the new lists by particle
-identity (the kernels are in :mod:`thermodem.kernels.neighbors`). :func:`rebuild_due` decides
+:func:`rebuild_lists` sorts the particles by cell (slab axis major), lists the particle pairs
+and particle-wall pairs within the interaction cut-off plus the skin into fresh index arrays,
+groups the particle pairs by slab layer (:mod:`thermodem.kernels.slabs`) and carries the
+contact history to the new lists by particle identity, in place (the kernels are in
+:mod:`thermodem.kernels.neighbors`). :func:`rebuild_due` decides
 when: after an insertion, at every step with ``rebuild_every_step``, or when a particle moved
 more than half the skin or a particle plus a wall moved more than the skin since the last
 build.
@@ -19,6 +20,7 @@ from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
+from thermodem.kernels import slabs as SL
 from thermodem.state.pairs import PairBuffers
 
 if TYPE_CHECKING:
@@ -38,10 +40,11 @@ def rebuild_lists(sim: Simulation) -> None:
     p = sim.particles
     n = p.count
     cell = cell_size(sim)
+    pb, wb = sim.pairs, sim.walls
     if n == 0:
-        sim.pairs.count = 0
-        sim.walls.count = 0
-        sim.row_start = np.zeros(1, np.int64)
+        pb.count = 0
+        pb.group_start = np.zeros(2, np.int64)
+        wb.count = 0
         sim.wall_row_start = np.zeros(1, np.int64)
         sim.reference = p.position.copy()
         return
@@ -55,57 +58,65 @@ def rebuild_lists(sim: Simulation) -> None:
                 sim.step_count,
                 sim.time,
             )
-    pb, wb = sim.pairs, sim.walls
     dims, edge = NB.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
+    axis = int(SL.choose_axis(p.position, sim.lower, edge, dims))
+    axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
     ncell = int(dims[0] * dims[1] * dims[2])
-    order = np.empty(n, np.int64)
+    order = np.empty(n, np.int32)
     cell_start = np.zeros(ncell + 1, np.int64)
-    NB.sort_by_cell(p.position, sim.lower, edge, dims, order, cell_start)
+    NB.sort_by_cell(p.position, sim.lower, edge, dims, axes, order, cell_start)
     p.permute(order)
     new_index = np.empty(n, np.int32)  # old particle index -> index after the sort
     new_index[order] = np.arange(n, dtype=np.int32)
     del order
-    # particle pairs: list into fresh index arrays, then carry the history
-    old_i, old_j, old_history, old_count = pb.i, pb.j, pb.history, pb.count
+    # particle pairs: list into fresh index arrays
+    old_i, old_j, old_count = pb.i, pb.j, pb.count
     new_i = np.empty(pb.capacity, np.int32)
     new_j = np.empty(pb.capacity, np.int32)
     while True:
         count = NB.build_pairs(
-            p.position,
-            p.radius,
-            p.global_id,
-            sim.lower,
-            sim.upper,
-            sim.periodic,
-            dims,
-            edge,
-            cell_start,
-            sim.extra,
-            sim.skin,
-            new_i,
-            new_j,
-        )
+            p.position, p.radius, p.global_id, sim.lower, sim.upper, sim.periodic, dims, edge,
+            axes, cell_start, sim.extra, sim.skin, new_i, new_j,
+        )  # fmt: skip
         if count <= new_i.shape[0]:
             break
         new_i = np.empty(PairBuffers.grown(pb.capacity, count), np.int32)
         new_j = np.empty_like(new_i)
+    del cell_start
+    pb.i, pb.j = new_i, new_j
+    # where each old touching pair's history goes (written over the old i array)
+    dest = old_i[:old_count]
+    if old_count:
+        offsets = np.empty(n + 1, np.int32)
+        if not NB.lower_index_offsets(new_i, new_j, count, n, offsets):
+            raise AssertionError("build_pairs must list pairs by their lower index")
+        NB.carry_destinations(
+            old_i, old_j, old_count, pb.history, new_index, offsets, new_i, new_j, dest
+        )
+        del offsets
+    del old_j
+    # slab groups (pairs across a periodic boundary need a sort)
+    nlayers = SL.layer_count(int(dims[axis]), bool(sim.periodic[axis]))
+    group_start = np.zeros(nlayers + 1, np.int64)
+    args = (p.position, sim.lower, edge, dims, axis, nlayers, new_i, new_j, count, group_start)
+    if not SL.group_pairs(*args):
+        sorted_i, sorted_j = np.empty_like(new_i), np.empty_like(new_j)
+        where = np.empty(count, np.int32)
+        SL.sort_pairs_by_group(*args, sorted_i, sorted_j, where)
+        new_i, new_j = sorted_i, sorted_j
+        carried = dest >= 0
+        dest[carried] = where[dest[carried]]
+        del where, carried
+    # history: moved in place to the new pair of the same two particles
     if new_i.shape[0] > pb.capacity:
-        pb.allocate(new_i.shape[0])  # old_* still hold the previous list
-    pb.i, pb.j, pb.count = new_i, new_j, count
-    if sim.row_start.shape[0] != n + 1:
-        sim.row_start = np.zeros(n + 1, np.int64)
-    if sim.entries.shape[0] < 2 * pb.capacity:
-        sim.entries = np.zeros(2 * pb.capacity, np.int32)
-    NB.particle_pair_csr(pb.i, pb.j, count, p.global_id, n, sim.row_start, sim.entries)
-    spare = pb.spare_history()
-    NB.carry_pair_history(
-        old_i, old_j, old_count, old_history, new_index, sim.row_start, sim.entries,
-        pb.j, spare, count,
-    )  # fmt: skip
-    pb.swap_history()  # (after a growth too: old_history is then the previous array)
-    pb.state[:count] = C.STATE_UNSET  # outputs live in the old history memory now
-    del old_i, old_j, old_history
-    # wall pairs
+        pb.allocate(new_i.shape[0], keep=old_count)
+    done = np.empty(old_count, np.int8)
+    width = pb.history_width
+    NB.move_rows(pb.history, dest, old_count, count, done, np.empty(width), np.empty(width))
+    del dest, done, old_i
+    pb.i, pb.j, pb.count, pb.group_start = new_i, new_j, count, group_start
+    pb.state[:count] = C.STATE_UNSET  # per-pair outputs of the old list: rewrite all
+    # wall pairs (few: a fresh history table)
     if sim.wall_row_start.shape[0] != n + 1:
         sim.wall_row_start = np.zeros(n + 1, np.int64)
     old_i, old_w, old_history, old_count = wb.i, wb.j, wb.history, wb.count
@@ -113,30 +124,26 @@ def rebuild_lists(sim: Simulation) -> None:
     new_w = np.empty(wb.capacity, np.int32)
     while True:
         wcount = NB.build_wall_pairs(
-            p.position,
-            p.radius,
-            sim.wall_kind,
-            sim.wall_rows,
-            sim.extra,
-            sim.skin,
-            new_i,
-            new_w,
-            sim.wall_row_start,
-        )
+            p.position, p.radius, sim.wall_kind, sim.wall_rows, sim.extra, sim.skin, new_i,
+            new_w, sim.wall_row_start,
+        )  # fmt: skip
         if wcount <= new_i.shape[0]:
             break
         new_i = np.empty(PairBuffers.grown(wb.capacity, wcount), np.int32)
         new_w = np.empty_like(new_i)
     if new_i.shape[0] > wb.capacity:
         wb.allocate(new_i.shape[0])
-    wb.i, wb.j, wb.count = new_i, new_w, wcount
+    new_history = np.zeros_like(wb.history)
     NB.carry_wall_history(
-        old_i, old_w, old_count, old_history, new_index, sim.wall_row_start, wb.j,
-        wb.spare_history(), wcount,
+        old_i, old_w, old_count, old_history, new_index, sim.wall_row_start, new_w,
+        new_history, wcount,
     )  # fmt: skip
-    wb.swap_history()
+    wb.i, wb.j, wb.count, wb.history = new_i, new_w, wcount, new_history
     wb.state[:wcount] = C.STATE_UNSET
-    sim.reference = p.position.copy()
+    if sim.reference.shape == p.position.shape:
+        sim.reference[:] = p.position
+    else:
+        sim.reference = p.position.copy()
     sim.wall_reference = sim.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
     sim.rebuild_count += 1
     sim._needs_rebuild = False

@@ -13,11 +13,10 @@ The state is a plain nested dict, which :mod:`thermodem.io.checkpoint` writes to
                     ledger_cumulative, rng (the bit generator state), pourers (state dicts),
                     material_names, history_width, pair_capacity, wall_pair_capacity},
       "particles": {every Particles array, in the current memory order},
-      "pairs":     {i, j, history, force, lever, roll, dissipation, normal_force, state:
-                    the first `count` rows},
+      "pairs":     {i, j, history, dissipation, normal_force, state: the first `count` rows;
+                    group_start: the slab groups of the list},
       "walls":     {the same for particle-wall pairs},
-      "arrays":    {row_start, entries, wall_row_start, reference, wall_reference, wall_rows,
-                    elastic},
+      "arrays":    {wall_row_start, reference, wall_reference, wall_rows, elastic},
       "thermal":   {"scalars": {...}, "arrays": {...}}   (only with a thermal engine)
     }
 
@@ -55,8 +54,6 @@ SCALARS: tuple[str, ...] = (
 )
 #: Array attributes of Simulation that are state (saved whole).
 ARRAYS: tuple[str, ...] = (
-    "row_start",
-    "entries",
     "wall_row_start",
     "reference",
     "wall_reference",
@@ -68,9 +65,6 @@ PAIR_ARRAYS: tuple[str, ...] = (
     "i",
     "j",
     "history",
-    "force",
-    "lever",
-    "roll",
     "dissipation",
     "normal_force",
     "state",
@@ -109,7 +103,6 @@ DERIVED: tuple[str, ...] = (
     "chunk_check",
     "_no_heat",
     "mechanisms",
-    "_no_reduce_heat",
 )
 #: Attributes of the thermal engine that are never saved (objects, back references).
 THERMAL_SKIP: tuple[str, ...] = ("sim", "settings", "wall_functions")
@@ -146,7 +139,9 @@ def _object_state(obj: Any, skip: tuple[str, ...]) -> dict[str, Any]:
 
 def _pair_state(buf: Any) -> dict[str, np.ndarray]:
     n = buf.count
-    return {name: getattr(buf, name)[:n].copy() for name in PAIR_ARRAYS}
+    state = {name: getattr(buf, name)[:n].copy() for name in PAIR_ARRAYS}
+    state["group_start"] = buf.group_start.copy()  # the slab groups of the list
+    return state
 
 
 def capture(sim: Simulation) -> dict[str, Any]:
@@ -194,6 +189,7 @@ def _load_pairs(buf: Any, arrays: dict[str, np.ndarray], count: int, capacity: i
             raise _mismatch(f"pair array {name!r} shape", source.shape[1:], target.shape[1:])
         target[:count] = source[:count]
     buf.count = count
+    buf.group_start = np.array(arrays["group_start"], np.int64)
 
 
 def restore(sim: Simulation, state: dict[str, Any]) -> None:

@@ -26,6 +26,7 @@ import numpy as np
 
 from thermodem.config.schema import Case
 from thermodem.engine import diagnostics as D
+from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
 from thermodem.engine.validation import check_completeness
 from thermodem.errors import SimulationError
@@ -36,10 +37,11 @@ from thermodem.kernels import contact as C
 from thermodem.kernels import pair_pass as PP
 from thermodem.kernels.integrate import (
     CHECK_CHUNK,
+    final_kick,
     kick_drift,
     max_column,
-    reduce_and_kick,
     reduce_checks,
+    reset_forces,
     sum_rows,
 )
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
@@ -62,6 +64,7 @@ class Simulation:
     ) -> None:
         """Build the simulation; ``insert_particles=False`` skips the static insertion entries
         (used when the state comes from a checkpoint, see :meth:`from_checkpoint`)."""
+        fix_mmap_threshold()  # freed arrays go back to the system (engine/malloc.py)
         if threads is not None:
             numba.set_num_threads(int(threads))
         check_completeness(case)  # validation layer 2 (engine/validation.py)
@@ -87,7 +90,6 @@ class Simulation:
         self.rolling_table = pair_table(models.rolling, case, self.material_names)
         rolling_history = models.rolling.spec.history_width > 0
         history_width = C.HISTORY_WIDTH_ROLLING if rolling_history else C.HISTORY_WIDTH_BASE
-        with_roll = models.rolling.model != "none"
         # domain and walls
         dom = case.domain
         self.lower = np.asarray(dom.lower, np.float64)
@@ -100,11 +102,12 @@ class Simulation:
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         # thermal engine (absent = mechanics only)
         z1, z3 = np.zeros(0), np.zeros((1, 1, 16))
+        z2 = np.zeros((1, 16))
+        # heat arguments of the contact passes when no heat is due (the scratch is unused)
         self._no_heat = (
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, np.zeros((1, 16)), z1, z1),
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, np.zeros((1, 16)), z1, z1),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, np.zeros((1, 7)), z1),
         )
-        self._no_reduce_heat = (False, z1, z1, z1, z1, np.zeros((1, 7)), z1)
         self.thermal = None
         if case.thermal is not None:
             from thermodem.engine.thermal import ThermalEngine
@@ -127,10 +130,8 @@ class Simulation:
         self.extra = float(nb.extra_distance)
         self.skin = nb.skin
         self.rebuild_every_step = nb.rebuild_every_step
-        self.pairs = PairBuffers(1024, history_width, with_roll)
-        self.walls = PairBuffers(64, history_width, with_roll)
-        self.row_start = np.zeros(1, np.int64)
-        self.entries = np.zeros(16, np.int32)
+        self.pairs = PairBuffers(1024, history_width)
+        self.walls = PairBuffers(64, history_width)
         self.wall_row_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
         self.chunk_check = np.zeros((1, 3))
@@ -216,108 +217,44 @@ class Simulation:
         if heat_due:
             # conduction evaluated in the contact pass, for the thermal step that follows
             th.prepare(self.time)
-            pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
             pair_pass, wall_pass = PP.passes_for(True, th.radius_id, th.conduction_id, th.override)
         else:
             pair_heat, wall_heat = self._no_heat
             pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0)
-        pair_pass(
-            p.position,
-            p.velocity,
-            p.angular_velocity,
-            p.radius,
-            p.mass,
-            p.moment_of_inertia,
-            p.type_id,
-            pb.i,
-            pb.j,
-            pb.count,
-            pb.history,
-            self.lower,
-            self.upper,
-            self.periodic,
-            self.extra,
-            dt,
-            nid,
-            self.normal_table,
-            tid,
-            self.tangential_table,
-            rid,
-            self.rolling_table,
-            pb.force,
-            pb.lever,
-            pb.roll,
-            pb.dissipation,
-            pb.normal_force,
-            pb.state,
-            pb.chunk_ledger,
-            *pair_heat,
-        )
-        wall_pass(
-            p.position,
-            p.velocity,
-            p.angular_velocity,
-            p.radius,
-            p.mass,
-            p.moment_of_inertia,
-            p.type_id,
-            wb.i,
-            wb.j,
-            wb.count,
-            wb.history,
-            self.wall_kind,
-            self.wall_rows,
-            self.wall_material,
-            self.extra,
-            dt,
-            nid,
-            self.normal_table,
-            tid,
-            self.tangential_table,
-            rid,
-            self.rolling_table,
-            wb.force,
-            wb.lever,
-            wb.roll,
-            wb.dissipation,
-            wb.normal_force,
-            wb.state,
-            wb.chunk_ledger,
-            *wall_heat,
-        )
+        ngroups = pb.ngroups
+        nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
             th.fresh = True
-            red_heat = th.reduce_heat_args()
+            th.fused_rows(max(ngroups, nwchunks))
+            pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+            reset_forces(p.force, p.torque, p.mass, self.gravity, True,
+                         p.heat_rate_by_mechanism, th.conductance_sum)  # fmt: skip
         else:
-            red_heat = self._no_reduce_heat
-        reduce_and_kick(
-            p.radius,
-            p.mass,
-            p.moment_of_inertia,
-            p.velocity,
-            p.angular_velocity,
-            p.force,
-            p.torque,
-            self.gravity,
-            self.dt,
-            self.row_start,
-            self.entries,
-            pb.force,
-            pb.lever,
-            pb.roll,
-            self.wall_row_start,
-            wb.force,
-            wb.lever,
-            wb.roll,
-            kick,
-            *red_heat,
-        )
+            no_mech, no_sum = self._no_heat[0][-2:]
+            reset_forces(p.force, p.torque, p.mass, self.gravity, False, no_mech, no_sum)
+        pair_pass(
+            p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
+            p.type_id, pb.i, pb.j, pb.group_start, pb.history, self.lower, self.upper,
+            self.periodic, self.extra, dt, nid, self.normal_table, tid, self.tangential_table,
+            rid, self.rolling_table, p.force, p.torque, pb.dissipation, pb.normal_force,
+            pb.state, pb.ledger_rows(ngroups), *pair_heat,
+        )  # fmt: skip
+        wall_pass(
+            p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
+            p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
+            self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
+            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
+            wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat,
+        )  # fmt: skip
+        if kick:
+            final_kick(p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
+                       p.moment_of_inertia, self.dt)  # fmt: skip
         self._accumulate_ledger(kick)
 
     def _accumulate_ledger(self, count_dissipation: bool) -> None:
         pb, wb = self.pairs, self.walls
-        npc = (pb.count + C.CHUNK - 1) // C.CHUNK
-        nwc = (wb.count + C.CHUNK - 1) // C.CHUNK
+        npc = pb.ngroups
+        nwc = (self.particles.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         sums = sum_rows(pb.chunk_ledger, npc) + sum_rows(wb.chunk_ledger, nwc)
         self.elastic = sums[C.L_ELASTIC_NORMAL : C.L_ELASTIC_ROLLING + 1].copy()
         self.contact_count = int(sums[C.L_TOUCHING])

@@ -317,22 +317,24 @@ class ThermalEngine:
         """Arguments of the fused contact pass (particle pairs) that switch conduction on."""
         return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
                 self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
-                self.scratch, self.pair_conductance, self.pair_heat)  # fmt: skip
+                self.scratch, self.sim.particles.heat_rate_by_mechanism,
+                self.conductance_sum)  # fmt: skip
 
     def wall_heat_args(self) -> tuple:
         """Arguments of the fused contact pass (wall pairs) that switch conduction on."""
         return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
                 self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
-                self.k_w, self.rhoc_w, self.scratch, self.wall_conductance,
-                self.wall_heat)  # fmt: skip
+                self.k_w, self.rhoc_w, self.scratch, self.sim.particles.heat_rate_by_mechanism,
+                self.conductance_sum)  # fmt: skip
 
-    def reduce_heat_args(self) -> tuple:
-        """Arguments of the fused per-particle reduction that sum the pair heat."""
-        p = self.sim.particles
-        if self.conductance_sum.shape[0] != p.count:
-            self.conductance_sum = np.zeros(p.count)
-        return (True, self.pair_conductance, self.pair_heat, self.wall_conductance,
-                self.wall_heat, p.heat_rate_by_mechanism, self.conductance_sum)  # fmt: skip
+    def fused_rows(self, rows: int) -> None:
+        """Scratch rows (one per slab group or wall chunk) and the per-particle conductance
+        sums for a fused contact pass."""
+        if self.scratch.shape[0] < rows:
+            self.scratch = np.zeros((rows, 16))
+        n = self.sim.particles.count
+        if self.conductance_sum.shape[0] != n:
+            self.conductance_sum = np.zeros(n)
 
     def conduction_passes(self) -> None:
         """Heat-only conduction passes over the current pair lists (frozen mechanics, init).
@@ -378,10 +380,10 @@ class ThermalEngine:
             return fixed
         if self.conductance_sum.shape[0] != p.count:
             self.conductance_sum = np.zeros(p.count)
-        K.heat_gather(
-            sim.row_start, sim.entries, self.pair_conductance, self.pair_heat,
-            sim.wall_row_start, self.wall_conductance, self.wall_heat, source, p.heat_rate,
-            p.heat_rate_by_mechanism, self.conductance_sum,
+        K.heat_scatter(
+            sim.pairs.i, sim.pairs.j, sim.pairs.group_start, self.pair_conductance,
+            self.pair_heat, sim.wall_row_start, self.wall_conductance, self.wall_heat, source,
+            p.heat_rate, p.heat_rate_by_mechanism, self.conductance_sum,
         )  # fmt: skip
         return fixed
 

@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 FORMAT = "thermodem-checkpoint"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: pair lists with slab groups, no per-pair force rows
 KINDS = ("checkpoint", "interrupted", "final", "failed")
 _NAME = re.compile(r"^checkpoint_(\d+)\.h5$")
 

@@ -7,7 +7,8 @@ history, the per-chunk ledger and the per-pair dissipation, and the pair states.
 
 Sign conventions: n is the unit vector from i to j; the relative velocity of i with respect to j
 at the contact point is v_rel = (v_i + ω_i × R_i n) - (v_j - ω_j × R_j n); the overlap rate is
-v_rel · n (> 0 approaching). The lever arms are the particle radii. A wall is j with infinite
+v_rel · n (> 0 approaching). The lever arms are the particle radii: the torque of the
+tangential force on i is R_i n × F_t, on j R_j n × F_t. A wall is j with infinite
 radius and mass, its surface velocity at the contact point v_w + Ω a × (q - c).
 """
 
@@ -23,7 +24,7 @@ from thermodem.models.mechanics.dispatch import (
     tangential_dispatch,
 )
 
-CHUNK = 2048  # pairs per chunk of the pair pass (one ledger row per chunk)
+CHUNK = 2048  # pairs per chunk of the heat-only pair passes
 
 # History columns of a contact (particle-particle or particle-wall).
 H_SPRING = 0  # 0:3 tangential spring displacement [m]
@@ -105,18 +106,16 @@ def contact_response(
     p_tangential,
     rolling_id,
     p_rolling,
-    out_force,
-    out_lever,
-    out_roll,
     out_diss,
     out_normal_force,
     ledger_row,
 ):
     """Forces of one touching contact (row k of the pair or wall-pair arrays).
 
-    Writes the force on i (out_force[k]), n x F_t (out_lever[k]), the rolling torque on i
-    (out_roll[k] when present), the dissipated power per mechanism (out_diss[k]), the normal
-    force, updates the history row and adds energies to the ledger row.
+    Returns (F_n, F_t (3), rolling torque on i (3)); the force on i is -F_n n + F_t and the
+    torque on i is R_i n x F_t plus the rolling torque. Writes the dissipated power per
+    mechanism (out_diss[k]) and the normal force, updates the history row and adds energies to
+    the ledger row.
     """
     rate = vrx * nx + vry * ny + vrz * nz
     f_el, f_damp, k_ref, gamma_n, u_n = normal_dispatch(
@@ -200,17 +199,6 @@ def contact_response(
         history[k, H_ROLL + 1] = my
         history[k, H_ROLL + 2] = mz
         history[k, H_ROLL_ENERGY] = u_r
-    # outputs: force on i = -F_n n + F_t
-    out_force[k, 0] = -f_n * nx + ftx
-    out_force[k, 1] = -f_n * ny + fty
-    out_force[k, 2] = -f_n * nz + ftz
-    out_lever[k, 0] = ny * ftz - nz * fty
-    out_lever[k, 1] = nz * ftx - nx * ftz
-    out_lever[k, 2] = nx * fty - ny * ftx
-    if out_roll.shape[0] > k:
-        out_roll[k, 0] = tx
-        out_roll[k, 1] = ty
-        out_roll[k, 2] = tz
     p_ndamp = f_damp * rate
     out_diss[k, D_NORMAL_DAMPING] = p_ndamp
     out_diss[k, D_TANGENTIAL_DAMPING] = p_tdamp
@@ -231,9 +219,7 @@ def contact_response(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _open_contact(
-    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force, out_state, ledger_row
-):
+def _open_contact(k, history, out_diss, out_normal_force, out_state, ledger_row):
     """Outputs of a pair that does not touch; a contact that just opened is cleared.
 
     The energy left in its springs when a contact opens is counted as friction (documented).
@@ -248,12 +234,6 @@ def _open_contact(
             ledger_row[L_ROLLING_FRICTION] += history[k, H_ROLL_ENERGY]
         for c in range(history.shape[1]):
             history[k, c] = 0.0
-    for c in range(3):
-        out_force[k, c] = 0.0
-        out_lever[k, c] = 0.0
-    if out_roll.shape[0] > k:
-        for c in range(3):
-            out_roll[k, c] = 0.0
     for c in range(out_diss.shape[1]):
         out_diss[k, c] = 0.0
     out_normal_force[k] = 0.0

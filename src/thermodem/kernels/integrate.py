@@ -1,4 +1,4 @@
-"""Per-particle passes: reduction of pair outputs and velocity Verlet integration.
+"""Per-particle passes: force reset and velocity Verlet integration.
 
 Velocity Verlet (spheres, so rotation needs no orientation):
     v(t+dt/2) = v(t) + F(t) dt / 2m,   x(t+dt) = x(t) + v(t+dt/2) dt,
@@ -91,111 +91,31 @@ def reduce_checks(chunk_check, n):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def reduce_and_kick(
-    radius,
-    mass,
-    inertia,
-    velocity,
-    angular_velocity,
-    force,
-    torque,
-    gravity,
-    dt,
-    row_start,
-    entries,
-    pair_force,
-    pair_lever,
-    pair_roll,
-    wall_row_start,
-    wall_force,
-    wall_lever,
-    wall_roll,
-    kick,
-    heat_on,
-    pair_conductance,
-    pair_heat,
-    wall_conductance,
-    wall_heat,
-    by_mechanism,
-    conductance_sum,
-):
-    """Sum each particle's pair and wall contributions in a fixed order, add gravity, and
-    (if ``kick``) apply the second half kick.
-
-    With ``heat_on`` the same traversal sums the pair heat rates (column 0 of
-    ``by_mechanism``, direct conduction), the wall heat rates (column 6) and the conductances
-    of each particle (``conductance_sum``, for the explicit Euler limit).
-    """
-    n = radius.shape[0]
-    has_roll = pair_roll.shape[0] > 0
-    has_wall_roll = wall_roll.shape[0] > 0
-    half = 0.5 * dt
-    for i in prange(n):
-        ri = radius[i]
-        fx = mass[i] * gravity[0]
-        fy = mass[i] * gravity[1]
-        fz = mass[i] * gravity[2]
-        tx = 0.0
-        ty = 0.0
-        tz = 0.0
-        q_direct = 0.0
-        q_wall = 0.0
-        h_sum = 0.0
-        for q in range(row_start[i], row_start[i + 1]):
-            # entry e >= 0: pair e with i as its first particle, else pair -e-1 with i second;
-            # the sign is exact (±1), so a sum with it equals adding or subtracting
-            e = entries[q]
-            k = e
-            sign = 1.0
-            if e < 0:
-                k = -e - 1
-                sign = -1.0
-            fx += sign * pair_force[k, 0]
-            fy += sign * pair_force[k, 1]
-            fz += sign * pair_force[k, 2]
-            tx += ri * pair_lever[k, 0]
-            ty += ri * pair_lever[k, 1]
-            tz += ri * pair_lever[k, 2]
-            if has_roll:
-                tx += sign * pair_roll[k, 0]
-                ty += sign * pair_roll[k, 1]
-                tz += sign * pair_roll[k, 2]
-            if heat_on:
-                h_sum += pair_conductance[k]
-                q_direct += sign * pair_heat[k]
-        for k in range(wall_row_start[i], wall_row_start[i + 1]):
-            if heat_on:
-                h_sum += wall_conductance[k]
-                q_wall += wall_heat[k]
-            fx += wall_force[k, 0]
-            fy += wall_force[k, 1]
-            fz += wall_force[k, 2]
-            tx += ri * wall_lever[k, 0]
-            ty += ri * wall_lever[k, 1]
-            tz += ri * wall_lever[k, 2]
-            if has_wall_roll:
-                tx += wall_roll[k, 0]
-                ty += wall_roll[k, 1]
-                tz += wall_roll[k, 2]
+def reset_forces(force, torque, mass, gravity, heat_on, by_mechanism, conductance_sum):
+    """Set each particle's force to its weight and its torque to zero before the pair passes
+    add the contacts; with ``heat_on`` also zero the conduction sums they add to (direct and
+    wall columns of ``by_mechanism``, ``conductance_sum``)."""
+    for i in prange(force.shape[0]):
+        m = mass[i]
+        for a in range(3):
+            force[i, a] = m * gravity[a]
+            torque[i, a] = 0.0
         if heat_on:
-            by_mechanism[i, 0] = q_direct
-            by_mechanism[i, 6] = q_wall
-            conductance_sum[i] = h_sum
-        force[i, 0] = fx
-        force[i, 1] = fy
-        force[i, 2] = fz
-        torque[i, 0] = tx
-        torque[i, 1] = ty
-        torque[i, 2] = tz
-        if kick:
-            inv_m = half / mass[i]
-            inv_i = half / inertia[i]
-            velocity[i, 0] += fx * inv_m
-            velocity[i, 1] += fy * inv_m
-            velocity[i, 2] += fz * inv_m
-            angular_velocity[i, 0] += tx * inv_i
-            angular_velocity[i, 1] += ty * inv_i
-            angular_velocity[i, 2] += tz * inv_i
+            by_mechanism[i, 0] = 0.0
+            by_mechanism[i, 6] = 0.0
+            conductance_sum[i] = 0.0
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def final_kick(velocity, angular_velocity, force, torque, mass, inertia, dt):
+    """Second half kick of velocity Verlet with the forces and torques at t + dt."""
+    half = 0.5 * dt
+    for i in prange(force.shape[0]):
+        inv_m = half / mass[i]
+        inv_i = half / inertia[i]
+        for a in range(3):
+            velocity[i, a] += force[i, a] * inv_m
+            angular_velocity[i, a] += torque[i, a] * inv_i
 
 
 @njit(cache=True, error_model="numpy")

@@ -3,8 +3,9 @@
 At each rebuild the particles are sorted by cell (a counting sort, so particles that are close
 in space are close in memory), then every pair closer than ``R_i + R_j + extra + skin`` is
 listed once. A pair is stored oriented so that ``global_id[i] < global_id[j]``; its history row
-is carried to the new list by particle identity (old index -> index after the sort), so a run
-that rebuilds every step and a run with a skin carry identical history. ``extra`` is the
+is carried to the new list by particle identity (old index -> index after the sort), in place
+(:func:`move_rows`), so a run that rebuilds every step and a run with a skin carry identical
+history. ``extra`` is the
 interaction distance beyond contact needed by gap models (near, non-touching pairs).
 
 All kernels write into preallocated buffers and report the count they needed; when a buffer is
@@ -77,26 +78,35 @@ def _axis_cell(x, lower, edge, n):
     return k
 
 
-@njit(cache=True, error_model="numpy")
-def sort_by_cell(position, lower, edge, dims, order, cell_start):
-    """Counting sort of particles by linear cell index.
+@njit(cache=True, inline="always", error_model="numpy")
+def linear_cell(cx, cy, cz, dims, axes):
+    """Linear index of cell (cx, cy, cz) with ``axes[0]`` the major (slowest) axis and
+    ``axes[2]`` the minor one, so that the cells of one layer along ``axes[0]`` are
+    contiguous (the slab layers of :mod:`thermodem.kernels.slabs`)."""
+    c = (cx, cy, cz)
+    return (c[axes[0]] * dims[axes[1]] + c[axes[1]]) * dims[axes[2]] + c[axes[2]]
 
-    Writes ``order`` (new position -> old index) and ``cell_start`` (ncell + 1 offsets).
+
+@njit(cache=True, error_model="numpy")
+def sort_by_cell(position, lower, edge, dims, axes, order, cell_start):
+    """Counting sort of particles by linear cell index (see :func:`linear_cell`).
+
+    Writes ``order`` (new position -> old index, int32) and ``cell_start`` (ncell + 1 offsets).
+    ``order`` first holds each particle's cell index (no extra per-particle buffer).
     """
     n = position.shape[0]
     ncell = dims[0] * dims[1] * dims[2]
     cell_start[:] = 0
-    cell_id = np.empty(n, dtype=np.int64)
     for i in range(n):
         c = cell_of(position[i], lower, edge, dims)
-        cid = (c[2] * dims[1] + c[1]) * dims[0] + c[0]
-        cell_id[i] = cid
+        cid = linear_cell(c[0], c[1], c[2], dims, axes)
         cell_start[cid + 1] += 1
     for c in range(ncell):
         cell_start[c + 1] += cell_start[c]
     fill = cell_start[:ncell].copy()
     for i in range(n):
-        cid = cell_id[i]
+        c = cell_of(position[i], lower, edge, dims)
+        cid = linear_cell(c[0], c[1], c[2], dims, axes)
         order[fill[cid]] = i
         fill[cid] += 1
 
@@ -131,6 +141,7 @@ def build_pairs(
     periodic,
     dims,
     edge,
+    axes,
     cell_start,
     extra,
     skin,
@@ -140,7 +151,9 @@ def build_pairs(
     """List every pair (i, j) with distance < R_i + R_j + extra + skin, each pair once.
 
     Particles must already be sorted by cell (``cell_start`` from :func:`sort_by_cell` applied
-    to the sorted positions). Pairs are oriented so that global_id[i] < global_id[j].
+    to the sorted positions). Pairs are oriented so that global_id[i] < global_id[j]; they are
+    listed in the order of the lower particle index, so the lower index's slab layer never
+    decreases along the list (what :func:`thermodem.kernels.slabs.group_pairs` relies on).
     Returns the number of pairs found; if it exceeds the buffers' length, nothing beyond the
     capacity is written and the caller must grow the buffers and call again.
     """
@@ -163,7 +176,7 @@ def build_pairs(
         for a in range(mz):
             for b in range(my):
                 for q in range(mx):
-                    cid = (sz[a] * dims[1] + sy[b]) * dims[0] + sx[q]
+                    cid = linear_cell(sx[q], sy[b], sz[a], dims, axes)
                     for j in range(cell_start[cid], cell_start[cid + 1]):
                         if j <= i:
                             continue
@@ -300,28 +313,92 @@ def _row_is_zero(history, k):
 
 
 @njit(cache=True, error_model="numpy")
-def carry_pair_history(
-    old_i, old_j, old_count, old_history, new_index, row_start, entries, new_j, new_history,
-    new_count,
-):  # fmt: skip
-    """Copy each old pair's history row to the new pair of the same two particles.
+def lower_index_offsets(pair_i, pair_j, npairs, n, offsets):
+    """``offsets[a]``: the first pair whose lower particle index is a (n + 1 offsets).
 
-    ``new_index[old particle index]`` is its index after the rebuild's sort. Pairs keep their
-    orientation (the smaller global id is i), so the new pair of an old pair (a, b) is the entry
-    of row a of the new per-particle list (``row_start``/``entries``, see
-    :func:`particle_pair_csr`) that has a as i and b as j. Rows of new pairs without an old
-    pair are zero; an all-zero old row (a pair that does not touch) needs no copy.
+    :func:`build_pairs` lists pairs in the order of their lower index, so the pairs of each
+    lower index are contiguous. Returns False if the list is not in that order.
     """
-    new_history[:new_count] = 0.0
+    a = 0
+    offsets[0] = 0
+    for k in range(npairs):
+        lo = min(pair_i[k], pair_j[k])
+        if lo < a:
+            return False
+        while a < lo:
+            a += 1
+            offsets[a] = k
+    while a < n:
+        a += 1
+        offsets[a] = npairs
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def carry_destinations(
+    old_i, old_j, old_count, history, new_index, offsets, new_i, new_j, dest
+):  # fmt: skip
+    """``dest[k]``: the new pair of old pair k (same two particles), or -1 when the old pair
+    is gone or its history row is zero (a pair that does not touch carries nothing).
+
+    ``new_index[old particle index]`` is its index after the rebuild's sort; ``offsets`` from
+    :func:`lower_index_offsets`. Pairs keep their orientation (the smaller global id is i).
+    ``dest`` may be ``old_i`` itself (each entry is read before it is written).
+    """
     for k in range(old_count):
-        if _row_is_zero(old_history, k):
+        if _row_is_zero(history, k):
+            dest[k] = -1
             continue
         a = new_index[old_i[k]]
         b = new_index[old_j[k]]
-        for q in range(row_start[a], row_start[a + 1]):
-            e = entries[q]
-            if e >= 0 and new_j[e] == b:
-                _copy_row(old_history, k, new_history, e)
+        lo = min(a, b)
+        found = -1
+        for e in range(offsets[lo], offsets[lo + 1]):
+            if new_i[e] == a and new_j[e] == b:
+                found = e
+                break
+        dest[k] = found
+
+
+@njit(cache=True, error_model="numpy")
+def move_rows(history, dest, old_count, new_count, done, carry, spare):
+    """Move row k of ``history`` to row ``dest[k]`` in place, for every old row k with
+    ``dest[k] >= 0``; every other row of the first ``new_count`` ends zero.
+
+    ``dest`` is one-to-one, so the moves form chains and cycles: each chain is followed from
+    its start, carrying one row at a time (``carry`` and ``spare`` hold a row, ``done`` marks
+    old rows whose content has left). The history therefore needs no second table.
+    """
+    width = history.shape[1]
+    for k in range(old_count):
+        done[k] = 0
+        if dest[k] < 0:
+            for c in range(width):
+                history[k, c] = 0.0
+    for k in range(old_count, new_count):
+        for c in range(width):
+            history[k, c] = 0.0
+    for k0 in range(old_count):
+        if done[k0] or dest[k0] < 0:
+            continue
+        done[k0] = 1
+        if dest[k0] == k0:
+            continue
+        for c in range(width):
+            carry[c] = history[k0, c]
+            history[k0, c] = 0.0  # vacated; a chain may land here later
+        e = dest[k0]
+        while True:
+            if e < old_count and dest[e] >= 0 and not done[e]:
+                done[e] = 1  # its own row moves on, ours lands
+                for c in range(width):
+                    spare[c] = history[e, c]
+                    history[e, c] = carry[c]
+                    carry[c] = spare[c]
+                e = dest[e]
+            else:
+                for c in range(width):
+                    history[e, c] = carry[c]
                 break
 
 
@@ -341,47 +418,6 @@ def carry_wall_history(
             if new_w[m] == old_w[k]:
                 _copy_row(old_history, k, new_history, m)
                 break
-
-
-@njit(cache=True, error_model="numpy")
-def particle_pair_csr(pair_i, pair_j, npairs, global_id, n, row_start, entries):
-    """Per-particle list of its pairs, each row ordered by the neighbour's global id.
-
-    Entry e >= 0 means pair e with the particle as i; e < 0 means pair ~e (= -e-1) as j.
-    A fixed order per particle makes the reduction independent of list order and threads.
-    """
-    row_start[:] = 0
-    for k in range(npairs):
-        row_start[pair_i[k] + 1] += 1
-        row_start[pair_j[k] + 1] += 1
-    for i in range(n):
-        row_start[i + 1] += row_start[i]
-    fill = row_start[:n].copy()
-    for k in range(npairs):
-        i = pair_i[k]
-        j = pair_j[k]
-        entries[fill[i]] = k
-        fill[i] += 1
-        entries[fill[j]] = -k - 1
-        fill[j] += 1
-    # insertion sort of each (short) row by the neighbour's global id
-    for i in range(n):
-        lo = row_start[i]
-        hi = row_start[i + 1]
-        for a in range(lo + 1, hi):
-            e = entries[a]
-            ke = e if e >= 0 else -e - 1
-            ge = global_id[pair_j[ke]] if e >= 0 else global_id[pair_i[ke]]
-            b = a - 1
-            while b >= lo:
-                f = entries[b]
-                kf = f if f >= 0 else -f - 1
-                gf = global_id[pair_j[kf]] if f >= 0 else global_id[pair_i[kf]]
-                if gf <= ge:
-                    break
-                entries[b + 1] = f
-                b -= 1
-            entries[b + 1] = e
 
 
 @njit(cache=True, error_model="numpy")

@@ -5,11 +5,14 @@ and particle-wall pair, the geometry (distance, unit normal, overlap, relative v
 contact point), the contact response of :mod:`thermodem.kernels.contact` and, when heat is due,
 the conduction of the pair.
 
-``prange`` runs over fixed-size chunks of the pair list; each pair writes its own output rows
-(force on i, lever vector n x F_t, rolling torque on i, dissipated power per mechanism, state),
-and each chunk writes its own ledger row. Nothing is accumulated across pairs with atomics, so
-the results do not depend on the number of threads; the per-particle reduction is
-:func:`thermodem.kernels.integrate.reduce_and_kick`.
+The particle pass runs over the slab groups of the list (:mod:`thermodem.kernels.slabs`): the
+even groups in parallel, then the odd ones. Each pair adds its force and torque (and, when
+heat is due, its heat rate and conductance) straight into the arrays of its two particles,
+which no other group of the same parity touches, and writes its own per-pair rows
+(dissipated power per mechanism, normal force, state); each group writes its own ledger row.
+The wall pass runs over fixed chunks of particles and their wall pairs. Nothing is accumulated
+with atomics and every particle receives its contributions in an order fixed by the list, so
+the results do not depend on the number of threads.
 
 Sign conventions: see :mod:`thermodem.kernels.contact`.
 """
@@ -30,7 +33,6 @@ from thermodem.geometry.wall_layout import (
 )
 from thermodem.kernels.conduction import pair_conductance
 from thermodem.kernels.contact import (
-    CHUNK,
     H_DURATION,
     H_IMPACT_VELOCITY,
     L_MAX_OVERLAP_RATIO,
@@ -42,6 +44,12 @@ from thermodem.kernels.contact import (
     contact_response,
 )
 from thermodem.kernels.neighbors import minimum_image, wall_distance
+
+WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
+
+# per-particle heat mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
+M_DIRECT = 0
+M_WALL = 6
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -124,7 +132,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         type_id,
         pair_i,
         pair_j,
-        npairs,
+        group_start,
         history,
         lower,
         upper,
@@ -137,9 +145,8 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         tangential_table,
         rolling_id,
         rolling_table,
-        out_force,
-        out_lever,
-        out_roll,
+        force,
+        torque,
         out_diss,
         out_normal_force,
         out_state,
@@ -154,14 +161,16 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         k_particle,
         rhoc_particle,
         scratch,
-        out_conductance,
-        out_heat,
+        by_mechanism,
+        conductance_sum,
     ):
-        """Contact forces of every listed particle pair (see module docstring).
+        """Contact forces of every listed particle pair, added to ``force`` and ``torque``
+        (see module docstring; the caller sets them to their non-contact values first).
 
         With ``heat_on`` the same pass evaluates the conduction of every touching and near pair
-        (see :func:`thermodem.kernels.conduction.pair_conductance`) into ``out_conductance`` and
-        ``out_heat`` (heat rate into i), with the temperatures of this moment.
+        (see :func:`thermodem.kernels.conduction.pair_conductance`) with the temperatures of
+        this moment, and adds the heat rate to column 0 of ``by_mechanism`` and the conductance
+        to ``conductance_sum`` of both particles (the caller zeroes them first).
         """
         # the model choice as compile-time constants (see passes_for)
         heat_on = HEAT_ON
@@ -169,109 +178,127 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         conduction_id = CONDUCTION_ID
         override = OVERRIDE
         length = upper - lower
-        nchunks = (npairs + CHUNK - 1) // CHUNK
-        for c in prange(nchunks):
-            srow = scratch[c]
-            row = chunk_ledger[c]
-            for q in range(row.shape[0]):
-                row[q] = 0.0
-            for k in range(c * CHUNK, min(npairs, (c + 1) * CHUNK)):
-                i = pair_i[k]
-                j = pair_j[k]
-                dx = minimum_image(position[j, 0] - position[i, 0], length[0], periodic[0])
-                dy = minimum_image(position[j, 1] - position[i, 1], length[1], periodic[1])
-                dz = minimum_image(position[j, 2] - position[i, 2], length[2], periodic[2])
-                dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-                ri = radius[i]
-                rj = radius[j]
-                overlap = ri + rj - dist
-                if overlap <= 0.0 or dist == 0.0:
-                    _open_contact(
-                        k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
-                        out_state, row,
-                    )  # fmt: skip
-                    out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
+        ngroups = group_start.shape[0] - 1
+        for parity in range(2):
+            for half in prange((ngroups + 1 - parity) // 2):
+                g = 2 * half + parity
+                srow = scratch[g]
+                row = chunk_ledger[g]
+                for q in range(row.shape[0]):
+                    row[q] = 0.0
+                for k in range(group_start[g], group_start[g + 1]):
+                    i = pair_i[k]
+                    j = pair_j[k]
+                    dx = minimum_image(position[j, 0] - position[i, 0], length[0], periodic[0])
+                    dy = minimum_image(position[j, 1] - position[i, 1], length[1], periodic[1])
+                    dz = minimum_image(position[j, 2] - position[i, 2], length[2], periodic[2])
+                    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+                    ri = radius[i]
+                    rj = radius[j]
+                    overlap = ri + rj - dist
+                    if overlap <= 0.0 or dist == 0.0:
+                        _open_contact(k, history, out_diss, out_normal_force, out_state, row)
+                        out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
+                        if heat_on:
+                            if out_state[k] == STATE_NEAR:
+                                h = _pp_conductance(
+                                    k, i, j, ri, rj, dist, overlap,
+                                    mass[i] * mass[j] / (mass[i] + mass[j]), type_id, history,
+                                    out_normal_force, radius_id, radius_table, conduction_id,
+                                    conduction_table, override, k_particle, rhoc_particle, srow,
+                                )  # fmt: skip
+                                q_ij = h * (temperature[j] - temperature[i])
+                                by_mechanism[i, M_DIRECT] += q_ij
+                                by_mechanism[j, M_DIRECT] -= q_ij
+                                conductance_sum[i] += h
+                                conductance_sum[j] += h
+                        continue
+                    out_state[k] = STATE_TOUCHING
+                    nx = dx / dist
+                    ny = dy / dist
+                    nz = dz / dist
+                    wix = angular_velocity[i, 0]
+                    wiy = angular_velocity[i, 1]
+                    wiz = angular_velocity[i, 2]
+                    wjx = angular_velocity[j, 0]
+                    wjy = angular_velocity[j, 1]
+                    wjz = angular_velocity[j, 2]
+                    # (ω_i R_i + ω_j R_j) × n
+                    sx = wix * ri + wjx * rj
+                    sy = wiy * ri + wjy * rj
+                    sz = wiz * ri + wjz * rj
+                    vrx = velocity[i, 0] - velocity[j, 0] + sy * nz - sz * ny
+                    vry = velocity[i, 1] - velocity[j, 1] + sz * nx - sx * nz
+                    vrz = velocity[i, 2] - velocity[j, 2] + sx * ny - sy * nx
+                    eff_radius = ri * rj / (ri + rj)
+                    eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
+                    rolling_inertia = 0.0  # used by the rolling models only
+                    if rolling_id != 0:
+                        ii = inertia[i] + mass[i] * ri * ri
+                        ij = inertia[j] + mass[j] * rj * rj
+                        rolling_inertia = ii * ij / (ii + ij)
+                    ti = type_id[i]
+                    tj = type_id[j]
+                    f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
+                        k,
+                        history,
+                        nx,
+                        ny,
+                        nz,
+                        overlap,
+                        eff_radius,
+                        eff_mass,
+                        rolling_inertia,
+                        vrx,
+                        vry,
+                        vrz,
+                        wix - wjx,
+                        wiy - wjy,
+                        wiz - wjz,
+                        dt,
+                        normal_id,
+                        normal_table[ti, tj],
+                        tangential_id,
+                        tangential_table[ti, tj],
+                        rolling_id,
+                        rolling_table[ti, tj],
+                        out_diss,
+                        out_normal_force,
+                        row,
+                    )
+                    # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
+                    fx = -f_n * nx + ftx
+                    fy = -f_n * ny + fty
+                    fz = -f_n * nz + ftz
+                    lx = ny * ftz - nz * fty
+                    ly = nz * ftx - nx * ftz
+                    lz = nx * fty - ny * ftx
+                    force[i, 0] += fx
+                    force[i, 1] += fy
+                    force[i, 2] += fz
+                    force[j, 0] -= fx
+                    force[j, 1] -= fy
+                    force[j, 2] -= fz
+                    torque[i, 0] += ri * lx + tx
+                    torque[i, 1] += ri * ly + ty
+                    torque[i, 2] += ri * lz + tz
+                    torque[j, 0] += rj * lx - tx
+                    torque[j, 1] += rj * ly - ty
+                    torque[j, 2] += rj * lz - tz
+                    r_min = min(ri, rj)
+                    if overlap > row[L_MAX_OVERLAP_RATIO] * r_min:  # (no division per contact)
+                        row[L_MAX_OVERLAP_RATIO] = overlap / r_min
                     if heat_on:
-                        if out_state[k] == STATE_NEAR:
-                            h = _pp_conductance(
-                                k, i, j, ri, rj, dist, overlap,
-                                mass[i] * mass[j] / (mass[i] + mass[j]), type_id, history,
-                                out_normal_force, radius_id, radius_table, conduction_id,
-                                conduction_table, override, k_particle, rhoc_particle, srow,
-                            )  # fmt: skip
-                            out_conductance[k] = h
-                            out_heat[k] = h * (temperature[j] - temperature[i])
-                        else:  # beyond the interaction distance: no exchange
-                            out_conductance[k] = 0.0
-                            out_heat[k] = 0.0
-                    continue
-                out_state[k] = STATE_TOUCHING
-                nx = dx / dist
-                ny = dy / dist
-                nz = dz / dist
-                wix = angular_velocity[i, 0]
-                wiy = angular_velocity[i, 1]
-                wiz = angular_velocity[i, 2]
-                wjx = angular_velocity[j, 0]
-                wjy = angular_velocity[j, 1]
-                wjz = angular_velocity[j, 2]
-                # (ω_i R_i + ω_j R_j) × n
-                sx = wix * ri + wjx * rj
-                sy = wiy * ri + wjy * rj
-                sz = wiz * ri + wjz * rj
-                vrx = velocity[i, 0] - velocity[j, 0] + sy * nz - sz * ny
-                vry = velocity[i, 1] - velocity[j, 1] + sz * nx - sx * nz
-                vrz = velocity[i, 2] - velocity[j, 2] + sx * ny - sy * nx
-                eff_radius = ri * rj / (ri + rj)
-                eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
-                rolling_inertia = 0.0  # used by the rolling models only
-                if rolling_id != 0:
-                    ii = inertia[i] + mass[i] * ri * ri
-                    ij = inertia[j] + mass[j] * rj * rj
-                    rolling_inertia = ii * ij / (ii + ij)
-                ti = type_id[i]
-                tj = type_id[j]
-                contact_response(
-                    k,
-                    history,
-                    nx,
-                    ny,
-                    nz,
-                    overlap,
-                    eff_radius,
-                    eff_mass,
-                    rolling_inertia,
-                    vrx,
-                    vry,
-                    vrz,
-                    wix - wjx,
-                    wiy - wjy,
-                    wiz - wjz,
-                    dt,
-                    normal_id,
-                    normal_table[ti, tj],
-                    tangential_id,
-                    tangential_table[ti, tj],
-                    rolling_id,
-                    rolling_table[ti, tj],
-                    out_force,
-                    out_lever,
-                    out_roll,
-                    out_diss,
-                    out_normal_force,
-                    row,
-                )
-                r_min = min(ri, rj)
-                if overlap > row[L_MAX_OVERLAP_RATIO] * r_min:  # (no division per contact)
-                    row[L_MAX_OVERLAP_RATIO] = overlap / r_min
-                if heat_on:
-                    h = _pp_conductance(
-                        k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
-                        out_normal_force, radius_id, radius_table, conduction_id,
-                        conduction_table, override, k_particle, rhoc_particle, srow,
-                    )  # fmt: skip
-                    out_conductance[k] = h
-                    out_heat[k] = h * (temperature[j] - temperature[i])
+                        h = _pp_conductance(
+                            k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
+                            out_normal_force, radius_id, radius_table, conduction_id,
+                            conduction_table, override, k_particle, rhoc_particle, srow,
+                        )  # fmt: skip
+                        q_ij = h * (temperature[j] - temperature[i])
+                        by_mechanism[i, M_DIRECT] += q_ij
+                        by_mechanism[j, M_DIRECT] -= q_ij
+                        conductance_sum[i] += h
+                        conductance_sum[j] += h
 
     return particle_pair_pass
 
@@ -287,7 +314,7 @@ def wall_pair_pass(
     type_id,
     wall_pair_i,
     wall_pair_w,
-    nwpairs,
+    wall_row_start,
     history,
     wall_kind,
     wall_rows,
@@ -300,9 +327,8 @@ def wall_pair_pass(
     tangential_table,
     rolling_id,
     rolling_table,
-    out_force,
-    out_lever,
-    out_roll,
+    force,
+    torque,
     out_diss,
     out_normal_force,
     out_state,
@@ -319,20 +345,25 @@ def wall_pair_pass(
     k_wall,
     rhoc_wall,
     scratch,
-    out_conductance,
-    out_heat,
+    by_mechanism,
+    conductance_sum,
 ):
-    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass).
+    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
+    added to ``force`` and ``torque`` after the particle pairs.
 
-    With ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero).
+    Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
+    ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
+    column 6 of ``by_mechanism`` and to ``conductance_sum``.
     """
-    nchunks = (nwpairs + CHUNK - 1) // CHUNK
+    n = radius.shape[0]
+    nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
     for c in prange(nchunks):
         srow = scratch[c]
         row = chunk_ledger[c]
         for q in range(row.shape[0]):
             row[q] = 0.0
-        for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
+        first = wall_row_start[c * WALL_CHUNK]
+        for k in range(first, wall_row_start[min(n, (c + 1) * WALL_CHUNK)]):
             i = wall_pair_i[k]
             w = wall_pair_w[k]
             wrow = wall_rows[w]
@@ -340,10 +371,7 @@ def wall_pair_pass(
             ri = radius[i]
             overlap = ri - d
             if overlap <= 0.0:
-                _open_contact(
-                    k, history, out_force, out_lever, out_roll, out_diss, out_normal_force,
-                    out_state, row,
-                )  # fmt: skip
+                _open_contact(k, history, out_diss, out_normal_force, out_state, row)
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 if heat_on:
                     h = 0.0
@@ -354,8 +382,8 @@ def wall_pair_pass(
                             conduction_table, override, k_particle, rhoc_particle, k_wall,
                             rhoc_wall, srow,
                         )  # fmt: skip
-                    out_conductance[k] = h
-                    out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    by_mechanism[i, M_WALL] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    conductance_sum[i] += h
                 continue
             out_state[k] = STATE_TOUCHING
             # n from the particle towards the wall
@@ -405,9 +433,6 @@ def wall_pair_pass(
                 tangential_table[ti, tw],
                 rolling_id,
                 rolling_table[ti, tw],
-                out_force,
-                out_lever,
-                out_roll,
                 out_diss,
                 out_normal_force,
                 row,
@@ -416,6 +441,12 @@ def wall_pair_pass(
             fx = -f_n * nx + ftx
             fy = -f_n * ny + fty
             fz = -f_n * nz + ftz
+            force[i, 0] += fx
+            force[i, 1] += fy
+            force[i, 2] += fz
+            torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
+            torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
+            torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
             row[L_WALL_WORK] += (fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az) * dt
             ratio = overlap / ri
             if ratio > row[L_MAX_OVERLAP_RATIO]:
@@ -429,5 +460,5 @@ def wall_pair_pass(
                         conduction_table, override, k_particle, rhoc_particle, k_wall,
                         rhoc_wall, srow,
                     )  # fmt: skip
-                out_conductance[k] = h
-                out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
+                by_mechanism[i, M_WALL] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                conductance_sum[i] += h

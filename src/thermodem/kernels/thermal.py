@@ -3,8 +3,8 @@
 The pair pass computes, for each listed particle pair and particle–wall pair, the conductance
 H (the direct-conduction model evaluated at T_i = 0, T_j = 1: every model of the spec is linear
 in the temperature difference) and the heat rate into i, Q = H (T_j - T_i). It writes per-pair
-arrays; the particle pass sums them in the same fixed per-particle order as the forces, so what
-i gains j loses exactly and the result does not depend on the number of threads.
+arrays; :func:`heat_scatter` adds them to both particles by slab group, so what i gains j loses
+exactly and the result does not depend on the number of threads.
 """
 
 from __future__ import annotations
@@ -142,34 +142,45 @@ def heat_from_conductance(
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def heat_gather(
-    row_start, entries, pair_conductance, pair_heat, wall_row_start, wall_conductance, wall_heat,
-    source, heat_rate, by_mechanism, conductance_sum,
+def heat_scatter(
+    pair_i, pair_j, group_start, pair_conductance, pair_heat, wall_row_start, wall_conductance,
+    wall_heat, source, heat_rate, by_mechanism, conductance_sum,
 ):  # fmt: skip
-    """Per-particle heat rate by mechanism and the sum of conductances, in a fixed order."""
+    """Per-particle heat rate by mechanism and the sum of conductances from the per-pair arrays.
+
+    The pair heat is added to both particles by slab group, even groups then odd groups
+    (:mod:`thermodem.kernels.slabs`), in the order of the fused contact pass: what i gains j
+    loses exactly, and the sums do not depend on the number of threads.
+    """
     n = heat_rate.shape[0]
     for i in prange(n):
-        q_direct = 0.0
-        h_sum = 0.0
-        for q in range(row_start[i], row_start[i + 1]):
-            e = entries[q]
-            if e >= 0:
-                q_direct += pair_heat[e]
-                h_sum += pair_conductance[e]
-            else:
-                k = -e - 1
-                q_direct -= pair_heat[k]
-                h_sum += pair_conductance[k]
+        for m in range(by_mechanism.shape[1]):
+            by_mechanism[i, m] = 0.0
+        conductance_sum[i] = 0.0
+    ngroups = group_start.shape[0] - 1
+    for parity in range(2):
+        for half in prange((ngroups + 1 - parity) // 2):
+            g = 2 * half + parity
+            for k in range(group_start[g], group_start[g + 1]):
+                h = pair_conductance[k]
+                if h == 0.0:
+                    continue
+                i = pair_i[k]
+                j = pair_j[k]
+                q = pair_heat[k]
+                by_mechanism[i, M_DIRECT] += q
+                by_mechanism[j, M_DIRECT] -= q
+                conductance_sum[i] += h
+                conductance_sum[j] += h
+    for i in prange(n):
         q_wall = 0.0
+        h_sum = conductance_sum[i]
         for k in range(wall_row_start[i], wall_row_start[i + 1]):
             q_wall += wall_heat[k]
             h_sum += wall_conductance[k]
-        for m in range(by_mechanism.shape[1]):
-            by_mechanism[i, m] = 0.0
-        by_mechanism[i, M_DIRECT] = q_direct
         by_mechanism[i, M_WALL] = q_wall
         by_mechanism[i, M_SOURCE] = source[i]
-        heat_rate[i] = q_direct + q_wall + source[i]
+        heat_rate[i] = by_mechanism[i, M_DIRECT] + q_wall + source[i]
         conductance_sum[i] = h_sum
 
 

@@ -1,14 +1,18 @@
 """Pair-list state: indices, contact history and per-pair outputs, with a capacity.
 
 The arrays are indexed by pair; ``count`` of them are in use. History rows are carried across
-neighbour rebuilds by particle identity (see :func:`thermodem.kernels.neighbors.carry_history`).
+neighbour rebuilds by particle identity, in place (see
+:func:`thermodem.kernels.neighbors.move_rows`).
 
-Memory layout (bytes per pair slot, history width W = 6 or 10 with a rolling spring): ``i``,
-``j`` int32 (8), ``history`` float64 (8 W), ``scratch`` float64 (8 max(W, 6 or 9)),
-``dissipation`` float32 (16), ``normal_force`` (8), ``state`` int8 (1). The per-step outputs
-``force``, ``lever`` and (with rolling) ``roll`` are C-contiguous views into ``scratch``: every
-pair pass rewrites them, so at a rebuild the same memory receives the carried history (no
-permanent spare history). The capacity grows to 1.1 x the count a rebuild needed, never shrinks.
+Memory layout (bytes per pair slot, history width W = 6, or 10 with a rolling spring): ``i``,
+``j`` int32 (8), ``history`` float64 (8 W), ``dissipation`` float32 (16), ``normal_force`` (8),
+``state`` int8 (1): 81 B with W = 6. Forces and torques are not stored per pair: the pair
+passes add them straight into the particles' arrays (:mod:`thermodem.kernels.slabs`). The
+capacity grows to 1.1 x the count a rebuild needed, never shrinks; capacity that is never
+written is not resident.
+
+For particle pairs ``group_start`` holds the slab groups of the list (``ngroups + 1``
+offsets); for particle-wall pairs the list is grouped by particle (``Simulation.wall_row_start``).
 """
 
 from __future__ import annotations
@@ -24,52 +28,38 @@ GROWTH = 1.1
 class PairBuffers:
     """Pair-list arrays with a capacity; grown (never shrunk) when a rebuild needs more."""
 
-    def __init__(self, capacity: int, history_width: int, with_roll: bool) -> None:
+    def __init__(self, capacity: int, history_width: int) -> None:
         self.count = 0
         self.history_width = history_width
-        self.with_roll = with_roll
+        self.group_start = np.zeros(2, np.int64)
+        self.chunk_ledger = np.zeros((1, C.LEDGER_WIDTH))
         self.allocate(capacity)
 
-    def allocate(self, capacity: int) -> None:
-        """Fresh arrays of ``capacity`` slots (contents zero, count unchanged)."""
+    @property
+    def ngroups(self) -> int:
+        return self.group_start.shape[0] - 1
+
+    def allocate(self, capacity: int, keep: int = 0) -> None:
+        """Arrays of ``capacity`` slots; the first ``keep`` history rows are kept, the other
+        contents are zero (count unchanged)."""
         capacity = max(int(capacity), 16)
+        old = getattr(self, "history", None)
         self.capacity = capacity
         self.i = np.zeros(capacity, np.int32)
         self.j = np.zeros(capacity, np.int32)
         self.history = np.zeros((capacity, self.history_width))
-        self.scratch = np.zeros(capacity * self.scratch_width())
-        self._output_views()
+        if keep and old is not None:
+            self.history[:keep] = old[:keep]
+        del old
         self.dissipation = np.zeros((capacity, 4), np.float32)
         self.normal_force = np.zeros(capacity)
         self.state = np.zeros(capacity, np.int8)
-        self.chunk_ledger = np.zeros((capacity // C.CHUNK + 2, C.LEDGER_WIDTH))
 
-    def scratch_width(self) -> int:
-        """Floats per slot of the scratch block: the history width, and at least the outputs
-        (force, lever: 6; with a rolling torque: 9)."""
-        return max(self.history_width, 9 if self.with_roll else 6)
-
-    def _output_views(self) -> None:
-        cap, s = self.capacity, self.scratch
-        self.force = s[: 3 * cap].reshape(cap, 3)
-        self.lever = s[3 * cap : 6 * cap].reshape(cap, 3)
-        self.roll = s[6 * cap : 9 * cap].reshape(cap, 3) if self.with_roll else np.zeros((0, 3))
-
-    def spare_history(self) -> np.ndarray:
-        """The scratch memory as a (capacity, W) history table (valid until the next pass)."""
-        cap, width = self.capacity, self.history_width
-        return self.scratch[: cap * width].reshape(cap, width)
-
-    def swap_history(self) -> None:
-        """After the carried history was written into :meth:`spare_history`: make it the
-        history, and the old history memory the scratch space of the outputs."""
-        new = self.spare_history()
-        if self.scratch_width() == self.history_width:
-            self.scratch = self.history.reshape(-1)  # the two blocks swap roles
-        else:  # scratch wider than history (constant-torque rolling): give it a fresh block
-            self.scratch = np.zeros(self.capacity * self.scratch_width())
-        self.history = new
-        self._output_views()
+    def ledger_rows(self, rows: int) -> np.ndarray:
+        """The per-group (or per-chunk) ledger table with at least ``rows`` rows."""
+        if self.chunk_ledger.shape[0] < rows:
+            self.chunk_ledger = np.zeros((rows, C.LEDGER_WIDTH))
+        return self.chunk_ledger
 
     @staticmethod
     def grown(capacity: int, needed: int) -> int:
