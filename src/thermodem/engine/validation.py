@@ -33,13 +33,15 @@ MECHANICAL_FAMILIES = ("normal", "tangential", "rolling")
 
 #: Nominal throughput for the run time estimate: particle-steps per second per thread, and
 #: the cost of a step that does not grow with the particle count [s] (kernel launches, Python).
-#: Measured on 2 threads: 1.04e6 particle-steps/s for the 50,000-sphere packed bed of
-#: bench/bench_packed_bed.py (Hertz-Mindlin), ~0.4 ms per step for a few hundred particles.
-PARTICLE_STEPS_PER_THREAD = 5.0e5
+#: Measured (2026-12-01): ~6e6 particle-steps/s per thread for the 50,000-sphere packed bed of
+#: bench/bench_packed_bed.py (Hertz-Mindlin, mechanics only), ~0.4 ms per step for a few
+#: hundred particles; the estimate takes half of that rate (heat, walls, denser contacts).
+PARTICLE_STEPS_PER_THREAD = 3.0e6
 SECONDS_PER_STEP = 4.0e-4
 #: Memory model: bytes per particle (state arrays, neighbour index, copies while sorting) and
-#: per listed pair (indices, history, forces, keys, CSR entries; ×1.25 growth margin), and
-#: pairs per particle in a dense bed (3.6 measured in the benchmark bed, plus near pairs).
+#: per listed pair (indices, history, dissipation, normal force, state, and a rebuild's new
+#: indices; ×1.25 growth margin), and pairs per particle in a dense bed (3.6 measured in the
+#: benchmark bed, plus near pairs). Measured: ~560 B per particle in that bed.
 BYTES_PER_PARTICLE = 400.0
 PAIRS_PER_PARTICLE = 4.5
 BASELINE_BYTES = 250e6
@@ -212,9 +214,9 @@ def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceE
         particle_seconds += seconds
     particle_steps = particle_seconds / dt_run
     width = sim.pairs.history_width
-    pair_bytes = 1.25 * (8 + 8 * width + 72 + 32 + 9 + 24 + 16)
+    pair_bytes = 1.25 * (8 + 8 * width + 16 + 8 + 1 + 9)
     if sim.thermal is not None:
-        pair_bytes += 32
+        pair_bytes += 16  # conductance and heat rate (heat-only passes)
     memory = BASELINE_BYTES + final * (BYTES_PER_PARTICLE + PAIRS_PER_PARTICLE * pair_bytes)
     seconds = steps * SECONDS_PER_STEP + particle_steps / (PARTICLE_STEPS_PER_THREAD * threads)
     total, avail = physical_memory()
