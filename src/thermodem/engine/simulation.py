@@ -8,11 +8,11 @@ Order inside one step (``Simulation.step``):
 2. walls translate; pouring inserts the particles that are due;
 3. the pair lists are rebuilt if a particle moved more than half the skin, or a particle plus
    a wall moved more than the skin, or particles were inserted (history carried by identity);
-4. pair passes: geometry and contact forces of every particle and wall pair, dissipation per
-   mechanism, history, ledger rows per chunk;
-5. reduction to per-particle force and torque in a fixed order, with gravity added there
-   (the per-particle heat sources of the thermal engine will join this pass), and the second
-   half kick;
+4. forces set to the weights, torques to zero (and the conduction sums, when heat is due);
+   pair passes: geometry and contact forces of every particle and wall pair, added straight
+   into the particles by slab group (``thermodem.kernels.slabs``), dissipation per mechanism,
+   history, ledger rows per group;
+5. the second half kick;
 6. overlap check; 7. writers on their triggers (owned by the caller, see
    ``thermodem.engine.runner``).
 """
@@ -199,7 +199,7 @@ class Simulation:
 
     # ------------------------------------------------------------------------------ forces
     def _compute_forces(self, kick: bool, contact_dt: float | None = None) -> None:
-        """Pair passes, reduction and (if ``kick``) the second half kick.
+        """Force reset, pair passes and (if ``kick``) the second half kick.
 
         ``contact_dt`` is the time the contact histories advance by (the time step, or 0 for
         the force evaluation at t = 0, so that a contact present at the start has not aged).

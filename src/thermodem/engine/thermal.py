@@ -371,7 +371,7 @@ class ThermalEngine:
 
     def gather(self, time: float, reduced: bool = False) -> np.ndarray:
         """Per-particle heat rates from the pair heat arrays and the sources; returns the
-        fixed-temperature mask. ``reduced``: the fused reduction already summed the pairs."""
+        fixed-temperature mask. ``reduced``: the fused contact pass already summed the pairs."""
         sim = self.sim
         p = sim.particles
         fixed, source = self._fixed_and_sources(time)

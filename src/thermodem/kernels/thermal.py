@@ -292,7 +292,8 @@ def total_enthalpy(temperature, mass, type_id, table_t, table_c, table_n):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def finish_heat(source, heat_rate, by_mechanism):
-    """Source column and total heat rate after the fused reduction filled columns 0 and 6."""
+    """Source column and total heat rate after the fused contact pass filled columns 0 and 6
+    (:func:`heat_scatter` fills them itself)."""
     for i in prange(heat_rate.shape[0]):
         by_mechanism[i, M_SOURCE] = source[i]
         heat_rate[i] = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
