@@ -34,10 +34,10 @@ MECHANICAL_FAMILIES = ("normal", "tangential", "rolling")
 #: Nominal throughput for the run time estimate: particle-steps per second per thread, and
 #: the cost of a step that does not grow with the particle count [s] (kernel launches, Python).
 #: Measured (2026-12-01): ~6e6 particle-steps/s per thread for the 50,000-sphere packed bed of
-#: bench/bench_packed_bed.py (Hertz-Mindlin, mechanics only), ~0.4 ms per step for a few
+#: bench/bench_packed_bed.py (Hertz-Mindlin, mechanics only), ~0.12 ms per step for a few
 #: hundred particles; the estimate takes half of that rate (heat, walls, denser contacts).
 PARTICLE_STEPS_PER_THREAD = 3.0e6
-SECONDS_PER_STEP = 4.0e-4
+SECONDS_PER_STEP = 1.5e-4
 #: Memory model: bytes per particle (state arrays, neighbour index, copies while sorting) and
 #: per listed pair (indices, history, dissipation, normal force, state, and a rebuild's new
 #: indices; ×1.25 growth margin), and pairs per particle in a dense bed (3.6 measured in the
