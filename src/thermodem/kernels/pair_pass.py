@@ -196,99 +196,91 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     ri = radius[i]
                     rj = radius[j]
                     overlap = ri + rj - dist
+                    eff_mass = 0.0
                     if overlap <= 0.0 or dist == 0.0:
                         _open_contact(k, history, out_diss, out_normal_force, out_state, row)
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
-                        if heat_on:
-                            if out_state[k] == STATE_NEAR:
-                                h = _pp_conductance(
-                                    k, i, j, ri, rj, dist, overlap,
-                                    mass[i] * mass[j] / (mass[i] + mass[j]), type_id, history,
-                                    out_normal_force, radius_id, radius_table, conduction_id,
-                                    conduction_table, override, k_particle, rhoc_particle, srow,
-                                )  # fmt: skip
-                                q_ij = h * (temperature[j] - temperature[i])
-                                by_mechanism[i, M_DIRECT] += q_ij
-                                by_mechanism[j, M_DIRECT] -= q_ij
-                                conductance_sum[i] += h
-                                conductance_sum[j] += h
-                        continue
-                    out_state[k] = STATE_TOUCHING
-                    nx = dx / dist
-                    ny = dy / dist
-                    nz = dz / dist
-                    wix = angular_velocity[i, 0]
-                    wiy = angular_velocity[i, 1]
-                    wiz = angular_velocity[i, 2]
-                    wjx = angular_velocity[j, 0]
-                    wjy = angular_velocity[j, 1]
-                    wjz = angular_velocity[j, 2]
-                    # (ω_i R_i + ω_j R_j) × n
-                    sx = wix * ri + wjx * rj
-                    sy = wiy * ri + wjy * rj
-                    sz = wiz * ri + wjz * rj
-                    vrx = velocity[i, 0] - velocity[j, 0] + sy * nz - sz * ny
-                    vry = velocity[i, 1] - velocity[j, 1] + sz * nx - sx * nz
-                    vrz = velocity[i, 2] - velocity[j, 2] + sx * ny - sy * nx
-                    eff_radius = ri * rj / (ri + rj)
-                    eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
-                    rolling_inertia = 0.0  # used by the rolling models only
-                    if rolling_id != 0:
-                        ii = inertia[i] + mass[i] * ri * ri
-                        ij = inertia[j] + mass[j] * rj * rj
-                        rolling_inertia = ii * ij / (ii + ij)
-                    ti = type_id[i]
-                    tj = type_id[j]
-                    f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
-                        k,
-                        history,
-                        nx,
-                        ny,
-                        nz,
-                        overlap,
-                        eff_radius,
-                        eff_mass,
-                        rolling_inertia,
-                        vrx,
-                        vry,
-                        vrz,
-                        wix - wjx,
-                        wiy - wjy,
-                        wiz - wjz,
-                        dt,
-                        normal_id,
-                        normal_table[ti, tj],
-                        tangential_id,
-                        tangential_table[ti, tj],
-                        rolling_id,
-                        rolling_table[ti, tj],
-                        out_diss,
-                        out_normal_force,
-                        row,
-                    )
-                    # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
-                    fx = -f_n * nx + ftx
-                    fy = -f_n * ny + fty
-                    fz = -f_n * nz + ftz
-                    lx = ny * ftz - nz * fty
-                    ly = nz * ftx - nx * ftz
-                    lz = nx * fty - ny * ftx
-                    force[i, 0] += fx
-                    force[i, 1] += fy
-                    force[i, 2] += fz
-                    force[j, 0] -= fx
-                    force[j, 1] -= fy
-                    force[j, 2] -= fz
-                    torque[i, 0] += ri * lx + tx
-                    torque[i, 1] += ri * ly + ty
-                    torque[i, 2] += ri * lz + tz
-                    torque[j, 0] += rj * lx - tx
-                    torque[j, 1] += rj * ly - ty
-                    torque[j, 2] += rj * lz - tz
-                    r_min = min(ri, rj)
-                    if overlap > row[L_MAX_OVERLAP_RATIO] * r_min:  # (no division per contact)
-                        row[L_MAX_OVERLAP_RATIO] = overlap / r_min
-                    if heat_on:
+                    else:
+                        out_state[k] = STATE_TOUCHING
+                        nx = dx / dist
+                        ny = dy / dist
+                        nz = dz / dist
+                        wix = angular_velocity[i, 0]
+                        wiy = angular_velocity[i, 1]
+                        wiz = angular_velocity[i, 2]
+                        wjx = angular_velocity[j, 0]
+                        wjy = angular_velocity[j, 1]
+                        wjz = angular_velocity[j, 2]
+                        # (ω_i R_i + ω_j R_j) × n
+                        sx = wix * ri + wjx * rj
+                        sy = wiy * ri + wjy * rj
+                        sz = wiz * ri + wjz * rj
+                        vrx = velocity[i, 0] - velocity[j, 0] + sy * nz - sz * ny
+                        vry = velocity[i, 1] - velocity[j, 1] + sz * nx - sx * nz
+                        vrz = velocity[i, 2] - velocity[j, 2] + sx * ny - sy * nx
+                        eff_radius = ri * rj / (ri + rj)
+                        eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
+                        rolling_inertia = 0.0  # used by the rolling models only
+                        if rolling_id != 0:
+                            ii = inertia[i] + mass[i] * ri * ri
+                            ij = inertia[j] + mass[j] * rj * rj
+                            rolling_inertia = ii * ij / (ii + ij)
+                        ti = type_id[i]
+                        tj = type_id[j]
+                        f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
+                            k,
+                            history,
+                            nx,
+                            ny,
+                            nz,
+                            overlap,
+                            eff_radius,
+                            eff_mass,
+                            rolling_inertia,
+                            vrx,
+                            vry,
+                            vrz,
+                            wix - wjx,
+                            wiy - wjy,
+                            wiz - wjz,
+                            dt,
+                            normal_id,
+                            normal_table[ti, tj],
+                            tangential_id,
+                            tangential_table[ti, tj],
+                            rolling_id,
+                            rolling_table[ti, tj],
+                            out_diss,
+                            out_normal_force,
+                            row,
+                        )
+                        # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
+                        fx = -f_n * nx + ftx
+                        fy = -f_n * ny + fty
+                        fz = -f_n * nz + ftz
+                        lx = ny * ftz - nz * fty
+                        ly = nz * ftx - nx * ftz
+                        lz = nx * fty - ny * ftx
+                        force[i, 0] += fx
+                        force[i, 1] += fy
+                        force[i, 2] += fz
+                        force[j, 0] -= fx
+                        force[j, 1] -= fy
+                        force[j, 2] -= fz
+                        torque[i, 0] += ri * lx + tx
+                        torque[i, 1] += ri * ly + ty
+                        torque[i, 2] += ri * lz + tz
+                        torque[j, 0] += rj * lx - tx
+                        torque[j, 1] += rj * ly - ty
+                        torque[j, 2] += rj * lz - tz
+                        r_min = min(ri, rj)
+                        if overlap > row[L_MAX_OVERLAP_RATIO] * r_min:  # (no division per contact)
+                            row[L_MAX_OVERLAP_RATIO] = overlap / r_min
+                    # conduction of touching and near pairs (one call site: Numba's SSA check
+                    # warns when the inlined model selection appears twice in one function)
+                    if heat_on and out_state[k] != STATE_FAR:
+                        if out_state[k] != STATE_TOUCHING:
+                            eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
                         h = _pp_conductance(
                             k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
@@ -373,85 +365,78 @@ def wall_pair_pass(
             if overlap <= 0.0:
                 _open_contact(k, history, out_diss, out_normal_force, out_state, row)
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
-                if heat_on:
-                    h = 0.0
-                    if out_state[k] == STATE_NEAR and wrow[COL_THERMAL_KIND] != 0.0:
-                        h = _pw_conductance(
-                            k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
-                            out_normal_force, radius_id, radius_table, conduction_id,
-                            conduction_table, override, k_particle, rhoc_particle, k_wall,
-                            rhoc_wall, srow,
-                        )  # fmt: skip
-                    by_mechanism[i, M_WALL] += h * (wrow[COL_TEMPERATURE] - temperature[i])
-                    conductance_sum[i] += h
-                continue
-            out_state[k] = STATE_TOUCHING
-            # n from the particle towards the wall
-            nx = -wnx
-            ny = -wny
-            nz = -wnz
-            # wall surface velocity at q: v_w + Ω a × (q - c)
-            om = wrow[COL_OMEGA]
-            ax = wrow[COL_AXIS] * om
-            ay = wrow[COL_AXIS + 1] * om
-            az = wrow[COL_AXIS + 2] * om
-            rx = qx - wrow[COL_POINT]
-            ry = qy - wrow[COL_POINT + 1]
-            rz = qz - wrow[COL_POINT + 2]
-            vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
-            vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
-            vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
-            wix = angular_velocity[i, 0]
-            wiy = angular_velocity[i, 1]
-            wiz = angular_velocity[i, 2]
-            vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
-            vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
-            vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
-            ti = type_id[i]
-            tw = wall_material[w]
-            rolling_inertia = inertia[i] + mass[i] * ri * ri
-            f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
-                k,
-                history,
-                nx,
-                ny,
-                nz,
-                overlap,
-                ri,
-                mass[i],
-                rolling_inertia,
-                vrx,
-                vry,
-                vrz,
-                wix - ax,
-                wiy - ay,
-                wiz - az,
-                dt,
-                normal_id,
-                normal_table[ti, tw],
-                tangential_id,
-                tangential_table[ti, tw],
-                rolling_id,
-                rolling_table[ti, tw],
-                out_diss,
-                out_normal_force,
-                row,
-            )
-            # work done by the wall on the particle this step
-            fx = -f_n * nx + ftx
-            fy = -f_n * ny + fty
-            fz = -f_n * nz + ftz
-            force[i, 0] += fx
-            force[i, 1] += fy
-            force[i, 2] += fz
-            torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
-            torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
-            torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
-            row[L_WALL_WORK] += (fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az) * dt
-            ratio = overlap / ri
-            if ratio > row[L_MAX_OVERLAP_RATIO]:
-                row[L_MAX_OVERLAP_RATIO] = ratio
-            if heat_on:
+            else:
+                out_state[k] = STATE_TOUCHING
+                # n from the particle towards the wall
+                nx = -wnx
+                ny = -wny
+                nz = -wnz
+                # wall surface velocity at q: v_w + Ω a × (q - c)
+                om = wrow[COL_OMEGA]
+                ax = wrow[COL_AXIS] * om
+                ay = wrow[COL_AXIS + 1] * om
+                az = wrow[COL_AXIS + 2] * om
+                rx = qx - wrow[COL_POINT]
+                ry = qy - wrow[COL_POINT + 1]
+                rz = qz - wrow[COL_POINT + 2]
+                vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
+                vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
+                vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
+                wix = angular_velocity[i, 0]
+                wiy = angular_velocity[i, 1]
+                wiz = angular_velocity[i, 2]
+                vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
+                vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
+                vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
+                ti = type_id[i]
+                tw = wall_material[w]
+                rolling_inertia = inertia[i] + mass[i] * ri * ri
+                f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
+                    k,
+                    history,
+                    nx,
+                    ny,
+                    nz,
+                    overlap,
+                    ri,
+                    mass[i],
+                    rolling_inertia,
+                    vrx,
+                    vry,
+                    vrz,
+                    wix - ax,
+                    wiy - ay,
+                    wiz - az,
+                    dt,
+                    normal_id,
+                    normal_table[ti, tw],
+                    tangential_id,
+                    tangential_table[ti, tw],
+                    rolling_id,
+                    rolling_table[ti, tw],
+                    out_diss,
+                    out_normal_force,
+                    row,
+                )
+                # work done by the wall on the particle this step
+                fx = -f_n * nx + ftx
+                fy = -f_n * ny + fty
+                fz = -f_n * nz + ftz
+                force[i, 0] += fx
+                force[i, 1] += fy
+                force[i, 2] += fz
+                torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
+                torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
+                torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
+                row[L_WALL_WORK] += (
+                    fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az
+                ) * dt
+                ratio = overlap / ri
+                if ratio > row[L_MAX_OVERLAP_RATIO]:
+                    row[L_MAX_OVERLAP_RATIO] = ratio
+            # conduction from fixed-temperature walls, touching and near pairs (one call site,
+            # as in the particle pass)
+            if heat_on and out_state[k] != STATE_FAR:
                 h = 0.0
                 if wrow[COL_THERMAL_KIND] != 0.0:
                     h = _pw_conductance(
