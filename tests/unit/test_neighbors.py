@@ -469,3 +469,36 @@ def test_slab_groups_and_contact_forces(tmp_path, length, periodic):
     np.testing.assert_allclose(force, expected, rtol=0.0, atol=1e-12 * scale)
     # what i gets j loses: the forces sum to zero to round-off
     assert np.abs(force.sum(axis=0)).max() < 1e-12 * scale * len(rad)
+
+
+def test_pair_buffer_growth_keeps_the_history(monkeypatch):
+    """Pouring grows the pair buffers while contacts carry history (the rows are kept and then
+    moved); a run that never grows them (a large first capacity) is identical to the bit."""
+    from thermodem.config.load import load_case
+    from thermodem.state import pairs as P
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "default.yaml"
+    original_init, original_allocate = P.PairBuffers.__init__, P.PairBuffers.allocate
+    kept: list[int] = []
+
+    def allocate(self, capacity, keep=0):
+        kept.append(keep)
+        original_allocate(self, capacity, keep)
+
+    def run(first_capacity: int | None) -> np.ndarray:
+        def init(self, capacity, history_width):
+            original_init(self, first_capacity or capacity, history_width)
+
+        monkeypatch.setattr(P.PairBuffers, "__init__", init)
+        sim = Simulation(load_case(example))
+        sim.run(steps=20000)
+        p = sim.particles
+        return p.position[np.argsort(p.global_id)]
+
+    monkeypatch.setattr(P.PairBuffers, "allocate", allocate)
+    grown = run(None)
+    assert max(kept) > 100, kept  # grown while more than 100 rows of history were in use
+    kept.clear()
+    fixed = run(100_000)
+    assert max(kept) == 0, kept
+    assert np.array_equal(grown, fixed)
