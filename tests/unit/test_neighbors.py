@@ -380,6 +380,49 @@ def test_skin_run_equals_rebuild_every_step(tmp_path):
     assert np.array_equal(by_gid(skin, "position"), by_gid(every, "position"))
 
 
+def test_periodic_skin_run_equals_rebuild_every_step(tmp_path, monkeypatch):
+    """The same comparison on a bed that is periodic in x and y, where pairs touch across the
+    boundaries of the slab axis: the list is then sorted into slab groups and the carried
+    history is remapped through that sort at every rebuild."""
+    from thermodem.kernels import slabs as SL
+
+    sorts = []
+    original_sort = SL.sort_pairs_by_group
+
+    def counting_sort(*args):
+        sorts.append(1)
+        return original_sort(*args)
+
+    monkeypatch.setattr(SL, "sort_pairs_by_group", counting_sort)
+    rng = np.random.default_rng(7)
+    spacing = 1.99 * R0
+    grid = np.stack(np.meshgrid(np.arange(5), np.arange(5), np.arange(4), indexing="ij"), -1)
+    pos = (grid.reshape(-1, 3) + 0.5) * spacing + rng.uniform(-0.01, 0.01, (100, 3)) * R0
+    rad = rng.uniform(0.95 * R0, R0, len(pos))
+    vel = rng.normal(0.0, 0.2, pos.shape)
+    floor = {"kind": "plane", "material": "grain", "point": [0, 0, 0], "normal": [0, 0, 1]}
+    runs = []
+    for every_step in (False, True):
+        sim = build(
+            tmp_path, pos, rad, vel, lower=(0.0, 0.0, -0.01),
+            upper=(5 * spacing, 5 * spacing, 0.21), periodic=(True, True, False),
+            walls=[floor], neighbors={"skin": 0.05 * R0, "rebuild_every_step": every_step},
+            dt=2e-5, gravity=(0.0, 0.0, -9.81),
+            contact={"normal": "hertz", "tangential": "mindlin", "rolling": "epsd"},
+            tag=f"periodic{every_step}",
+        )  # fmt: skip
+        sim.run(steps=300)
+        runs.append(sim)
+    skin, every = runs
+    assert 3 <= skin.rebuild_count < 100 and every.rebuild_count == 301
+    assert len(sorts) > skin.rebuild_count  # pairs across the slab axis' boundary: sorted
+    assert skin.contact_count > 50
+    for name in ("position", "velocity", "angular_velocity"):
+        np.testing.assert_allclose(
+            by_gid(skin, name), by_gid(every, name), rtol=1e-12, atol=1e-15, err_msg=name
+        )
+
+
 def test_dropping_history_at_rebuild_changes_the_run(tmp_path):
     """The comparison above can fail: losing the history at each rebuild changes the result."""
     steps = 400
