@@ -182,7 +182,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         for parity in range(2):
             for half in prange((ngroups + 1 - parity) // 2):
                 g = 2 * half + parity
-                srow = scratch[g]
+                srow = scratch[g] if heat_on else scratch[0]  # (one row when heat is off)
                 row = chunk_ledger[g]
                 for q in range(row.shape[0]):
                     row[q] = 0.0
@@ -350,7 +350,7 @@ def wall_pair_pass(
     n = radius.shape[0]
     nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
     for c in prange(nchunks):
-        srow = scratch[c]
+        srow = scratch[c] if heat_on else scratch[0]  # (one row when heat is off)
         row = chunk_ledger[c]
         for q in range(row.shape[0]):
             row[q] = 0.0
