@@ -43,6 +43,15 @@ def minimum_image(dx, length, periodic):
     return dx
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def pair_separation(position, i, j, length, periodic):
+    """(dx, dy, dz, distance) from particle i to particle j, minimum image on periodic axes."""
+    dx = minimum_image(position[j, 0] - position[i, 0], length[0], periodic[0])
+    dy = minimum_image(position[j, 1] - position[i, 1], length[1], periodic[1])
+    dz = minimum_image(position[j, 2] - position[i, 2], length[2], periodic[2])
+    return dx, dy, dz, math.sqrt(dx * dx + dy * dy + dz * dz)
+
+
 @njit(cache=True, error_model="numpy")
 def cell_grid(lower, upper, cell_size, periodic):
     """Number of cells per axis (at least 1) and the actual cell edge per axis."""

@@ -43,7 +43,7 @@ from thermodem.kernels.contact import (
     _open_contact,
     contact_response,
 )
-from thermodem.kernels.neighbors import minimum_image, wall_distance
+from thermodem.kernels.neighbors import pair_separation, wall_distance
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
 
@@ -189,10 +189,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                 for k in range(group_start[g], group_start[g + 1]):
                     i = pair_i[k]
                     j = pair_j[k]
-                    dx = minimum_image(position[j, 0] - position[i, 0], length[0], periodic[0])
-                    dy = minimum_image(position[j, 1] - position[i, 1], length[1], periodic[1])
-                    dz = minimum_image(position[j, 2] - position[i, 2], length[2], periodic[2])
-                    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+                    dx, dy, dz, dist = pair_separation(position, i, j, length, periodic)
                     ri = radius[i]
                     rj = radius[j]
                     overlap = ri + rj - dist

@@ -16,7 +16,7 @@ from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
 from thermodem.kernels.contact import CHUNK, STATE_FAR
-from thermodem.kernels.neighbors import minimum_image, wall_distance
+from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance
 
 # per-particle mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
@@ -68,10 +68,7 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
                     continue
                 i = pair_i[k]
                 j = pair_j[k]
-                dx = minimum_image(position[j, 0] - position[i, 0], length[0], periodic[0])
-                dy = minimum_image(position[j, 1] - position[i, 1], length[1], periodic[1])
-                dz = minimum_image(position[j, 2] - position[i, 2], length[2], periodic[2])
-                dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+                dist = pair_separation(position, i, j, length, periodic)[3]
                 ri = radius[i]
                 rj = radius[j]
                 overlap = ri + rj - dist
