@@ -9,7 +9,8 @@ gravity, dt = 5e-6 s) are poured into an open box and settled; the settled bed i
 
 With ``--heat MODEL`` the bed conducts heat (contact radius: geometric) with that direct
 conduction model, solved every ``--substeps`` mechanical steps (default 1: every step, the
-spec's calculation cycle).
+spec's calculation cycle). ``--conductance-tolerance TOL`` sets
+``thermal.conductance_force_tolerance`` (default 0: every contact evaluated at every step).
 
 Settling uses the same materials with a softer damping (e = 0.1) and dt = 1e-5 s to get to rest
 faster; the timed run uses exactly the parameters above.
@@ -69,6 +70,7 @@ def case_dict(
     end_time: float,
     heat: str | None = None,
     substeps: str = "1",
+    tolerance: float = 0.0,
 ) -> dict:
     side, height, fill_height, _ = bed_geometry(n)
     material = {
@@ -101,6 +103,7 @@ def case_dict(
             "gas": HEAT_GAS.get(heat, {}),
             "contact_radius": "geometric",
             "substeps": substeps if substeps == "auto" else int(substeps),
+            "conductance_force_tolerance": tolerance,
             "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * z"},
         }
     if positions_file is None:
@@ -170,19 +173,23 @@ def rss_bytes() -> int:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
-def timed(n: int, steps: int, threads: int, heat: str | None, substeps: str = "1") -> dict:
+def timed(
+    n: int, steps: int, threads: int, heat: str | None, substeps: str = "1", tolerance: float = 0.0
+) -> dict:
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
     bed = settle(n)
     # baseline: interpreter + libraries + compiled kernels on a tiny case
     tiny = Simulation(
-        case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0, heat, substeps)), threads=threads
+        case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0, heat, substeps, tolerance)),
+        threads=threads,
     )
     tiny.run(steps=5)
     baseline = rss_bytes()
     sim = Simulation(
-        case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0, heat, substeps)), threads=threads
+        case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0, heat, substeps, tolerance)),
+        threads=threads,
     )
     sim.run(steps=20)  # warm-up
     # one neighbour rebuild of the full bed, so that the peak memory includes a rebuild's
@@ -199,6 +206,7 @@ def timed(n: int, steps: int, threads: int, heat: str | None, substeps: str = "1
         "threads": threads,
         "heat": heat,
         "substeps": substeps if heat else None,
+        "conductance_force_tolerance": tolerance if heat else None,
         "particle_steps_per_s": n * steps / elapsed,
         "seconds": elapsed,
         "rebuilds": sim.rebuild_count - r0,
@@ -217,11 +225,21 @@ def main() -> None:
     ap.add_argument("--threads", type=int, nargs="*", default=[1, 2])
     ap.add_argument("--heat", default=None, help="direct conduction model (thermal issue)")
     ap.add_argument("--substeps", default="1", help="thermal substeps: an integer or 'auto'")
+    ap.add_argument(
+        "--conductance-tolerance",
+        type=float,
+        default=0.0,
+        help="thermal.conductance_force_tolerance (0: every contact evaluated at every step)",
+    )
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
-        print(json.dumps(timed(args.n, args.steps, args.threads[0], args.heat, args.substeps)))
+        res = timed(
+            args.n, args.steps, args.threads[0], args.heat, args.substeps,
+            args.conductance_tolerance,
+        )  # fmt: skip
+        print(json.dumps(res))
         return
     settle(args.n)  # in this process, so the timed child starts from the cached bed
     results = []
@@ -240,13 +258,19 @@ def main() -> None:
         ]
         if args.heat:
             cmd += ["--heat", args.heat, "--substeps", args.substeps]
+            cmd += ["--conductance-tolerance", str(args.conductance_tolerance)]
         out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
         res = json.loads(out.strip().splitlines()[-1])
         results.append(res)
         if not args.json:
             print(
                 f"N = {res['n']}, threads = {th}"
-                + (f", heat {res['heat']} (substeps {res['substeps']})" if res["heat"] else "")
+                + (
+                    f", heat {res['heat']} (substeps {res['substeps']}, conductance force "
+                    f"tolerance {res['conductance_force_tolerance']:g})"
+                    if res["heat"]
+                    else ""
+                )
                 + f": {res['particle_steps_per_s'] / 1e6:.2f} M "
                 f"particle-steps/s ({res['steps']} steps, {res['rebuilds']} rebuilds, "
                 f"{res['contacts_per_particle']:.2f} contacts/particle, "

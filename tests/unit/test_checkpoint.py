@@ -143,6 +143,20 @@ def periodic_thermal_case() -> dict:
     }
 
 
+def reuse_thermal_case() -> dict:
+    """The periodic bed with the resistance network and the conductance reuse (its state is
+    in the contact history)."""
+    case = periodic_thermal_case()
+    surface = {"microhardness": 3e7, "surface_roughness": 1e-7, "surface_slope": 0.1,
+               "thermal_accommodation": 0.8}  # fmt: skip
+    for material in case["materials"].values():
+        material.update(surface)
+    case["thermal"].update(
+        direct_conduction="resistance_network", conductance_force_tolerance=0.02, substeps=1
+    )
+    return case
+
+
 def _assert_same(a: Simulation, b: Simulation) -> None:
     for name, arr in a.particles.arrays().items():
         assert np.array_equal(arr, getattr(b.particles, name)), name
@@ -162,8 +176,8 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
 
 @pytest.mark.parametrize(
     ("make", "stop", "total"),
-    [(drum_case, 230, 700), (periodic_thermal_case, 101, 400)],
-    ids=["drum-pour-epsd-moving-wall", "periodic-thermal"],
+    [(drum_case, 230, 700), (periodic_thermal_case, 101, 400), (reuse_thermal_case, 101, 400)],
+    ids=["drum-pour-epsd-moving-wall", "periodic-thermal", "periodic-conductance-reuse"],
 )
 def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -> None:
     case = case_from_dict(make())

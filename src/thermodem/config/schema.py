@@ -212,6 +212,7 @@ class Case(StrictModel):
                             f"thermal.{key}.{k}.select.material: unknown material {m!r}; "
                             f"allowed: {allowed}"
                         )
+            self._check_conductance_reuse(th)
             rule = th.initial_temperature
             if rule is not None and rule.kind == "per_material":
                 for m in rule.values:
@@ -221,3 +222,30 @@ class Case(StrictModel):
                             f"allowed: {allowed}"
                         )
         return self
+
+    def _check_conductance_reuse(self, th: ThermalSettings) -> None:
+        """The reuse holds a conductance for a given normal force: the model must depend on
+        the contact through the normal force only, and the conductivities must be constant."""
+        tol = th.conductance_force_tolerance
+        if tol == 0.0:
+            return
+        key = "thermal.conductance_force_tolerance"
+        spec = th.direct_conduction.spec
+        if not spec.extra.get("conductance_from_force"):
+            allowed = [
+                m.name
+                for m in registry.all_models()
+                if m.family == "direct_conduction" and m.extra.get("conductance_from_force")
+            ]
+            raise ValueError(
+                f"{key}: {tol} needs a direct_conduction model whose conductance depends on "
+                f"the contact through the normal force only ({', '.join(allowed)}); "
+                f"{spec.name!r} also depends on the overlap, contact time or impact velocity: "
+                "use 0"
+            )
+        tabled = [n for n, m in self.materials.items() if m.thermal_conductivity_table]
+        if tabled:
+            raise ValueError(
+                f"{key}: {tol} needs constant thermal conductivities, but materials "
+                f"{', '.join(tabled)} have a thermal_conductivity_table: use 0"
+            )

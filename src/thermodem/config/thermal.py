@@ -7,6 +7,7 @@ Example::
       direct_conduction: batchelor_obrien_simple
       gas: {thermal_conductivity: 0.0263}   # the interstitial gas (default: air, 300 K, 1 atm)
       substeps: 1                  # solve heat every n mechanical steps, or "auto"
+      conductance_force_tolerance: 0   # resistance_network: reuse H while F_n is within tol
       initial_temperature: {kind: uniform, value: 293.15}
       fixed_temperature: [{select: {material: heater}, temperature: 400.0}]
       heat_flux: [{select: {region: {lower: [...], upper: [...]}}, flux: 1000.0}]
@@ -204,6 +205,13 @@ class ThermalSettings(StrictModel):
         default=1, description="solve heat every n mechanical steps, or 'auto' from the limit"
     )
     max_substeps: int = Field(default=1000, ge=1)
+    conductance_force_tolerance: float = Field(
+        default=0.0,
+        ge=0,
+        le=0.1,
+        description="reuse a contact's conductance while its normal force stays within this "
+        "relative change of the last evaluation (secant in between); 0: evaluate every step",
+    )
     frozen_mechanics: bool = Field(
         default=False, description="positions and contacts fixed; heat only"
     )

@@ -199,7 +199,7 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
         raise _mismatch("the list of materials", list(s["material_names"]), sim.material_names)
     if int(s["history_width"]) != sim.pairs.history_width:
         raise _mismatch(
-            "the contact history width (rolling model)",
+            "the contact history width (rolling model, thermal.conductance_force_tolerance)",
             int(s["history_width"]),
             sim.pairs.history_width,
         )

@@ -90,6 +90,11 @@ class Simulation:
         self.rolling_table = pair_table(models.rolling, case, self.material_names)
         rolling_history = models.rolling.spec.history_width > 0
         history_width = C.HISTORY_WIDTH_ROLLING if rolling_history else C.HISTORY_WIDTH_BASE
+        if case.thermal is not None and case.thermal.conductance_force_tolerance > 0.0:
+            # the conductance reuse's columns, last (kernels find them from the row's end;
+            # the base width plus them stays below the rolling width, which kernels test)
+            history_width += PP.REUSE_COLUMNS
+            assert C.HISTORY_WIDTH_BASE + PP.REUSE_COLUMNS < C.HISTORY_WIDTH_ROLLING
         # domain and walls
         dom = case.domain
         self.lower = np.asarray(dom.lower, np.float64)
@@ -105,8 +110,8 @@ class Simulation:
         z2 = np.zeros((1, 16))
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
         self._no_heat = (
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1),
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, np.zeros((1, 7)), z1),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
         )
         self.thermal = None
         if case.thermal is not None:
@@ -230,7 +235,7 @@ class Simulation:
             reset_forces(p.force, p.torque, p.mass, self.gravity, True,
                          p.heat_rate_by_mechanism, th.conductance_sum)  # fmt: skip
         else:
-            no_mech, no_sum = self._no_heat[0][-2:]
+            no_mech, no_sum = self._no_heat[0][-3:-1]
             reset_forces(p.force, p.torque, p.mass, self.gravity, False, no_mech, no_sum)
         pair_pass(
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,

@@ -55,6 +55,9 @@ class ThermalEngine:
         names = sim.material_names
         self.radius_id = settings.contact_radius.spec.model_id
         self.conduction_id = settings.direct_conduction.spec.model_id
+        # conductance reuse (0: the model is evaluated at every thermal step), see
+        # docs/models/conductance_reuse.md; the pair histories carry REUSE_COLUMNS more columns
+        self.tolerance = float(settings.conductance_force_tolerance)
         # which materials meet: particle materials with each other and with walls that
         # exchange heat (fixed-temperature walls)
         particle_mats = set(self._particle_materials(case))
@@ -318,14 +321,14 @@ class ThermalEngine:
         return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
                 self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
                 self.scratch, self.sim.particles.heat_rate_by_mechanism,
-                self.conductance_sum)  # fmt: skip
+                self.conductance_sum, self.tolerance)  # fmt: skip
 
     def wall_heat_args(self) -> tuple:
         """Arguments of the fused contact pass (wall pairs) that switch conduction on."""
         return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
                 self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
                 self.k_w, self.rhoc_w, self.scratch, self.sim.particles.heat_rate_by_mechanism,
-                self.conductance_sum)  # fmt: skip
+                self.conductance_sum, self.tolerance)  # fmt: skip
 
     def fused_rows(self, rows: int) -> None:
         """Scratch rows (one per slab group or wall chunk) and the per-particle conductance
@@ -358,14 +361,14 @@ class ThermalEngine:
             pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
             self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
             self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
-            self.pair_heat,
+            self.pair_heat, self.tolerance,
         )  # fmt: skip
         K.conduction_wall_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
             wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
             sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
             self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w, self.rhoc_w,
-            self.scratch, self.wall_conductance, self.wall_heat,
+            self.scratch, self.wall_conductance, self.wall_heat, self.tolerance,
         )  # fmt: skip
         self.conductance_ready = reuse
 

@@ -44,6 +44,7 @@ from thermodem.kernels.contact import (
     contact_response,
 )
 from thermodem.kernels.neighbors import pair_separation, wall_distance
+from thermodem.models import registry
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
 
@@ -52,10 +53,74 @@ M_DIRECT = 0
 M_WALL = 6
 
 
+#: history columns of the conductance reuse (last in the row, present only when
+#: thermal.conductance_force_tolerance > 0): reference normal force (negative: no slope yet),
+#: conductance there, slope dH/dF_n of the secant through the last two evaluations
+REUSE_COLUMNS = 3
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _reused_conductance(k, history, f_n, tolerance):
+    """(H, True) from the stored evaluations of pair k when its normal force f_n > 0 is close
+    to the last evaluated one, else (0, False): the conductance reuse of
+    ``thermal.conductance_force_tolerance`` (docs/models/conductance_reuse.md).
+
+    With a slope: H = H_ref + S (f_n - F_ref) while |f_n - F_ref| <= tol F_ref. Without one
+    (a single evaluation so far, or a jump): H = H_ref while |f_n - F_ref| <= tol² F_ref.
+    """
+    col = history.shape[1] - REUSE_COLUMNS
+    f_ref = history[k, col]
+    df = f_n - abs(f_ref)
+    if f_ref > 0.0:
+        if abs(df) <= tolerance * f_ref:
+            return history[k, col + 1] + history[k, col + 2] * df, True
+    elif f_ref < 0.0 and abs(df) <= -tolerance * tolerance * f_ref:
+        return history[k, col + 1], True
+    return 0.0, False
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _store_evaluation(k, history, f_n, h, tolerance):
+    """Keep the evaluation (f_n, H) of pair k, with the secant slope from the previous one when
+    the two forces are within 2 tol f_n of each other (else: no slope)."""
+    col = history.shape[1] - REUSE_COLUMNS
+    f_ref = abs(history[k, col])
+    df = f_n - f_ref
+    if f_ref > 0.0 and df != 0.0 and abs(df) <= 2.0 * tolerance * f_n:
+        history[k, col + 2] = (h - history[k, col + 1]) / df
+        history[k, col] = f_n
+    else:
+        history[k, col + 2] = 0.0
+        history[k, col] = -f_n
+    history[k, col + 1] = h
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _conductance(
+    k, history, tolerance, ri, rj, dist, overlap, eff_mass, f_n, radius_id, p_radius,
+    conduction_id, p_conduction, override, ki, kj, ci, cj, srow,
+):  # fmt: skip
+    """:func:`pair_conductance` of pair k, or its reuse (``tolerance`` > 0, touching pairs)."""
+    reuse = tolerance > 0.0 and f_n > 0.0
+    if reuse:
+        h, found = _reused_conductance(k, history, f_n, tolerance)
+        if found:
+            return h
+    h = pair_conductance(
+        ri, rj, dist, overlap, eff_mass, f_n, history[k, H_DURATION],
+        history[k, H_IMPACT_VELOCITY], radius_id, p_radius, conduction_id, p_conduction,
+        override, ki, kj, ci, cj, srow,
+    )  # fmt: skip
+    if reuse:
+        _store_evaluation(k, history, f_n, h, tolerance)
+    return h
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _pp_conductance(
     k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history, normal_force, radius_id,
     radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, srow,
+    tolerance,
 ):  # fmt: skip
     ti = type_id[i]
     tj = type_id[j]
@@ -66,10 +131,10 @@ def _pp_conductance(
         if override > 1:
             ci = rhoc_particle[i]
             cj = rhoc_particle[j]
-    return pair_conductance(
-        ri, rj, dist, overlap, eff_mass, normal_force[k],
-        history[k, H_DURATION], history[k, H_IMPACT_VELOCITY], radius_id, radius_table[ti, tj],
-        conduction_id, conduction_table[ti, tj], override, ki, kj, ci, cj, srow,
+    return _conductance(
+        k, history, tolerance, ri, rj, dist, overlap, eff_mass, normal_force[k], radius_id,
+        radius_table[ti, tj], conduction_id, conduction_table[ti, tj], override, ki, kj, ci,
+        cj, srow,
     )  # fmt: skip
 
 
@@ -77,7 +142,7 @@ def _pp_conductance(
 def _pw_conductance(
     k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force, radius_id,
     radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall,
-    rhoc_wall, srow,
+    rhoc_wall, srow, tolerance,
 ):  # fmt: skip
     ti = type_id[i]
     tw = wall_material[w]
@@ -88,11 +153,17 @@ def _pw_conductance(
         if override > 1:
             ci = rhoc_particle[i]
             cw = rhoc_wall[w]
-    return pair_conductance(
-        ri, math.inf, d, overlap, mass[i], normal_force[k], history[k, H_DURATION],
-        history[k, H_IMPACT_VELOCITY], radius_id, radius_table[ti, tw], conduction_id,
-        conduction_table[ti, tw], override, ki, kw, ci, cw, srow,
+    return _conductance(
+        k, history, tolerance, ri, math.inf, d, overlap, mass[i], normal_force[k], radius_id,
+        radius_table[ti, tw], conduction_id, conduction_table[ti, tw], override, ki, kw, ci,
+        cw, srow,
     )  # fmt: skip
+
+
+def reusable(conduction_id: int) -> bool:
+    """Whether the direct-conduction model of this id allows the conductance reuse."""
+    specs = [m for m in registry.all_models() if m.family == "direct_conduction"]
+    return any(m.model_id == conduction_id and m.extra.get("conductance_from_force") for m in specs)
 
 
 _PASSES: dict[tuple[bool, int, int, int], tuple] = {}
@@ -120,6 +191,7 @@ def passes_for(heat_on: bool, radius_id: int, conduction_id: int, override: int)
 
 def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
     """Define the particle pair pass with the model choice captured as constants."""
+    REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
 
     @njit(cache=True, parallel=True, error_model="numpy")
     def particle_pair_pass(
@@ -163,6 +235,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         scratch,
         by_mechanism,
         conductance_sum,
+        tolerance,
     ):
         """Contact forces of every listed particle pair, added to ``force`` and ``torque``
         (see module docstring; the caller sets them to their non-contact values first).
@@ -177,6 +250,8 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         radius_id = RADIUS_ID
         conduction_id = CONDUCTION_ID
         override = OVERRIDE
+        if not REUSABLE:
+            tolerance = 0.0  # (the reuse's code is dropped)
         length = upper - lower
         ngroups = group_start.shape[0] - 1
         for parity in range(2):
@@ -282,6 +357,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
                             conduction_table, override, k_particle, rhoc_particle, srow,
+                            tolerance,
                         )  # fmt: skip
                         q_ij = h * (temperature[j] - temperature[i])
                         by_mechanism[i, M_DIRECT] += q_ij
@@ -336,6 +412,7 @@ def wall_pair_pass(
     scratch,
     by_mechanism,
     conductance_sum,
+    tolerance,
 ):
     """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
     added to ``force`` and ``torque`` after the particle pairs.
@@ -440,7 +517,7 @@ def wall_pair_pass(
                         k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
                         out_normal_force, radius_id, radius_table, conduction_id,
                         conduction_table, override, k_particle, rhoc_particle, k_wall,
-                        rhoc_wall, srow,
+                        rhoc_wall, srow, tolerance,
                     )  # fmt: skip
                 by_mechanism[i, M_WALL] += h * (wrow[COL_TEMPERATURE] - temperature[i])
                 conductance_sum[i] += h

@@ -17,7 +17,7 @@ from numba import njit, prange
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
 from thermodem.kernels.contact import CHUNK, STATE_FAR
 from thermodem.kernels.neighbors import pair_separation, wall_distance
-from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance
+from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance, reusable
 
 # per-particle mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
 M_DIRECT = 0
@@ -41,11 +41,13 @@ def conduction_pair_pass_for(radius_id: int, conduction_id: int, override: int) 
 
 
 def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
+    REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
+
     @njit(cache=True, parallel=True, error_model="numpy")
     def conduction_pair_pass(
         position, radius, mass, temperature, type_id, pair_i, pair_j, npairs, state, normal_force,
         history, lower, upper, periodic, radius_id, radius_table, conduction_id, conduction_table,
-        override, k_particle, rhoc_particle, scratch, out_conductance, out_heat,
+        override, k_particle, rhoc_particle, scratch, out_conductance, out_heat, tolerance,
     ):  # fmt: skip
         """Conductance and heat rate into i of every listed particle pair (near pairs included).
 
@@ -57,6 +59,8 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
         radius_id = RADIUS_ID
         conduction_id = CONDUCTION_ID
         override = OVERRIDE
+        if not REUSABLE:
+            tolerance = 0.0  # (the reuse's code is dropped)
         length = upper - lower
         nchunks = (npairs + CHUNK - 1) // CHUNK
         for c in prange(nchunks):
@@ -76,7 +80,7 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
                     k, i, j, ri, rj, dist, overlap, mass[i] * mass[j] / (mass[i] + mass[j]),
                     type_id, history, normal_force, radius_id,
                     radius_table, conduction_id, conduction_table, override, k_particle,
-                    rhoc_particle, row,
+                    rhoc_particle, row, tolerance,
                 )  # fmt: skip
                 out_conductance[k] = h
                 out_heat[k] = h * (temperature[j] - temperature[i])
@@ -89,7 +93,7 @@ def conduction_wall_pass(
     position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
     normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
     conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
-    scratch, out_conductance, out_heat,
+    scratch, out_conductance, out_heat, tolerance,
 ):  # fmt: skip
     """Heat from fixed-temperature walls into particles (adiabatic walls give zero).
 
@@ -113,7 +117,7 @@ def conduction_wall_pass(
             h = _pw_conductance(
                 k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force,
                 radius_id, radius_table, conduction_id, conduction_table, override, k_particle,
-                rhoc_particle, k_wall, rhoc_wall, row,
+                rhoc_particle, k_wall, rhoc_wall, row, tolerance,
             )  # fmt: skip
             out_conductance[k] = h
             out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])

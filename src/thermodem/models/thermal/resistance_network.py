@@ -118,6 +118,26 @@ def resistance_macrogap(k_g, r_h, r_c, m_gas, b):
 
 
 @njit(cache=True, error_model="numpy")
+def _macro_branch(k_g, r_h, r_c, m_gas, b, res_solid):
+    """1/(R_c + R_G) [W/K]: ``resistance_macrogap`` written as a conductance x = 1/R_G =
+    π k_g [...]/2, so that 1/(R_c + 1/x) = x/(1 + x R_c) takes one division (0 when the gas
+    region is empty, or R_c = inf)."""
+    if r_c >= r_h:
+        return 0.0
+    root = math.sqrt(r_h * r_h - r_c * r_c)
+    big_a = 2.0 * root
+    big_b = b * r_h
+    if big_b >= big_a:
+        return 0.0
+    big_s = 2.0 * (r_h - r_c * r_c / (2.0 * r_h)) + m_gas
+    s_minus_a = m_gas + r_c**4 / (r_h * (r_h + root) ** 2)
+    x = 0.5 * math.pi * k_g * (big_s * math.log((big_s - big_b) / s_minus_a) + big_b - big_a)
+    if res_solid == np.inf:
+        return 0.0
+    return x / (1.0 + x * res_solid)
+
+
+@njit(cache=True, error_model="numpy")
 def resistance_network_conductance(
     k_i, k_j, r_i, r_j, f_n, e_star, c_zhou, h_micro, sigma, tau, k_g, m_gas, b
 ):
@@ -132,7 +152,8 @@ def resistance_network_conductance(
     - ln q gives both erfc⁻¹ from their logarithms, -ln(2q) and -ln(0.03q) (no further log),
       and (H'/P0)^0.96 = exp(-0.96 ln q);
     - R_s and R_g are inverted in closed form; the contact-surface branch is
-      g_L g/(g_L + g) with g_L = 1/R_L = 2 k_h r_c, g = 1/R_s + 1/R_g.
+      g_L g/(g_L + g) with g_L = 1/R_L = 2 k_h r_c, g = 1/R_s + 1/R_g;
+    - the macrogap branch is x/(1 + x R_c), x = 1/R_G (one division).
     """
     r_eff = effective_radius(r_i, r_j)
     r_c = 0.0
@@ -143,7 +164,7 @@ def resistance_network_conductance(
         log_scale = math.log(2.0 * e_star / (math.pi * r_eff * c_zhou * c_zhou * h_micro))
         log_q = min(log_scale + log_u / 3.0, 0.0)
     res_solid = resistance_solid_layer(k_i, r_i, r_c) + resistance_solid_layer(k_j, r_j, r_c)
-    conductance = 1.0 / (res_solid + resistance_macrogap(k_g, 2.0 * r_eff, r_c, m_gas, b))
+    conductance = _macro_branch(k_g, 2.0 * r_eff, r_c, m_gas, b, res_solid)
     if r_c <= 0.0:
         return conductance
     # a1 = erfc⁻¹(min(2q, 1)) (>= 0), a2 = erfc⁻¹(0.03 q) - a1
@@ -153,12 +174,15 @@ def resistance_network_conductance(
         a1 = erfinv_central(1.0 - 2.0 * math.exp(log_q))
     else:
         a1 = 0.0
-    a2 = erfcinv_neg_log(-_LN_0_03 - log_q) - a1
+    a1_plus_a2 = erfcinv_neg_log(-_LN_0_03 - log_q)
     k_h = 2.0 * k_i * k_j / (k_i + k_j)
     area = math.pi * r_c * r_c
     g_s = math.exp(0.96 * log_q) * area * k_h * tau / (1.184 * sigma)  # 1/R_s
     s2 = 2.0 * math.sqrt(2.0) * sigma
-    g_g = k_g * area * math.log1p(a2 / (a1 + m_gas / s2)) / (s2 * a2)  # 1/R_g
+    m_s = m_gas / s2
+    # 1/R_g, with ln(1 + a2/(a1 + M/s2)) = ln(a1 + a2 + M/s2) - ln(a1 + M/s2): two independent
+    # logarithms instead of a division followed by log1p (shorter dependency chain)
+    g_g = k_g * area * (math.log(a1_plus_a2 + m_s) - math.log(a1 + m_s)) / (s2 * (a1_plus_a2 - a1))
     g = g_s + g_g
     g_l = 2.0 * k_h * r_c  # 1/R_L
     return conductance + g_l * g / (g_l + g)
@@ -256,6 +280,8 @@ register(
         "poisson_ratio",
     ),
     swap_pairs=((0, 1), (2, 3)),
+    # H depends on the contact through F_n only: thermal.conductance_force_tolerance allowed
+    conductance_from_force=True,
     # thermal.gas read by pack (k_g; M from Λ, Pr = μ c_p / k_g and γ)
     uses_gas=(
         "thermal_conductivity",
