@@ -5,7 +5,8 @@ groups in parallel, then odd ones; kernels/slabs.py), so every particle receives
 contributions in an order fixed by the list; each group and each chunk of particles writes
 its own ledger row. A run with 1 thread and a run with 2 threads must therefore be
 bit-identical. The bed below has more than 4096 particles and many slab groups, so every
-parallel loop is split between the threads.
+parallel loop is split between the threads. A second run adds heat (resistance network with
+the conductance reuse, whose per-pair state sits after the rolling model's history columns).
 """
 
 from __future__ import annotations
@@ -35,7 +36,18 @@ def write_bed(path: Path) -> None:
     save_particle_file(path, InsertedParticles(pos, rad, vel, None, "grain"))
 
 
-def run(path: Path, threads: int, steps: int) -> tuple[Simulation, list[int]]:
+HEAT = {  # the resistance network with the conductance reuse (state in the pair history,
+    # after the rolling model's columns), a hot floor
+    "microhardness": 3e7,
+    "surface_roughness": 1e-7,
+    "surface_slope": 0.1,
+    "thermal_accommodation": 0.8,
+    "thermal_conductivity": 50.0,
+    "specific_heat": 800.0,
+}
+
+
+def run(path: Path, threads: int, steps: int, heat: bool = False) -> tuple[Simulation, list[int]]:
     numba.set_num_threads(threads)
     upper = [SHAPE[0] * SPACING, SHAPE[1] * SPACING, 0.3]
     case = {
@@ -64,6 +76,14 @@ def run(path: Path, threads: int, steps: int) -> tuple[Simulation, list[int]]:
         ],
         "insertion": [{"kind": "file", "material": "grain", "path": str(path)}],
     }
+    if heat:
+        case["materials"]["grain"].update(HEAT)
+        case["walls"][0]["thermal"] = {"kind": "fixed", "temperature": 400.0}
+        case["thermal"] = {
+            "direct_conduction": "resistance_network",
+            "conductance_force_tolerance": 0.02,
+            "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * x"},
+        }
     sim = Simulation(case_from_dict(case))
     seen: list[int] = []
     sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
@@ -76,13 +96,14 @@ def by_gid(sim: Simulation, name: str) -> np.ndarray:
 
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
-def test_one_and_two_threads_bit_identical(tmp_path):
+@pytest.mark.parametrize("heat", [False, True], ids=["mechanics", "conductance-reuse"])
+def test_one_and_two_threads_bit_identical(tmp_path, heat):
     path = tmp_path / "bed.txt"
     write_bed(path)
     previous = numba.get_num_threads()
     try:
-        one, seen_one = run(path, 1, 60)
-        two, seen_two = run(path, 2, 60)
+        one, seen_one = run(path, 1, 60, heat)
+        two, seen_two = run(path, 2, 60, heat)
     finally:
         numba.set_num_threads(previous)
     assert set(seen_one) == {1} and set(seen_two) == {2}
@@ -91,7 +112,11 @@ def test_one_and_two_threads_bit_identical(tmp_path):
     assert one.pairs.count > 2 * C.CHUNK and one.pairs.ngroups >= 8
     assert one.rebuild_count > 1 and one.contact_count > one.particles.count // 2
     assert one.rebuild_count == two.rebuild_count
-    for name in ("position", "velocity", "angular_velocity", "force", "torque"):
+    names = ["position", "velocity", "angular_velocity", "force", "torque"]
+    if heat:
+        names += ["temperature", "heat_rate_by_mechanism"]
+        assert one.pairs.history_width == C.HISTORY_WIDTH_ROLLING + 3
+    for name in names:
         a = by_gid(one, name)
         b = by_gid(two, name)
         assert np.array_equal(a, b), (name, np.abs(a - b).max())
