@@ -189,6 +189,11 @@ def models(
                 typer.echo(f"    requires materials.*: {', '.join(spec.requires)}")
             if spec.uses_gas:
                 typer.echo(f"    reads thermal.gas: {', '.join(spec.uses_gas)}")
+            if spec.extra.get("conductance_from_force"):
+                typer.echo(
+                    "    allows thermal.conductance_force_tolerance (conductance reuse, "
+                    "docs/models/conductance_reuse.md)"
+                )
             fields = spec.params.model_fields
             if not fields:
                 typer.echo("    parameters: none")

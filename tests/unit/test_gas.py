@@ -203,6 +203,7 @@ def test_validate_and_models_show_the_gas(tmp_path):
     assert "Λ = 6.868e-08 m (from P = 101325 Pa, T = 300 K, d = 3.66e-10 m)" in out.output
     models = CliRunner().invoke(app, ["models", "direct_conduction"])
     assert "reads thermal.gas: thermal_conductivity, specific_heat" in models.output
+    assert models.output.count("allows thermal.conductance_force_tolerance") == 1
 
 
 def test_api_refuses_a_gas_parameter():
