@@ -97,44 +97,33 @@ def resistance_solid_layer(k, r, r_c):
 
 
 @njit(cache=True, error_model="numpy")
-def resistance_macrogap(k_g, r_h, r_c, m_gas, b):
-    """R_G = 2 / (π k_g [S ln((S - B)/(S - A)) + B - A]) [K/W], macrogap gas (Bahrami 2006).
+def macrogap_bracket(r_h, r_c, m_gas, b):
+    """S ln((S - B)/(S - A)) + B - A [m] of the macrogap (Bahrami 2006); 0 when the gas region
+    is empty (r_c >= r_h or B >= A).
 
     A = 2 sqrt(r_h² - r_c²), S = 2 (r_h - r_c²/(2 r_h)) + M, B = b r_h. S - A is evaluated as
-    M + r_c⁴/(r_h (r_h + sqrt(r_h² - r_c²))²) (no cancellation). Infinite when the gas region
-    is empty (B >= A).
+    M + r_c⁴/(r_h (r_h + sqrt(r_h² - r_c²))²) (no cancellation).
     """
     if r_c >= r_h:
-        return np.inf
+        return 0.0
     root = math.sqrt(r_h * r_h - r_c * r_c)
     big_a = 2.0 * root
     big_b = b * r_h
     if big_b >= big_a:
-        return np.inf
+        return 0.0
     big_s = 2.0 * (r_h - r_c * r_c / (2.0 * r_h)) + m_gas
     s_minus_a = m_gas + r_c**4 / (r_h * (r_h + root) ** 2)
-    bracket = big_s * math.log((big_s - big_b) / s_minus_a) + big_b - big_a
-    return 2.0 / (math.pi * k_g * bracket)
+    return big_s * math.log((big_s - big_b) / s_minus_a) + big_b - big_a
 
 
 @njit(cache=True, error_model="numpy")
-def _macro_branch(k_g, r_h, r_c, m_gas, b, res_solid):
-    """1/(R_c + R_G) [W/K]: ``resistance_macrogap`` written as a conductance x = 1/R_G =
-    π k_g [...]/2, so that 1/(R_c + 1/x) = x/(1 + x R_c) takes one division (0 when the gas
-    region is empty, or R_c = inf)."""
-    if r_c >= r_h:
-        return 0.0
-    root = math.sqrt(r_h * r_h - r_c * r_c)
-    big_a = 2.0 * root
-    big_b = b * r_h
-    if big_b >= big_a:
-        return 0.0
-    big_s = 2.0 * (r_h - r_c * r_c / (2.0 * r_h)) + m_gas
-    s_minus_a = m_gas + r_c**4 / (r_h * (r_h + root) ** 2)
-    x = 0.5 * math.pi * k_g * (big_s * math.log((big_s - big_b) / s_minus_a) + big_b - big_a)
-    if res_solid == np.inf:
-        return 0.0
-    return x / (1.0 + x * res_solid)
+def resistance_macrogap(k_g, r_h, r_c, m_gas, b):
+    """R_G = 2 / (π k_g [S ln((S - B)/(S - A)) + B - A]) [K/W], macrogap gas (Bahrami 2006);
+    the bracket by :func:`macrogap_bracket`. Infinite when the gas region is empty."""
+    bracket = macrogap_bracket(r_h, r_c, m_gas, b)
+    if bracket == 0.0:
+        return np.inf
+    return 2.0 / (math.pi * k_g * bracket)
 
 
 @njit(cache=True, error_model="numpy")
@@ -164,7 +153,12 @@ def resistance_network_conductance(
         log_scale = math.log(2.0 * e_star / (math.pi * r_eff * c_zhou * c_zhou * h_micro))
         log_q = min(log_scale + log_u / 3.0, 0.0)
     res_solid = resistance_solid_layer(k_i, r_i, r_c) + resistance_solid_layer(k_j, r_j, r_c)
-    conductance = _macro_branch(k_g, 2.0 * r_eff, r_c, m_gas, b, res_solid)
+    # macrogap branch 1/(R_c + R_G) = x/(1 + x R_c), x = 1/R_G = π k_g bracket/2 (one division;
+    # 0 when the gas region is empty or the solid layers are blocked, R_c = inf)
+    conductance = 0.0
+    if res_solid < np.inf:
+        x = 0.5 * math.pi * k_g * macrogap_bracket(2.0 * r_eff, r_c, m_gas, b)
+        conductance = x / (1.0 + x * res_solid)
     if r_c <= 0.0:
         return conductance
     # a1 = erfc⁻¹(min(2q, 1)) (>= 0), a2 = erfc⁻¹(0.03 q) - a1
