@@ -166,6 +166,15 @@ def _unit(description: str) -> tuple[str, str]:
     return m.group(1), rest
 
 
+_THERMAL_PAIR_FAMILIES = ("direct_conduction", "indirect_conduction")
+_TARGET_TEXT = {
+    "contacts": "touching pairs (contact lists)",
+    "range": "pairs within the model's interaction range (the range pair set)",
+    "external": "an external pair set (e.g. Voronoi neighbours)",
+    "particles": "single particles",
+}
+
+
 @app.command()
 def models(
     family: str | None = typer.Argument(None, help="only this family (e.g. normal)"),
@@ -189,7 +198,12 @@ def models(
                 typer.echo(f"    requires materials.*: {', '.join(spec.requires)}")
             if spec.uses_gas:
                 typer.echo(f"    reads thermal.gas: {', '.join(spec.uses_gas)}")
-            if spec.extra.get("conductance_from_force"):
+            if fam in _THERMAL_PAIR_FAMILIES and spec.name != "none":
+                where = _TARGET_TEXT[spec.target]
+                if spec.interaction_range is not None and spec.target == "contacts":
+                    where += "; pairs across a gap: the range pair set"
+                typer.echo(f"    runs on: {where}")
+            if spec.conductance_from_force:
                 typer.echo(
                     "    allows thermal.conductance_force_tolerance (conductance reuse, "
                     "docs/models/conductance_reuse.md)"

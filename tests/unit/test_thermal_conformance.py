@@ -57,7 +57,7 @@ IDS = [f"{s.family}.{s.name}" for s in SPECS]
 
 
 def params_of(spec):
-    return spec.params(**spec.extra.get("example_params", {}))
+    return spec.params(**spec.example_params)
 
 
 def random_inputs(rng, wall: bool):
@@ -111,7 +111,7 @@ def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
 @pytest.mark.parametrize("wall", [False, True])
 def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
     p = spec.pack(params_of(spec), resolve_pair(MAT_I, MAT_J, is_wall=wall))
-    assert p.dtype == np.float64 and p.shape == (registry.PARAM_WIDTH,)
+    assert p.dtype == np.float64 and p.shape == (spec.width,)
     rng = np.random.default_rng(spec.model_id + 100 * wall)
     dispatch = DISPATCH[spec.family]
     for _ in range(60):
@@ -123,10 +123,10 @@ def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
         if wall:
             continue
         if spec.antisymmetric:
-            swapped = call(spec, spec.kernel, swap_row(p, spec.extra["swap_pairs"]), x, swap=True)
+            swapped = call(spec, spec.kernel, swap_row(p, spec.swap_pairs), x, swap=True)
             assert swapped == -own
         else:
-            assert spec.extra.get("symmetric")
+            assert spec.symmetric
             assert call(spec, spec.kernel, p, x, swap=True) == pytest.approx(own, rel=1e-12)
 
 

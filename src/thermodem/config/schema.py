@@ -231,11 +231,11 @@ class Case(StrictModel):
             return
         key = "thermal.conductance_force_tolerance"
         spec = th.direct_conduction.spec
-        if not spec.extra.get("conductance_from_force"):
+        if not spec.conductance_from_force:
             allowed = [
                 m.name
                 for m in registry.all_models()
-                if m.family == "direct_conduction" and m.extra.get("conductance_from_force")
+                if m.family == "direct_conduction" and m.conductance_from_force
             ]
             raise ValueError(
                 f"{key}: {tol} needs a direct_conduction model whose conductance depends on "

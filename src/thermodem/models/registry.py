@@ -6,10 +6,13 @@ A model is a small Numba-compiled scalar function (its *kernel*) plus:
 - a pydantic parameter schema (SI names, bounds, defaults; the paper cited in its docstring),
 - a ``pack`` function turning the parameters and the two materials that meet into a float64
   row for that type pair (mixing rules are written there, explicitly),
-- metadata: its integer id inside the family (the fused loops switch on it), history width and
+- metadata: its integer id inside the family (the fused loops switch on it), the names of its
+  parameter row's columns (``columns``: the row width comes from them), history width and
   which history entries flip sign when i and j swap, the interaction range beyond contact it
-  needs, the material properties it requires, the properties of the case's interstitial gas
-  (``thermal.gas``, handed to ``pack`` as ``pair.gas``) it reads, and the reference.
+  needs, where it runs (``target``: touching pairs, pairs within a range, an external pair set
+  or single particles), the material properties it requires, the properties of the case's
+  interstitial gas (``thermal.gas``, handed to ``pack`` as ``pair.gas``) it reads, and the
+  reference.
 
 The integer ids are written as constants in the model modules (not assigned at import time) so
 that the compiled dispatchers, which are cached on disk by Numba, never disagree with the
@@ -40,8 +43,15 @@ FAMILIES: tuple[str, ...] = (
     "heat_source",
 )
 
-#: Width of every family's packed parameter row (rows are padded with zeros to this width).
+#: Width of a packed parameter row of a model that does not name its columns (the mechanics
+#: families; their rows are padded with zeros to this width).
 PARAM_WIDTH = 16
+
+#: Where a thermal term runs (see ``docs/architecture.md``, "Heat terms on pair sets"):
+#: ``contacts`` touching pairs of the contact list, ``range`` every pair whose surface gap is
+#: within the model's interaction range (touching pairs included), ``external`` a pair set
+#: given from outside with per-pair inputs (Voronoi faces), ``particles`` single particles.
+TARGETS: tuple[str, ...] = ("contacts", "range", "external", "particles")
 
 
 @dataclass(frozen=True)
@@ -62,7 +72,24 @@ class ModelSpec:
     interaction_range: Callable[..., float] | None = None
     antisymmetric: bool = True
     uses_gas: tuple[str, ...] = ()
-    extra: dict[str, Any] = field(default_factory=dict)
+    columns: tuple[str, ...] | None = None
+    swap_pairs: tuple[tuple[int, int], ...] = ()
+    target: str = "contacts"
+    symmetric: bool = False
+    conductance_from_force: bool = False
+    example_params: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def width(self) -> int:
+        """Width of the packed parameter row: the named columns (at least 1; a model without
+        parameters packs one zero), or PARAM_WIDTH for a model that names no columns."""
+        return PARAM_WIDTH if self.columns is None else max(len(self.columns), 1)
+
+    def column(self, name: str) -> int:
+        """Index of the named column of the packed row (KeyError naming the columns)."""
+        if self.columns is None or name not in self.columns:
+            raise KeyError(f"{self.family}.{self.name} has no column {name!r}: {self.columns}")
+        return self.columns.index(name)
 
 
 _REGISTRY: dict[str, dict[str, ModelSpec]] = {f: {} for f in FAMILIES}
@@ -84,9 +111,23 @@ def register(
     interaction_range: Callable[..., float] | None = None,
     antisymmetric: bool = True,
     uses_gas: tuple[str, ...] = (),
-    **extra: Any,
+    columns: tuple[str, ...] | None = None,
+    swap_pairs: tuple[tuple[int, int], ...] = (),
+    target: str = "contacts",
+    symmetric: bool = False,
+    conductance_from_force: bool = False,
+    example_params: dict[str, Any] | None = None,
 ) -> ModelSpec:
-    """Register a model; the (family, name) and (family, model_id) pairs must be unique."""
+    """Register a model; the (family, name) and (family, model_id) pairs must be unique.
+
+    ``columns`` names the columns of the row ``pack`` returns (``pack`` must return exactly
+    that many values; see :func:`packed`); ``swap_pairs`` the column pairs exchanged when i
+    and j swap; ``target`` where a thermal term runs (:data:`TARGETS`); ``symmetric`` that
+    the kernel's value is unchanged when i and j swap (contact radii);
+    ``conductance_from_force`` that the conductance depends on a contact through its normal
+    force only (allows ``thermal.conductance_force_tolerance``); ``example_params`` parameters
+    the conformance tests use for a model without defaults.
+    """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
     models = _REGISTRY[family]
@@ -99,6 +140,11 @@ def register(
             )
     if len(history_flip) != history_width:
         raise ValueError(f"{family}.{name}: history_flip must have history_width entries")
+    if target not in TARGETS:
+        raise ValueError(f"{family}.{name}: target {target!r} is not one of {TARGETS}")
+    for a, b in swap_pairs:
+        if columns is not None and not (0 <= a < len(columns) and 0 <= b < len(columns)):
+            raise ValueError(f"{family}.{name}: swap pair {(a, b)} outside columns {columns}")
     spec = ModelSpec(
         family=family,
         name=name,
@@ -114,7 +160,12 @@ def register(
         interaction_range=interaction_range,
         antisymmetric=antisymmetric,
         uses_gas=tuple(uses_gas),
-        extra=dict(extra),
+        columns=None if columns is None else tuple(columns),
+        swap_pairs=tuple((int(a), int(b)) for a, b in swap_pairs),
+        target=target,
+        symmetric=symmetric,
+        conductance_from_force=conductance_from_force,
+        example_params=dict(example_params or {}),
     )
     models[name] = spec
     return spec
@@ -157,8 +208,23 @@ def unknown_name_message(family: str, name: str) -> str:
     return f"unknown {family} model {name!r}{hint} allowed: {', '.join(choices)}"
 
 
+def packed(columns: tuple[str, ...], values: dict[str, float]) -> np.ndarray:
+    """The float64 row of a model with named ``columns`` from ``{column name: value}``.
+
+    Every column must be given, and nothing else: a misspelt or missing name is an error here,
+    not a silent zero in a kernel.
+    """
+    missing = [c for c in columns if c not in values]
+    unknown = [k for k in values if k not in columns]
+    if missing or unknown:
+        raise ValueError(f"row of columns {columns}: missing {missing}, unknown {unknown}")
+    row = np.array([float(values[c]) for c in columns], dtype=np.float64)
+    return row if row.size else np.zeros(1)
+
+
 def pad_row(values: list[float] | tuple[float, ...] | np.ndarray) -> np.ndarray:
-    """A float64 parameter row of width PARAM_WIDTH from the first values."""
+    """A float64 parameter row of width PARAM_WIDTH from the first values (models without
+    named columns)."""
     row = np.zeros(PARAM_WIDTH, dtype=np.float64)
     values = np.asarray(values, dtype=np.float64)
     if values.size > PARAM_WIDTH:

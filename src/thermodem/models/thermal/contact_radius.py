@@ -30,7 +30,7 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
-from thermodem.models.registry import pad_row, register
+from thermodem.models.registry import packed, register
 from thermodem.state.materials import Material, PairContext, effective_youngs_modulus
 
 NONE = 0
@@ -43,6 +43,18 @@ MORRIS2016_AREA = 6
 MORRIS2016_AREA_TIME = 7
 
 FAMILY = "contact_radius"
+
+# Named columns of the packed rows (``register(columns=...)``; kernels index ``p`` by these).
+HERTZ_FORCE_COLUMNS = ("e_star",)
+HF_E_STAR = 0
+ZHOU2010_COLUMNS = ("e_star", "correction_factor", "from_force")
+Z10_E_STAR, Z10_FACTOR, Z10_FROM_FORCE = 0, 1, 2
+LU2017_COLUMNS = ("normal_stiffness", "e_star_real")
+LU_STIFFNESS, LU_E_STAR_REAL = 0, 1
+MORRIS_AREA_COLUMNS = ("e_star_real",)
+MA_E_STAR_REAL = 0
+MORRIS_AREA_TIME_COLUMNS = ("e_star_real", "e_star", "linear_law", "normal_stiffness")
+MAT_E_STAR_REAL, MAT_E_STAR, MAT_LINEAR, MAT_STIFFNESS = 0, 1, 2, 3
 
 
 # ------------------------------------------------------------------ shared scalar helpers
@@ -112,7 +124,7 @@ class NoneParams(StrictModel):
 
 
 def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
-    return pad_row([])
+    return packed((), {})
 
 
 @njit(cache=True, error_model="numpy")
@@ -129,7 +141,7 @@ class GeometricParams(StrictModel):
 
 
 def pack_geometric(params: GeometricParams, pair: PairContext) -> np.ndarray:
-    return pad_row([])
+    return packed((), {})
 
 
 @njit(cache=True, error_model="numpy")
@@ -144,14 +156,14 @@ class HertzForceParams(StrictModel):
 
 
 def pack_hertz_force(params: HertzForceParams, pair: PairContext) -> np.ndarray:
-    return pad_row([pair.effective_youngs_modulus])
+    return packed(HERTZ_FORCE_COLUMNS, {"e_star": pair.effective_youngs_modulus})
 
 
 @njit(cache=True, error_model="numpy")
 def hertz_force_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
-    return hertz_radius_from_force(f_n, effective_radius(r_i, r_j), p[0])
+    return hertz_radius_from_force(f_n, effective_radius(r_i, r_j), p[HF_E_STAR])
 
 
 # ---------------------------------------------------------------------- Hertz (overlap)
@@ -160,7 +172,7 @@ class HertzOverlapParams(StrictModel):
 
 
 def pack_hertz_overlap(params: HertzOverlapParams, pair: PairContext) -> np.ndarray:
-    return pad_row([])
+    return packed((), {})
 
 
 @njit(cache=True, error_model="numpy")
@@ -190,7 +202,8 @@ def pack_zhou2010(params: Zhou2010Params, pair: PairContext) -> np.ndarray:
     e_sim = pair.effective_youngs_modulus
     e_real = effective_youngs_modulus_real(pair, "contact_radius.zhou2010")
     mode = 1.0 if params.hertz_from == "force" else 0.0
-    return pad_row([e_sim, (e_sim / e_real) ** 0.2, mode])
+    values = {"e_star": e_sim, "correction_factor": (e_sim / e_real) ** 0.2, "from_force": mode}
+    return packed(ZHOU2010_COLUMNS, values)
 
 
 @njit(cache=True, error_model="numpy")
@@ -198,9 +211,9 @@ def zhou2010_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff)
     if overlap <= 0.0:
         return 0.0
     r_eff = effective_radius(r_i, r_j)
-    if p[2] == 1.0:
-        return p[1] * hertz_radius_from_force(f_n, r_eff, p[0])
-    return p[1] * math.sqrt(r_eff * overlap)
+    if p[Z10_FROM_FORCE] == 1.0:
+        return p[Z10_FACTOR] * hertz_radius_from_force(f_n, r_eff, p[Z10_E_STAR])
+    return p[Z10_FACTOR] * math.sqrt(r_eff * overlap)
 
 
 # ------------------------------------------------------------------------------ Lu 2017
@@ -229,14 +242,16 @@ class Lu2017Params(StrictModel):
 
 def pack_lu2017(params: Lu2017Params, pair: PairContext) -> np.ndarray:
     e_real = effective_youngs_modulus_real(pair, "contact_radius.lu2017")
-    return pad_row([params.normal_stiffness, e_real])
+    values = {"normal_stiffness": params.normal_stiffness, "e_star_real": e_real}
+    return packed(LU2017_COLUMNS, values)
 
 
 @njit(cache=True, error_model="numpy")
 def lu2017_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
-    return hertz_radius_from_force(p[0] * overlap, effective_radius(r_i, r_j), p[1])
+    f_spring = p[LU_STIFFNESS] * overlap
+    return hertz_radius_from_force(f_spring, effective_radius(r_i, r_j), p[LU_E_STAR_REAL])
 
 
 # ------------------------------------------------------------------------ Morris 2016a
@@ -251,14 +266,15 @@ class Morris2016AreaParams(StrictModel):
 
 
 def pack_morris2016_area(params: Morris2016AreaParams, pair: PairContext) -> np.ndarray:
-    return pad_row([effective_youngs_modulus_real(pair, "contact_radius.morris2016_area")])
+    e_real = effective_youngs_modulus_real(pair, "contact_radius.morris2016_area")
+    return packed(MORRIS_AREA_COLUMNS, {"e_star_real": e_real})
 
 
 @njit(cache=True, error_model="numpy")
 def morris2016_area_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0:
         return 0.0
-    return hertz_radius_from_force(f_n, effective_radius(r_i, r_j), p[0])
+    return hertz_radius_from_force(f_n, effective_radius(r_i, r_j), p[MA_E_STAR_REAL])
 
 
 class Morris2016AreaTimeParams(StrictModel):
@@ -294,7 +310,9 @@ def pack_morris2016_area_time(params: Morris2016AreaTimeParams, pair: PairContex
             "contact_radius.morris2016_area_time with contact_law 'linear' needs normal_stiffness"
         )
     k_n = params.normal_stiffness or 0.0
-    return pad_row([e_real, pair.effective_youngs_modulus, 1.0 if linear else 0.0, k_n])
+    values = {"e_star_real": e_real, "e_star": pair.effective_youngs_modulus,
+              "linear_law": 1.0 if linear else 0.0, "normal_stiffness": k_n}  # fmt: skip
+    return packed(MORRIS_AREA_TIME_COLUMNS, values)
 
 
 @njit(cache=True, error_model="numpy")
@@ -302,16 +320,16 @@ def morris2016_area_time_radius(p, r_i, r_j, dist, overlap, f_n, t_contact, v_im
     if overlap <= 0.0:
         return 0.0
     r_eff = effective_radius(r_i, r_j)
-    radius = hertz_radius_from_force(f_n, r_eff, p[0])
+    radius = hertz_radius_from_force(f_n, r_eff, p[MAT_E_STAR_REAL])
     if v_impact <= 0.0:
         return radius
-    if p[2] == 1.0:
-        t_sim = math.pi * math.sqrt(m_eff / p[3])
+    if p[MAT_LINEAR] == 1.0:
+        t_sim = math.pi * math.sqrt(m_eff / p[MAT_STIFFNESS])
     else:
-        t_sim = hertz_collision_time(m_eff, r_eff, p[1], v_impact)
+        t_sim = hertz_collision_time(m_eff, r_eff, p[MAT_E_STAR], v_impact)
     if t_contact >= t_sim:
         return radius
-    t_real = hertz_collision_time(m_eff, r_eff, p[0], v_impact)
+    t_real = hertz_collision_time(m_eff, r_eff, p[MAT_E_STAR_REAL], v_impact)
     return radius * (t_real / t_sim) ** (2.0 / 3.0)
 
 
@@ -342,11 +360,13 @@ def contact_radius_dispatch(model_id, p, r_i, r_j, dist, overlap, f_n, t_contact
 
 # --------------------------------------------------------------------------- registration
 _COMMON = dict(family=FAMILY, antisymmetric=False, symmetric=True, swap_pairs=())
+_NO_COLUMNS = ()
 _HERTZ = "Hertz (1882); Johnson (1985) Contact Mechanics, CUP"
 _REAL = ("youngs_modulus", "poisson_ratio", "youngs_modulus_real")
 
 register(
     name="none",
+    columns=_NO_COLUMNS,
     model_id=NONE,
     kernel=none_radius,
     params=NoneParams,
@@ -357,6 +377,7 @@ register(
 )
 register(
     name="geometric",
+    columns=_NO_COLUMNS,
     model_id=GEOMETRIC,
     kernel=geometric_radius,
     params=GeometricParams,
@@ -367,6 +388,7 @@ register(
 )
 register(
     name="hertz_force",
+    columns=HERTZ_FORCE_COLUMNS,
     model_id=HERTZ_FORCE,
     kernel=hertz_force_radius,
     params=HertzForceParams,
@@ -378,6 +400,7 @@ register(
 )
 register(
     name="hertz_overlap",
+    columns=_NO_COLUMNS,
     model_id=HERTZ_OVERLAP,
     kernel=hertz_overlap_radius,
     params=HertzOverlapParams,
@@ -388,6 +411,7 @@ register(
 )
 register(
     name="zhou2010",
+    columns=ZHOU2010_COLUMNS,
     model_id=ZHOU2010,
     kernel=zhou2010_radius,
     params=Zhou2010Params,
@@ -399,6 +423,7 @@ register(
 )
 register(
     name="lu2017",
+    columns=LU2017_COLUMNS,
     model_id=LU2017,
     kernel=lu2017_radius,
     params=Lu2017Params,
@@ -411,6 +436,7 @@ register(
 )
 register(
     name="morris2016_area",
+    columns=MORRIS_AREA_COLUMNS,
     model_id=MORRIS2016_AREA,
     kernel=morris2016_area_radius,
     params=Morris2016AreaParams,
@@ -422,6 +448,7 @@ register(
 )
 register(
     name="morris2016_area_time",
+    columns=MORRIS_AREA_TIME_COLUMNS,
     model_id=MORRIS2016_AREA_TIME,
     kernel=morris2016_area_time_radius,
     params=Morris2016AreaTimeParams,

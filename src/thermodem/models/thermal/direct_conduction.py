@@ -16,9 +16,12 @@ exactly commutative operations (a + b, a * b, min) of the two sides' terms, so s
 j — temperatures, radii and the row columns listed in ``swap_pairs`` (see :func:`swap_row`) —
 negates the result bit for bit, and it is 0 at equal temperatures.
 
-Row layout shared by the family: [k_i, k_j, (ρc)_i, (ρc)_j, model-specific symmetric values...],
-``swap_pairs = ((0, 1), (2, 3))``. The static kernels read only columns 0-1, which is what
-lets the collisional models call them with their own row.
+Row layout shared by the family: the named columns ``k_i, k_j, rhoc_i, rhoc_j`` first
+(:data:`HEAD`, indices :data:`K_I`, :data:`K_J`, :data:`RHOC_I`, :data:`RHOC_J`), then each
+model's own symmetric columns, named in its ``register(columns=...)`` and indexed by module
+constants; ``swap_pairs = ((0, 1), (2, 3))``. The static kernels read only ``k_i`` and ``k_j``,
+which is what lets the collisional models call them with their own row, and the k(T)/ρc(T)
+override of the engine replaces exactly these four columns.
 
 Kernels are compiled with ``error_model="numpy"``: they never raise (a division by zero gives
 inf/NaN, which the NaN flag of the pair loop catches), as the architecture asks of kernels.
@@ -38,7 +41,7 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
-from thermodem.models.registry import pad_row, register
+from thermodem.models.registry import packed, register
 from thermodem.models.thermal.contact_radius import (
     effective_radius,
     hertz_collision_time,
@@ -65,6 +68,18 @@ ZHOU2008 = 8
 FAMILY = "direct_conduction"
 SWAP_PAIRS = ((0, 1), (2, 3))
 
+#: The columns every row of the family starts with (the override replaces them).
+HEAD = ("k_i", "k_j", "rhoc_i", "rhoc_j")
+K_I, K_J, RHOC_I, RHOC_J = 0, 1, 2, 3
+#: Batchelor & O'Brien complete (and modified: one column more).
+BOB_COLUMNS = (*HEAD, "k_f", "blend", "cylinder_ratio", "cutoff_gap_ratio")
+BOB_K_F, BOB_BLEND, BOB_CYLINDER_RATIO, BOB_CUTOFF_RATIO = 4, 5, 6, 7
+BOB_MODIFIED_COLUMNS = (*BOB_COLUMNS, "dai2019_cylinder")
+BOB_DAI2019 = 8
+#: Collisional models (Sun & Chen, Zhou).
+COLLISIONAL_COLUMNS = (*HEAD, "e_star", "correction_factor", "static_model")
+COL_E_STAR, COL_CORRECTION, COL_STATIC_MODEL = 4, 5, 6
+
 BLEND_SPEC_LINEAR = 0
 BLEND_HERMITE = 1
 _BLENDS = {"spec_linear": BLEND_SPEC_LINEAR, "hermite": BLEND_HERMITE}
@@ -86,13 +101,18 @@ def _heat_capacities(pair: PairContext, model: str) -> list[float]:
     return [m.density * require(m, "specific_heat", model) for m in (pair.mat_i, pair.mat_j)]
 
 
+def head_values(k: list[float], rhoc: tuple[float, float] = (0.0, 0.0)) -> dict[str, float]:
+    """The family's head columns from the two conductivities (and heat capacities)."""
+    return {"k_i": k[0], "k_j": k[1], "rhoc_i": rhoc[0], "rhoc_j": rhoc[1]}
+
+
 # --------------------------------------------------------------------------------- none
 class NoneParams(StrictModel):
     """No direct conduction."""
 
 
 def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
-    return pad_row([])
+    return packed(HEAD, head_values([0.0, 0.0]))
 
 
 @njit(cache=True, error_model="numpy")
@@ -116,7 +136,7 @@ class BatchelorOBrienSimpleParams(StrictModel):
 def bob_simple_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     if overlap <= 0.0 or r_c <= 0.0:
         return 0.0
-    k_bar = p[0] * p[1] / (p[0] + p[1])
+    k_bar = p[K_I] * p[K_J] / (p[K_I] + p[K_J])
     return 4.0 * k_bar * r_c * (t_j - t_i)
 
 
@@ -210,8 +230,10 @@ def pack_bob_complete(params: BatchelorOBrienCompleteParams, pair: PairContext) 
     k_i, k_j = _conductivities(pair, model)
     k_f = pair.gas.thermal_conductivity
     _check_kpf(k_i, k_j, k_f, model)
-    values = [k_f, _BLENDS[params.blend], params.cylinder_radius]
-    return pad_row([k_i, k_j, 0.0, 0.0, *values, params.cutoff_gap_ratio])
+    values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
+                                        "cylinder_ratio": params.cylinder_radius,
+                                        "cutoff_gap_ratio": params.cutoff_gap_ratio}  # fmt: skip
+    return packed(BOB_COLUMNS, values)
 
 
 def bob_interaction_range(params: StrictModel, radius_i: float, radius_j: float) -> float:
@@ -223,8 +245,10 @@ def bob_interaction_range(params: StrictModel, radius_i: float, radius_j: float)
 @njit(cache=True, error_model="numpy")
 def bob_complete_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     r_eff = effective_radius(r_i, r_j)
-    k_p = 2.0 * p[0] * p[1] / (p[0] + p[1])
-    h = bob_conductance(k_p, p[4], r_eff, max(r_c, 0.0), overlap, p[5], p[6] * r_eff, p[7] * r_eff)
+    k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
+    r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
+    cutoff = p[BOB_CUTOFF_RATIO] * r_eff
+    h = bob_conductance(k_p, p[BOB_K_F], r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff)
     return h * (t_j - t_i)
 
 
@@ -253,24 +277,29 @@ def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) 
     ratio = 0.0 if dai else float(params.cylinder_radius)
     if not dai and ratio <= 0.0:
         raise ValueError(f"{model}: cylinder_radius must be > 0 or 'dai2019', got {ratio}")
-    values = [k_f, _BLENDS[params.blend], ratio, params.cutoff_gap_ratio]
-    return pad_row([k_i, k_j, 0.0, 0.0, *values, 1.0 if dai else 0.0])
+    values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
+                                        "cylinder_ratio": ratio,
+                                        "cutoff_gap_ratio": params.cutoff_gap_ratio,
+                                        "dai2019_cylinder": 1.0 if dai else 0.0}  # fmt: skip
+    return packed(BOB_MODIFIED_COLUMNS, values)
 
 
 @njit(cache=True, error_model="numpy")
 def bob_modified_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     r_eff = effective_radius(r_i, r_j)
-    k_p = 2.0 * p[0] * p[1] / (p[0] + p[1])
-    if p[8] == 1.0:
-        r_cyl = 1.3121 * (k_p / p[4]) ** -0.19 * min(r_i, r_j)
+    k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
+    k_f = p[BOB_K_F]
+    if p[BOB_DAI2019] == 1.0:
+        r_cyl = 1.3121 * (k_p / k_f) ** -0.19 * min(r_i, r_j)
     else:
-        r_cyl = p[6] * r_eff
-    h_bob = bob_conductance(k_p, p[4], r_eff, max(r_c, 0.0), overlap, p[5], r_cyl, p[7] * r_eff)
+        r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
+    cutoff = p[BOB_CUTOFF_RATIO] * r_eff
+    h_bob = bob_conductance(k_p, k_f, r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff)
     if h_bob <= 0.0:
         return 0.0
     area = math.pi * r_cyl * r_cyl
-    res_i = r_i / (p[0] * area)
-    res_j = 0.0 if math.isinf(r_j) else r_j / (p[1] * area)
+    res_i = r_i / (p[K_I] * area)
+    res_j = 0.0 if math.isinf(r_j) else r_j / (p[K_J] * area)
     return (t_j - t_i) / ((res_i + res_j) + 1.0 / h_bob)
 
 
@@ -288,8 +317,8 @@ def thermal_pipe_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact,
         return 0.0
     area = math.pi * r_c * r_c
     if math.isinf(r_j):
-        return p[0] * area / (r_i - overlap) * (t_j - t_i)
-    k_h = 2.0 * p[0] * p[1] / (p[0] + p[1])
+        return p[K_I] * area / (r_i - overlap) * (t_j - t_i)
+    k_h = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
     return k_h * area / ((r_i + r_j) - overlap) * (t_j - t_i)
 
 
@@ -306,8 +335,8 @@ def qrc2020_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_im
         return 0.0
     area = math.pi * r_c * r_c
     if math.isinf(r_j):
-        return p[0] * area / r_i * (t_j - t_i)
-    k_tilde = (r_i + r_j) / (r_i / p[0] + r_j / p[1])
+        return p[K_I] * area / r_i * (t_j - t_i)
+    k_tilde = (r_i + r_j) / (r_i / p[K_I] + r_j / p[K_J])
     return k_tilde * area / ((r_i + r_j) - overlap) * (t_j - t_i)
 
 
@@ -323,8 +352,8 @@ def rojek2014_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_
     if overlap <= 0.0:
         return 0.0
     if math.isinf(r_j):
-        return 2.0 * p[0] * r_i * (t_j - t_i)
-    k_h = 2.0 * p[0] * p[1] / (p[0] + p[1])
+        return 2.0 * p[K_I] * r_i * (t_j - t_i)
+    k_h = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
     return k_h * 0.5 * (r_i + r_j) * (t_j - t_i)
 
 
@@ -411,10 +440,10 @@ class Zhou2008Params(StrictModel):
 
 
 def _pack_collisional(params: StrictModel, pair: PairContext, model: str, c: float) -> np.ndarray:
-    k_i, k_j = _conductivities(pair, model)
-    rc_i, rc_j = _heat_capacities(pair, model)
-    e_star = pair.effective_youngs_modulus
-    return pad_row([k_i, k_j, rc_i, rc_j, e_star, c, _STATIC_MODELS[params.static_model]])
+    values = head_values(_conductivities(pair, model), _heat_capacities(pair, model))
+    values |= {"e_star": pair.effective_youngs_modulus, "correction_factor": c,
+               "static_model": _STATIC_MODELS[params.static_model]}  # fmt: skip
+    return packed(COLLISIONAL_COLUMNS, values)
 
 
 def pack_sun_chen1988(params: SunChen1988Params, pair: PairContext) -> np.ndarray:
@@ -437,22 +466,24 @@ def collisional_rate(
         return 0.0
     r_eff = effective_radius(r_i, r_j)
     if v_impact > 0.0 and m_eff > 0.0:
-        t_c = hertz_collision_time(m_eff, r_eff, p[4], v_impact)
+        e_star = p[COL_E_STAR]
+        t_c = hertz_collision_time(m_eff, r_eff, e_star, v_impact)
         if t_contact < t_c:
-            r_max = hertz_max_contact_radius(m_eff, r_eff, p[4], v_impact)
+            r_max = hertz_max_contact_radius(m_eff, r_eff, e_star, v_impact)
             if r_max <= 0.0:  # v_impact so small that R_c^max underflows: Q -> 0
                 return 0.0
-            effusivity = 1.0 / math.sqrt(p[2] * p[0]) + 1.0 / math.sqrt(p[3] * p[1])
+            k_i, k_j, rhoc_i, rhoc_j = p[K_I], p[K_J], p[RHOC_I], p[RHOC_J]
+            effusivity = 1.0 / math.sqrt(rhoc_i * k_i) + 1.0 / math.sqrt(rhoc_j * k_j)
             if zhou:
                 area = r_max * r_max
-                c_i = zhou2008_coefficient(p[2] / p[3], p[0] * t_c / (p[2] * area))
-                c_j = zhou2008_coefficient(p[3] / p[2], p[1] * t_c / (p[3] * area))
+                c_i = zhou2008_coefficient(rhoc_i / rhoc_j, k_i * t_c / (rhoc_i * area))
+                c_j = zhou2008_coefficient(rhoc_j / rhoc_i, k_j * t_c / (rhoc_j * area))
                 c = 0.5 * (c_i + c_j)
             else:
-                c = 0.87 * p[5]
+                c = 0.87 * p[COL_CORRECTION]
             return c * math.pi * r_max * r_max / (math.sqrt(t_c) * effusivity) * (t_j - t_i)
     args = (t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff)
-    return static_rate(int(p[6]), p, *args)
+    return static_rate(int(p[COL_STATIC_MODEL]), p, *args)
 
 
 @njit(cache=True, error_model="numpy")
@@ -465,6 +496,27 @@ def sun_chen1988_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact,
 def zhou2008_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     args = (t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff)
     return collisional_rate(p, *args, True)
+
+
+# ----------------------------------------------------------- separated pairs (range set)
+@njit(cache=True, inline="always", error_model="numpy")
+def separated_conductance(model_id, p, r_i, r_j, dist):
+    """Conductance H [W/K] of the *separated-pair* part of a direct model that conducts across
+    a gap (those registered with an ``interaction_range``: Batchelor & O'Brien complete and
+    modified), 0 for touching pairs and other models.
+
+    The engine evaluates it on the range pair set (pairs within the model's largest gap), and
+    the contact pass evaluates the same kernels on touching pairs only, so no pair is counted
+    twice. A wall is ``r_j = inf`` with ``dist`` the centre-to-wall distance.
+    """
+    overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
+    if overlap >= 0.0:
+        return 0.0
+    if model_id == BATCHELOR_OBRIEN_COMPLETE:
+        return bob_complete_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+    elif model_id == BATCHELOR_OBRIEN_MODIFIED:
+        return bob_modified_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+    return 0.0
 
 
 # ---------------------------------------------------------------------------- dispatcher
@@ -506,9 +558,10 @@ def _register(name, model_id, kernel, params, summary, reference, pack=None, **k
     """register() with this family's swap pairs; default pack: [k_i, k_j]."""
 
     def pack_k(params: StrictModel, pair: PairContext) -> np.ndarray:
-        return pad_row(_conductivities(pair, f"{FAMILY}.{name}"))
+        return packed(HEAD, head_values(_conductivities(pair, f"{FAMILY}.{name}")))
 
     kw.setdefault("requires", ("thermal_conductivity",))
+    kw.setdefault("columns", HEAD)
     register(family=FAMILY, name=name, model_id=model_id, kernel=kernel, params=params,
              pack=pack or pack_k, summary=summary, reference=reference, swap_pairs=SWAP_PAIRS,
              **kw)  # fmt: skip
@@ -526,7 +579,7 @@ _register(
     BatchelorOBrienCompleteParams,
     "Batchelor & O'Brien contact (η regimes) and separated-particle conduction",
     _BOB + "; Dai, Hanaor & Gan (2019); Moscardini et al. (2018)",
-    pack_bob_complete, interaction_range=bob_interaction_range,
+    pack_bob_complete, interaction_range=bob_interaction_range, columns=BOB_COLUMNS,
     uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(
@@ -535,7 +588,7 @@ _register(
     "Batchelor & O'Brien in series with the particles' inner resistances (Yun & Evans)",
     "Yun & Evans (2010) Comput. Geotech. 37, 991-998; Dai, Hanaor & Gan (2019) Int. J. Therm. "
     "Sci. 142, 266-279",
-    pack_bob_modified, interaction_range=bob_interaction_range,
+    pack_bob_modified, interaction_range=bob_interaction_range, columns=BOB_MODIFIED_COLUMNS,
     uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(
@@ -557,11 +610,11 @@ _register(
     "sun_chen1988", SUN_CHEN1988, sun_chen1988_rate, SunChen1988Params,
     "collisional conduction U/t_c of a Hertz impact, then a static model after t_c",
     "Sun & Chen (1988) Int. J. Heat Mass Transf. 31, 969-975; Zhou, Yu & Zulli (2009)",
-    pack_sun_chen1988, requires=_COLL,
+    pack_sun_chen1988, requires=_COLL, columns=COLLISIONAL_COLUMNS,
 )  # fmt: skip
 _register(
     "zhou2008", ZHOU2008, zhou2008_rate, Zhou2008Params,
     "collisional conduction with Zhou's explicit C(Fo), then a static model after t_c",
     "Zhou, Yu & Horio (2008) Chem. Eng. J. 139, 510-516; Zhou, Yu & Zulli (2009)",
-    pack_zhou2008, requires=_COLL,
+    pack_zhou2008, requires=_COLL, columns=COLLISIONAL_COLUMNS,
 )  # fmt: skip
