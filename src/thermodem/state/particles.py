@@ -3,7 +3,7 @@
 Every per-particle quantity is a contiguous NumPy array with the particle as first index.
 ``global_id`` is the stable identity of a particle (history keys, restarts, output); the array
 order changes when the neighbour list sorts particles by cell. ``heat_rate_by_mechanism`` has
-one column per heat transfer mechanism (:data:`HEAT_MECHANISMS`).
+one column per heat transfer mechanism (:data:`thermodem.state.heat.MECHANISMS`).
 """
 
 from __future__ import annotations
@@ -12,16 +12,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-#: Columns of ``heat_rate_by_mechanism`` [W].
-HEAT_MECHANISMS: tuple[str, ...] = (
-    "direct_conduction",
-    "indirect_conduction",
-    "convection",
-    "radiation",
-    "generation",
-    "source",
-    "wall",
-)
+from thermodem.state.heat import HEAT_MECHANISMS  # the columns, defined in state/heat.py
 
 
 @dataclass
@@ -72,7 +63,7 @@ class Particles:
         """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R².
 
         ``mechanisms`` is the number of columns of ``heat_rate_by_mechanism``: all of
-        :data:`HEAT_MECHANISMS` with a thermal engine, 0 for mechanics only (56 B/particle less).
+        :data:`HEAT_MECHANISMS` with a thermal engine, 0 for mechanics only (64 B/particle less).
         """
         n = radius.shape[0]
         radius = np.ascontiguousarray(radius, dtype=np.float64)
