@@ -202,7 +202,12 @@ def test_thermal_columns_and_plots(tmp_path: Path) -> None:
     out = tmp_path / "hot"
     run_case(case_from_dict(pour_case(thermal=True)), out, **_quiet())
     series = read_timeseries(out / "timeseries.csv")
-    for column in ("temperature_mean", "temperature_max", "heat_wall_heat", "heat_balance_error"):
+    for column in (
+        "temperature_mean",
+        "temperature_max",
+        "heat_in_wall_direct_conduction",
+        "heat_balance_error",
+    ):
         assert column in series, column
     assert series["temperature_max"][-1] > series["temperature_max"][0]
     result = CliRunner().invoke(app, ["plot", str(out)])

@@ -21,6 +21,7 @@ from thermodem.engine.simulation import Simulation
 from thermodem.kernels.contact import STATE_TOUCHING
 from thermodem.kernels.pair_pass import REUSE_COLUMNS
 from thermodem.models.thermal.resistance_network import resistance_network_conductance
+from thermodem.state import heat
 
 R = 1e-3
 TOL = 0.02
@@ -144,7 +145,10 @@ def test_conductances_with_reuse_stay_within_the_bound_of_the_exact_model(
         reused += int((np.abs(pb.history[: pb.count, col])[on] != f[on]).sum())
         pair_h, wall_h, exact_rate, scale = _exact(sim)
         engine = sim.particles.heat_rate_by_mechanism
-        excess = np.abs(engine[:, 0] + engine[:, 6] - exact_rate) - TOL**2 * scale
+        excess = (
+            np.abs(engine[:, heat.M_DIRECT] + engine[:, heat.M_WALL_DIRECT] - exact_rate)
+            - TOL**2 * scale
+        )
         assert excess.max() <= 1e-12 * scale.max(), excess.max()
         history = pb.history[: pb.count].copy()
         th.prepare(sim.time)
@@ -168,7 +172,10 @@ def test_without_reuse_the_engine_equals_the_exact_model(tmp_path: Path) -> None
     sim.run(steps=1500)
     engine = sim.particles.heat_rate_by_mechanism
     exact = _exact(sim)[2:]
-    assert np.abs(engine[:, 0] + engine[:, 6] - exact[0]).max() <= 1e-12 * exact[1].max()
+    assert (
+        np.abs(engine[:, heat.M_DIRECT] + engine[:, heat.M_WALL_DIRECT] - exact[0]).max()
+        <= 1e-12 * exact[1].max()
+    )
 
 
 @pytest.mark.parametrize(

@@ -147,7 +147,7 @@ def test_hot_wall_ledger_equals_integrated_wall_heat(tmp_path: Path) -> None:
     sim = Simulation(case_from_dict(case))
     u0 = sim.thermal.thermal_energy()
     sim.run(steps=3000)
-    wall_heat = sim.thermal.cumulative["wall_heat"]
+    wall_heat = sim.thermal.cumulative["heat_in_wall_direct_conduction"]
     assert wall_heat > 1e-6 * u0  # the floor heated the bed
     assert sim.thermal.thermal_energy() - u0 == pytest.approx(wall_heat, rel=1e-10)
     assert sim.thermal.thermal_steps == 600

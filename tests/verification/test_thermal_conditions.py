@@ -18,6 +18,7 @@ import pytest
 from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import ConfigError
+from thermodem.state import heat
 
 R = 1e-3
 RHO = 2500.0
@@ -83,7 +84,7 @@ def _temps(sim: Simulation) -> np.ndarray:
 
 def _source(sim: Simulation) -> np.ndarray:
     """Source column [W] by global id (heat flux, volumetric and external sources)."""
-    return sim.particles.heat_rate_by_mechanism[_order(sim), 5]
+    return sim.particles.heat_rate_by_mechanism[_order(sim), heat.M_SOURCE]
 
 
 # ------------------------------------------------------------------------ initial temperature
@@ -346,12 +347,12 @@ def test_external_source_ledger_integrates_power_over_active_window(tmp_path: Pa
     th = sim.thermal
     u0 = th.thermal_energy()
     sim.run(until=1.0)  # steps starting at 0, 0.25, 0.5, 0.75: before the window
-    assert th.cumulative["source_heat"] == 0.0
+    assert th.cumulative["heat_in_source"] == 0.0
     assert th.thermal_energy() == pytest.approx(u0, rel=1e-14)
     assert _temps(sim)[2] == 320.0
     assert _temps(sim)[1] < 350.0  # conduction ran
     sim.run(until=5.0)  # steps starting at 1.0 ... 2.75 are in [1, 3): 2 s of power
-    assert th.cumulative["source_heat"] == pytest.approx(power * 2.0, rel=1e-14)
+    assert th.cumulative["heat_in_source"] == pytest.approx(power * 2.0, rel=1e-14)
     assert th.thermal_energy() - u0 == pytest.approx(power * 2.0, rel=1e-10)
     assert abs(th.balance_error()) < 1e-12 * u0
     assert _temps(sim)[2] == 320.0  # outside the region
@@ -394,7 +395,7 @@ def test_region_selection_follows_current_positions(tmp_path: Path) -> None:
     sim.particles.velocity[:] = [1.0, 0.0, 0.0]
     sim.run(steps=300)
     assert sim.particles.position[0, 0] == pytest.approx(x0 + 300 * 1e-5, rel=1e-12)
-    assert sim.particles.heat_rate_by_mechanism[0, 5] == 0.0
+    assert sim.particles.heat_rate_by_mechanism[0, heat.M_SOURCE] == 0.0
     # thermal steps start at x0 + k dx, k = 0 ... 299: inside for k <= 105 (x <= -5 µm)
     heating = q * 4 * math.pi * R**2 / (mass() * C)
     assert sim.particles.temperature[0] == pytest.approx(300.0 + 106 * 1e-5 * heating, rel=1e-12)

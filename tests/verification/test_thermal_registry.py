@@ -81,7 +81,7 @@ def test_every_direct_conduction_model_runs(tmp_path: Path, model: str) -> None:
     assert abs(sim.thermal.balance_error()) < 1e-12 * u0
     if model != "none":
         assert np.abs(sim.particles.heat_rate_by_mechanism[:, 0]).max() > 0.0
-        assert sim.thermal.cumulative["wall_heat"] > 0.0
+        assert sim.thermal.cumulative["heat_in_wall_direct_conduction"] > 0.0
 
 
 @pytest.mark.parametrize("model", registry.names("contact_radius"))

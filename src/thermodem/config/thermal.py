@@ -5,6 +5,7 @@ Example::
     thermal:
       contact_radius: geometric
       direct_conduction: batchelor_obrien_simple
+      indirect_conduction: none    # e.g. {model: rong_horio1999, layer_thickness_ratio: 0.4}
       gas: {thermal_conductivity: 0.0263}   # the interstitial gas (default: air, 300 K, 1 atm)
       substeps: 1                  # solve heat every n mechanical steps, or "auto"
       conductance_force_tolerance: 0   # resistance_network: reuse H while F_n is within tol
@@ -26,7 +27,6 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
-from thermodem.models import registry
 from thermodem.state.gas import GasProperties
 
 Vec3 = tuple[float, float, float]
@@ -196,6 +196,17 @@ class ThermalSettings(StrictModel):
         validate_default=True,
         description="direct_conduction model",
     )
+    indirect_conduction: Any = Field(
+        default="none",
+        validate_default=True,
+        description="indirect_conduction model (conduction through the fluid between near "
+        "particles, evaluated on the range pair set)",
+    )
+    range_skin: float | None = Field(
+        default=None,
+        gt=0,
+        description="Verlet skin of the range pair set [m]; null: the contact list's skin",
+    )
     gas: GasProperties = Field(
         default_factory=GasProperties,
         description="interstitial gas read by every model that needs one; default: air at "
@@ -234,6 +245,11 @@ class ThermalSettings(StrictModel):
     @classmethod
     def _dc(cls, v: Any):  # noqa: ANN206
         return parse_thermal_choice("direct_conduction", v, "batchelor_obrien_simple")
+
+    @field_validator("indirect_conduction", mode="before")
+    @classmethod
+    def _ic(cls, v: Any):  # noqa: ANN206
+        return parse_thermal_choice("indirect_conduction", v, "none")
 
     @field_validator("substeps")
     @classmethod
@@ -280,7 +296,3 @@ class WallThermal(StrictModel):
 
             compile_expression(self.temperature, ("t",))
         return self
-
-
-def ensure_registry_loaded() -> None:
-    registry.names("direct_conduction")

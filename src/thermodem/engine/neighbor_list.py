@@ -66,6 +66,8 @@ def rebuild_lists(sim: Simulation) -> None:
     cell_start = np.zeros(ncell + 1, np.int64)
     NB.sort_by_cell(p.position, sim.lower, edge, dims, axes, order, cell_start)
     p.permute(order)
+    if sim.thermal is not None:
+        sim.thermal.particles_reordered()  # derived per-particle state and the range set
     new_index = np.empty(n, np.int32)  # old particle index -> index after the sort
     new_index[order] = np.arange(n, dtype=np.int32)
     del order

@@ -2,6 +2,11 @@
 
 Order inside one step (``Simulation.step``):
 
+0. a thermal step when one is due (every ``thermal.substeps`` steps, see
+   ``thermodem.engine.thermal``): the heat terms are evaluated on the state at the end of the
+   previous step (the contact conduction was computed by that step's pair pass) and the
+   temperatures advance by explicit Euler; with frozen mechanics every step is a thermal step
+   and nothing moves;
 1. first half kick and drift (velocity Verlet); in the same pass each particle is checked
    (non-finite value, outside the domain) and the largest displacement since the last
    neighbour build is found; a failed check raises before anything else moves;
@@ -11,7 +16,8 @@ Order inside one step (``Simulation.step``):
 4. forces set to the weights, torques to zero (and the conduction sums, when heat is due);
    pair passes: geometry and contact forces of every particle and wall pair, added straight
    into the particles by slab group (``thermodem.kernels.slabs``), dissipation per mechanism,
-   history, ledger rows per group;
+   history, ledger rows per group; when a thermal step follows, the same passes evaluate the
+   contact conduction of the touching pairs;
 5. the second half kick;
 6. overlap check; 7. writers on their triggers (owned by the caller, see
    ``thermodem.engine.runner``).
@@ -45,8 +51,9 @@ from thermodem.kernels.integrate import (
     sum_rows,
 )
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
+from thermodem.state.heat import HEAT_MECHANISMS
 from thermodem.state.pairs import PairBuffers
-from thermodem.state.particles import HEAT_MECHANISMS, Particles
+from thermodem.state.particles import Particles
 
 LEDGER_DISSIPATION = (
     "normal_damping",
@@ -154,10 +161,10 @@ class Simulation:
         self._compute_forces(kick=False, contact_dt=0.0)
         self.initial_energy = self.total_energy()
         if self.thermal is not None:
-            if self.thermal.fresh:
-                self.thermal.gather(self.time, reduced=True)
-            else:
-                self.thermal.compute_rates(self.time)
+            # the heat rates of the initial state (every term); the first thermal step
+            # evaluates them again from this same state
+            self.thermal.compute_rates(self.time)
+            self.thermal.fresh = False
             self.thermal.initial_energy = self.thermal.thermal_energy()
             self.thermal.cumulative["fixed_reset"] = 0.0  # resets before t = 0 are the start
 

@@ -1,4 +1,4 @@
-"""The thermal engine: temperatures, conduction, conditions, sources, explicit Euler, ledger.
+"""The thermal engine: temperatures, heat terms on pair sets, conditions, explicit Euler, ledger.
 
 Each particle is a lumped capacitance (spec 1.1): m c dT/dt = Q. Heat is solved with forward
 (explicit) Euler exactly as the spec's calculation cycle (1.2): at the start of a step the
@@ -8,41 +8,47 @@ a step). With ``substeps: n`` the heat is advanced every n mechanical steps with
 with ``frozen_mechanics`` the particles do not move and each step is a thermal step of
 ``thermal.time_step``.
 
-Heat ledger: U = Σ m c T changes by exactly the time-integrated wall heat and sources, minus
-the heat absorbed by fixed-temperature particles (pairwise conduction cancels by construction);
-``balance_error`` returns the difference, which is round-off.
+The heat rate of a particle is the sum of its mechanism columns (``thermodem.state.heat``),
+written by the terms (``thermodem.engine.terms``):
+
+1. the contact conduction (contact radius × direct conduction), evaluated inside the fused
+   contact pass of the mechanics at the step before a thermal step (or by a heat-only pass
+   with frozen mechanics and at the start);
+2. every other term, on its pair set, by the heat-only passes of ``kernels/heat_terms.py``:
+   the range set (``engine/range_set.py``) for gap conduction, the contact lists for terms
+   that need the normal force;
+3. the sources of the case (``engine/thermal_conditions.py``).
+
+Heat ledger: U = Σ m c T changes by exactly the time-integrated heat of the boundary
+mechanisms (walls, sources, ...), minus the heat absorbed by fixed-temperature particles
+(pairwise terms cancel by construction); ``balance_error`` returns the difference, which is
+round-off.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from thermodem.config.thermal import Selection, ThermalSettings
-from thermodem.engine.expressions import compile_expression
+from thermodem.config.thermal import ThermalSettings
+from thermodem.engine.range_set import RangePairSet
+from thermodem.engine.terms import HeatTerm, build_terms
+from thermodem.engine.thermal_conditions import ThermalConditions
 from thermodem.errors import ConfigError, SimulationError
-from thermodem.geometry import wall_layout as WL
-from thermodem.kernels import thermal as K
-from thermodem.state.materials import resolve_pair
-from thermodem.state.particles import HEAT_MECHANISMS
+from thermodem.geometry import wall_layout as wall_cols
+from thermodem.kernels import heat_terms as passes
+from thermodem.kernels import thermal as kernels
+from thermodem.state import heat
 
 if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
-
-def _wall_temperature_function(spec):  # noqa: ANN001, ANN202
-    """t -> T of a fixed-temperature wall (constant, table or expression)."""
-    value = spec.temperature
-    if isinstance(value, int | float):
-        return lambda t: float(value)
-    if isinstance(value, list):
-        times = np.array([a for a, _ in value])
-        temps = np.array([b for _, b in value])
-        return lambda t: float(np.interp(t, times, temps))
-    expr = compile_expression(value, ("t",))
-    return lambda t: float(expr(t))
+#: Attributes never saved in checkpoints (objects, back references, derived tables).
+SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "_empty")
+#: Prefix of the range set's arrays in the engine's checkpoint arrays.
+RANGE_PREFIX = "range_set__"
 
 
 class ThermalEngine:
@@ -53,44 +59,29 @@ class ThermalEngine:
         self.settings = settings
         case = sim.case
         names = sim.material_names
-        self.radius_id = settings.contact_radius.spec.model_id
-        self.conduction_id = settings.direct_conduction.spec.model_id
+        # which materials meet: particle materials with each other and with walls that
+        # exchange heat (fixed-temperature walls)
+        particle_mats = {e.material for e in case.insertion}
+        hot_walls = {w.material for w in case.walls if w.thermal.kind == "fixed"}
+
+        def meets(a: str, b: str) -> bool:
+            return (a in particle_mats and (b in particle_mats or b in hot_walls)) or (
+                b in particle_mats and a in hot_walls
+            )
+
+        def is_wall(a: str, b: str) -> bool:
+            return b in hot_walls and b not in particle_mats
+
+        self.contact, self.terms = build_terms(case, names, meets, is_wall)
+        self.radius_id = self.contact.radius_id
+        self.conduction_id = self.contact.direct_id
+        self.radius_table = self.contact.radius_table
+        self.conduction_table = self.contact.direct_table
         # conductance reuse (0: the model is evaluated at every thermal step), see
         # docs/models/conductance_reuse.md; the pair histories carry REUSE_COLUMNS more columns
         self.tolerance = float(settings.conductance_force_tolerance)
-        # which materials meet: particle materials with each other and with walls that
-        # exchange heat (fixed-temperature walls)
-        particle_mats = set(self._particle_materials(case))
-        hot_walls = {w.material for w in case.walls if w.thermal.kind == "fixed"}
-        n = len(names)
-        self.radius_table = np.zeros((n, n, 16))
-        self.conduction_table = np.zeros((n, n, 16))
-        for a, na in enumerate(names):
-            for b, nb in enumerate(names):
-                meets = (na in particle_mats and (nb in particle_mats or nb in hot_walls)) or (
-                    nb in particle_mats and na in hot_walls
-                )
-                if not meets:
-                    continue
-                pair = resolve_pair(
-                    case.materials[na],
-                    case.materials[nb],
-                    is_wall=nb in hot_walls and nb not in particle_mats,
-                    gas=settings.gas,
-                )
-                for table, choice in (
-                    (self.radius_table, settings.contact_radius),
-                    (self.conduction_table, settings.direct_conduction),
-                ):
-                    try:
-                        table[a, b] = choice.spec.pack(choice.params, pair)
-                    except ValueError as exc:
-                        raise ConfigError(
-                            f"thermal.{choice.family} = {choice.model!r} cannot be set up for "
-                            f"materials {na!r} and {nb!r}: {exc}"
-                        ) from None
         self._property_tables(case, names, particle_mats)
-        self.specific_heat_by_type = np.zeros(n)
+        self.specific_heat_by_type = np.zeros(len(names))
         for t, name in enumerate(names):
             c = case.materials[name].specific_heat
             if name in particle_mats and c is None:
@@ -99,26 +90,25 @@ class ThermalEngine:
                     "particles of this material (J/(kg K), > 0)"
                 )
             self.specific_heat_by_type[t] = c or 0.0
-        self.wall_functions = []
-        for w in case.walls:
-            fn = _wall_temperature_function(w.thermal) if w.thermal.kind == "fixed" else None
-            count = 6 - int(w.open_top) if w.kind == "box" else 1
-            self.wall_functions.extend([fn] * count)
+        self.conditions = ThermalConditions(sim, settings)
+        self.range_set = (
+            RangePairSet(settings.range_skin)
+            if any(t.target == "range" for t in self.terms)
+            else None
+        )
+        # per-pair conductances of the contact conduction (heat-only passes, frozen reuse)
         self.pair_conductance = np.zeros(0)
-        self.pair_heat = np.zeros(0)
         self.wall_conductance = np.zeros(0)
-        self.wall_heat = np.zeros(0)
+        # per-pair conductances of the other terms, stored with frozen mechanics
+        self.term_conductance = [np.zeros(0) for _ in self.terms]
+        self.term_wall_conductance = [np.zeros(0) for _ in self.terms]
+        self.term_ready = np.zeros(len(self.terms), np.bool_)
         self._empty = np.zeros(0)
-        self.fixed = np.zeros(0, np.bool_)
-        self.source = np.zeros(0)
         self.conductance_sum = np.zeros(0)
-        self.cumulative = {
-            "wall_heat": 0.0,
-            "source_heat": 0.0,
-            "fixed_absorbed": 0.0,
-            "inserted_heat": 0.0,
-            "fixed_reset": 0.0,
-        }
+        #: cumulative ledger [J]: heat in through every boundary mechanism, heat absorbed by
+        #: fixed particles, heat of inserted particles, resets of newly fixed particles
+        self.cumulative = {f"heat_in_{m.name}": 0.0 for m in heat.MECHANISMS if m.boundary}
+        self.cumulative.update(fixed_absorbed=0.0, inserted_heat=0.0, fixed_reset=0.0)
         self.limit = math.inf
         self.limit_particle = -1
         self.substeps = 1 if settings.substeps == "auto" else int(settings.substeps)
@@ -129,12 +119,21 @@ class ThermalEngine:
         # reuse_conductance = False re-evaluates them at every thermal step (tests)
         self.conductance_ready = False
         self.reuse_conductance = True
-        self._warned = False
         self.initial_energy = 0.0
+        self.boundary_columns = np.nonzero(heat.BOUNDARY)[0]
+        self.in_use = self._mechanisms_in_use()
+        self.sum_columns = np.array(sorted({*self.in_use, heat.M_SOURCE}), np.int64)
 
-    @staticmethod
-    def _particle_materials(case) -> list[str]:  # noqa: ANN001
-        return [e.material for e in case.insertion]
+    def _mechanisms_in_use(self) -> list[int]:
+        """Mechanism columns this case's terms and conditions can write (reported always)."""
+        cols = set()
+        if self.contact.active:
+            cols |= {heat.M_DIRECT, heat.M_WALL_DIRECT}
+        for t in self.terms:
+            cols |= {t.column, t.wall_column} - {-1}
+        if self.conditions.active:
+            cols.add(heat.M_SOURCE)
+        return sorted(cols)
 
     def _property_tables(self, case, names: list[str], particle_mats: set[str]) -> None:  # noqa: ANN001
         """Per-material tables of k(T) and c(T) (a constant is a one-node table)."""
@@ -169,9 +168,12 @@ class ThermalEngine:
             has_k |= m.thermal_conductivity_table is not None
             has_c |= m.specific_heat_table is not None and name in particle_mats
         self.has_c_table = has_c
-        self.override = 2 if (has_c or has_k) and has_c else (1 if has_k else 0)
-        self.scratch = np.zeros((1, 16))
-        self.euler_partials = np.zeros((1, 6))
+        # 0: constant properties; 1: k(T) replaces the conductivity columns of the rows;
+        # 2: k(T) and ρ c(T) replace the conductivity and heat capacity columns
+        self.override = 2 if has_c else (1 if has_k else 0)
+        self.scratch = np.zeros((1, max(self.conduction_table.shape[-1], 1)))
+        self.term_scratch = np.zeros((1, max([t.table.shape[-1] for t in self.terms] + [1])))
+        self.euler_partials = np.zeros((1, kernels.EULER_FIXED + len(heat.MECHANISMS)))
 
     def _interp(
         self,
@@ -187,134 +189,87 @@ class ThermalEngine:
             out[sel] = np.interp(temperature[sel], tt[a, : nn[a]], vv[a, : nn[a]])
         return out
 
-    # ------------------------------------------------------------------ initial conditions
+    # ---------------------------------------------------------------- conditions (API)
+    @property
+    def fixed(self) -> np.ndarray:
+        """Mask of the fixed-temperature particles at the last thermal evaluation."""
+        return self.conditions.fixed
+
+    @property
+    def source(self) -> np.ndarray:
+        """Source power of every particle at the last thermal evaluation [W]."""
+        return self.conditions.source
+
     def initial_temperature(self, position: np.ndarray, type_id: np.ndarray) -> np.ndarray:
         """Initial temperatures [K] of new particles from ``thermal.initial_temperature``."""
-        rule = self.settings.initial_temperature
-        n = position.shape[0]
-        default = self.sim.case.simulation.initial_temperature
-        if rule is None:
-            return np.full(n, default)
-        if rule.kind == "uniform":
-            return np.full(n, rule.value)
-        if rule.kind == "per_material":
-            names = self.sim.material_names
-            values = np.array([rule.values.get(m, rule.default) for m in names])
-            return values[type_id]
-        if rule.kind == "regions":
-            out = np.full(n, rule.default)
-            for box, temp in rule.regions:
-                out[self._in_box(position, box)] = temp
-            return out
-        fn = compile_expression(rule.expression, ("x", "y", "z"))
-        return np.broadcast_to(fn(position[:, 0], position[:, 1], position[:, 2]), (n,)).copy()
-
-    @staticmethod
-    def _in_box(position: np.ndarray, box) -> np.ndarray:  # noqa: ANN001
-        lo = np.asarray(box.lower)
-        hi = np.asarray(box.upper)
-        return np.all((position >= lo) & (position <= hi), axis=1)
-
-    def _select(self, sel: Selection) -> np.ndarray:
-        p = self.sim.particles
-        mask = np.ones(p.count, bool)
-        if sel.material is not None:
-            mask &= p.type_id == self.sim.material_index[sel.material]
-        if sel.region is not None:
-            mask &= self._in_box(p.position, sel.region)
-        if sel.ids is not None:
-            mask &= np.isin(p.global_id, np.asarray(sel.ids, np.int64))
-        return mask
-
-    # ------------------------------------------------------------------------ conditions
-    def _fixed_and_sources(self, time: float) -> tuple[np.ndarray, np.ndarray]:
-        p = self.sim.particles
-        s = self.settings
-        if self.fixed.shape[0] != p.count:
-            self.fixed = np.zeros(p.count, np.bool_)
-            self.source = np.zeros(p.count)
-        fixed, source = self.fixed, self.source
-        if not (s.fixed_temperature or s.heat_flux or s.volumetric_source or s.external_source):
-            return fixed, source
-        fixed[:] = False
-        source[:] = 0.0
-        for f in s.fixed_temperature:
-            mask = self._select(f.select)
-            fixed |= mask
-            before = self.thermal_energy(mask)
-            p.temperature[mask] = f.temperature
-            # a particle that becomes fixed is set to the bath temperature: ledgered
-            self.cumulative["fixed_reset"] += self.thermal_energy(mask) - before
-        for h in s.heat_flux:
-            mask = self._select(h.select)
-            source[mask] += h.flux * 4.0 * np.pi * p.radius[mask] ** 2
-        for v in s.volumetric_source:
-            mask = self._select(v.select)
-            source[mask] += v.power_density * 4.0 / 3.0 * np.pi * p.radius[mask] ** 3
-        for e in s.external_source:
-            if not (e.start_time <= time < e.end_time):
-                continue
-            mask = self._in_box(p.position, e.region)
-            if not mask.any():
-                continue
-            weight = np.pi * p.radius[mask] ** 2
-            if e.profile == "gaussian":
-                axis = np.asarray(e.axis, float) / np.linalg.norm(e.axis)
-                centre = 0.5 * (np.asarray(e.region.lower) + np.asarray(e.region.upper))
-                r = p.position[mask] - centre
-                r -= np.outer(r @ axis, axis)
-                weight = weight * np.exp(-(r**2).sum(axis=1) / (2.0 * e.sigma**2))
-            total = weight.sum()
-            if total > 0.0:
-                source[mask] += e.power * weight / total
-        return fixed, source
+        return self.conditions.initial_temperature(position, type_id)
 
     def _update_walls(self, time: float) -> None:
-        rows = self.sim.wall_rows
-        for w, fn in enumerate(self.wall_functions):
-            if fn is None:
-                rows[w, WL.COL_THERMAL_KIND] = 0.0
-            else:
-                rows[w, WL.COL_THERMAL_KIND] = 1.0
-                rows[w, WL.COL_TEMPERATURE] = fn(time)
+        self.conditions.update_walls(time)
+
+    def particles_reordered(self) -> None:
+        """Called after the particles were permuted or inserted (a neighbour rebuild)."""
+        self.conditions.invalidate()
+        if self.range_set is not None:
+            self.range_set.invalidate()
+        self.term_ready[:] = False
+
+    def _fixed_and_sources(self, time: float) -> tuple[np.ndarray, np.ndarray]:
+        p = self.sim.particles
+        if self.has_c_table and self.conditions.active:
+            before = p.temperature.copy()
+            fixed, source, _ = self.conditions.apply(time, self.specific_heat_by_type)
+            after = p.temperature[fixed]
+            self.cumulative["fixed_reset"] += kernels.total_enthalpy(
+                after, p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+            ) - kernels.total_enthalpy(
+                before[fixed], p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+            )
+            return fixed, source
+        fixed, source, reset = self.conditions.apply(time, self.specific_heat_by_type)
+        self.cumulative["fixed_reset"] += reset
+        return fixed, source
 
     # ------------------------------------------------------------------------------ step
     def _buffers(self) -> None:
         sim = self.sim
         if (
-            self.pair_heat.shape[0] < sim.pairs.capacity
-            or self.wall_heat.shape[0] < sim.walls.capacity
+            self.pair_conductance.shape[0] < sim.pairs.capacity
+            or self.wall_conductance.shape[0] < sim.walls.capacity
         ):
             self.conductance_ready = False
-        if self.pair_heat.shape[0] < sim.pairs.capacity:
+        if self.pair_conductance.shape[0] < sim.pairs.capacity:
             self.pair_conductance = np.zeros(sim.pairs.capacity)
-            self.pair_heat = np.zeros(sim.pairs.capacity)
-        if self.wall_heat.shape[0] < sim.walls.capacity:
+        if self.wall_conductance.shape[0] < sim.walls.capacity:
             self.wall_conductance = np.zeros(sim.walls.capacity)
-            self.wall_heat = np.zeros(sim.walls.capacity)
 
     def prepare(self, time: float) -> None:
-        """Buffers, wall temperatures at ``time`` and k(T), ρc(T) arrays for a conduction pass."""
+        """Buffers, wall temperatures at ``time``, fixed particles and sources, and the k(T),
+        ρc(T) arrays for the passes of this thermal step."""
         sim = self.sim
         p = sim.particles
-        pb, wb = sim.pairs, sim.walls
         self._buffers()
-        self._update_walls(time)
-        # fixed-temperature particles take their temperature before any conduction pass sees it
+        self.conditions.update_walls(time)
+        # fixed-temperature particles take their temperature before any pass sees it
         self._fixed_and_sources(time)
         self.k_p = self.rhoc_p = self.k_w = self.rhoc_w = self._empty
         if self.override:
             self.k_p = self._interp(self.k_t, self.k_v, self.k_n, p.type_id, p.temperature)
             c_p = self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
             self.rhoc_p = self.density_by_type[p.type_id] * c_p
-            wt = sim.wall_rows[:, WL.COL_TEMPERATURE]
+            wt = sim.wall_rows[:, wall_cols.COL_TEMPERATURE]
             self.k_w = self._interp(self.k_t, self.k_v, self.k_n, sim.wall_material, wt)
             self.rhoc_w = self.density_by_type[sim.wall_material] * self._interp(
                 self.c_t, self.c_v, self.c_n, sim.wall_material, wt
             )
-        rows = max(pb.count, wb.count) // K.CHUNK + 1
+        rows = max(sim.pairs.count, sim.walls.count) // kernels.CHUNK + 1
+        self._scratch_rows(rows)
+        if self.conductance_sum.shape[0] != p.count:
+            self.conductance_sum = np.zeros(p.count)
+
+    def _scratch_rows(self, rows: int) -> None:
         if self.scratch.shape[0] < rows:
-            self.scratch = np.zeros((rows, 16))
+            self.scratch = np.zeros((rows, self.scratch.shape[1]))
 
     def pair_heat_args(self) -> tuple:
         """Arguments of the fused contact pass (particle pairs) that switch conduction on."""
@@ -333,14 +288,14 @@ class ThermalEngine:
     def fused_rows(self, rows: int) -> None:
         """Scratch rows (one per slab group or wall chunk) and the per-particle conductance
         sums for a fused contact pass."""
-        if self.scratch.shape[0] < rows:
-            self.scratch = np.zeros((rows, 16))
+        self._scratch_rows(rows)
         n = self.sim.particles.count
         if self.conductance_sum.shape[0] != n:
             self.conductance_sum = np.zeros(n)
 
     def conduction_passes(self) -> None:
-        """Heat-only conduction passes over the current pair lists (frozen mechanics, init).
+        """Contact conduction by the heat-only passes (frozen mechanics, start): zeroes the
+        mechanism columns and the conductance sums, then adds the contact conduction.
 
         With frozen mechanics and temperature-independent properties the conductances cannot
         change (same positions, contacts, forces and materials), so after the first pass only
@@ -349,55 +304,163 @@ class ThermalEngine:
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
-        reuse = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
-        if reuse and self.conductance_ready:
-            K.heat_from_conductance(
-                pb.i, pb.j, pb.count, wb.i, wb.j, wb.count, sim.wall_rows, p.temperature,
-                self.pair_conductance, self.wall_conductance, self.pair_heat, self.wall_heat,
-            )  # fmt: skip
+        by_mech = p.heat_rate_by_mechanism
+        passes.zero_heat(by_mech, self.conductance_sum)
+        if not self.contact.active:
             return
-        K.conduction_pair_pass_for(self.radius_id, self.conduction_id, self.override)(
-            p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
-            pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
-            self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
-            self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
-            self.pair_heat, self.tolerance,
+        reuse = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        if not (reuse and self.conductance_ready):
+            kernels.conduction_pair_pass_for(self.radius_id, self.conduction_id, self.override)(
+                p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
+                pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
+                self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
+                self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
+                self.tolerance,
+            )  # fmt: skip
+            kernels.conduction_wall_pass(
+                p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
+                wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
+                sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
+                self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w,
+                self.rhoc_w, self.scratch, self.wall_conductance, self.tolerance,
+            )  # fmt: skip
+            self.conductance_ready = reuse
+        passes.pair_heat_from_conductance(
+            pb.i, pb.j, pb.group_start, self.pair_conductance, p.temperature, heat.M_DIRECT,
+            by_mech, self.conductance_sum,
         )  # fmt: skip
-        K.conduction_wall_pass(
-            p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
-            wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
-            sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
-            self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w, self.rhoc_w,
-            self.scratch, self.wall_conductance, self.wall_heat, self.tolerance,
+        passes.wall_heat_from_conductance(
+            wb.j, sim.wall_row_start, sim.wall_rows, self.wall_conductance, p.temperature,
+            heat.M_WALL_DIRECT, by_mech, self.conductance_sum,
         )  # fmt: skip
-        self.conductance_ready = reuse
 
-    def gather(self, time: float, reduced: bool = False) -> np.ndarray:
-        """Per-particle heat rates from the pair heat arrays and the sources; returns the
-        fixed-temperature mask. ``reduced``: the fused contact pass already summed the pairs."""
+    # ----------------------------------------------------------------- the other terms
+    def _term_rows(self, rows: int) -> np.ndarray:
+        if self.term_scratch.shape[0] < rows:
+            self.term_scratch = np.zeros((rows, self.term_scratch.shape[1]))
+        return self.term_scratch
+
+    def _range_gaps(self) -> tuple[float, float]:
+        p = self.sim.particles
+        r_max = float(p.radius.max()) if p.count else 0.0
+        gaps = [t.max_gap(r_max) for t in self.terms if t.target == "range"]
+        return max(g for g, _ in gaps), max(w for _, w in gaps)
+
+    def evaluate_terms(self) -> None:
+        """Add the heat of every term other than the contact conduction (at this state)."""
+        if not self.terms:
+            return
+        sim = self.sim
+        if self.range_set is not None and self.range_set.due(sim):
+            self.range_set.build(sim, *self._range_gaps())
+            self.term_ready[:] = False
+        frozen = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        for index, term in enumerate(self.terms):
+            if term.target == "range":
+                self._range_term(index, term, frozen)
+            elif term.target == "contacts":
+                self._contact_term(index, term, frozen)
+            else:  # pragma: no cover - external and particle terms come with their families
+                raise NotImplementedError(f"{term.key}: target {term.target!r}")
+
+    def _stored(self, index: int, pairs: int, walls: int) -> tuple[np.ndarray, np.ndarray]:
+        """The per-pair conductance arrays of term ``index`` with at least the given sizes."""
+        if self.term_conductance[index].shape[0] < pairs:
+            self.term_conductance[index] = np.zeros(pairs)
+            self.term_ready[index] = False
+        if self.term_wall_conductance[index].shape[0] < walls:
+            self.term_wall_conductance[index] = np.zeros(walls)
+            self.term_ready[index] = False
+        return self.term_conductance[index], self.term_wall_conductance[index]
+
+    def _range_term(self, index: int, term: HeatTerm, frozen: bool) -> None:
         sim = self.sim
         p = sim.particles
-        fixed, source = self._fixed_and_sources(time)
-        if reduced:
-            K.finish_heat(source, p.heat_rate, p.heat_rate_by_mechanism)
-            return fixed
-        if self.conductance_sum.shape[0] != p.count:
-            self.conductance_sum = np.zeros(p.count)
-        K.heat_scatter(
-            sim.pairs.i, sim.pairs.j, sim.pairs.group_start, self.pair_conductance,
-            self.pair_heat, sim.wall_row_start, self.wall_conductance, self.wall_heat, source,
-            p.heat_rate, p.heat_rate_by_mechanism, self.conductance_sum,
+        rs = self.range_set
+        by_mech = p.heat_rate_by_mechanism
+        store = frozen
+        pair_h, wall_h = self._stored(
+            index, rs.count if store else 0, rs.wall_count if store else 0
+        )
+        if store and self.term_ready[index]:
+            passes.pair_heat_from_conductance(
+                rs.i, rs.j, rs.group_start, pair_h, p.temperature, term.column, by_mech,
+                self.conductance_sum,
+            )  # fmt: skip
+            passes.wall_heat_from_conductance(
+                rs.wall_w, rs.wall_row_start, sim.wall_rows, wall_h, p.temperature,
+                term.wall_column, by_mech, self.conductance_sum,
+            )  # fmt: skip
+            return
+        k_i, k_j = term.k_columns if self.override else (-1, -1)
+        rows = max(rs.ngroups, p.count // passes.WALL_CHUNK + 1)
+        scratch = self._term_rows(rows)
+        passes.range_pair_pass(
+            p.position, p.radius, p.temperature, p.type_id, rs.i, rs.j, rs.group_start,
+            sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table, k_i,
+            k_j, self.k_p, scratch, term.column, by_mech, self.conductance_sum, store, pair_h,
         )  # fmt: skip
-        return fixed
+        passes.range_wall_pass(
+            p.position, p.radius, p.temperature, p.type_id, rs.wall_w, rs.wall_row_start,
+            sim.wall_kind, sim.wall_rows, sim.wall_material, term.evaluator, term.model_id,
+            term.table, k_i, k_j, self.k_p, self.k_w, scratch, term.wall_column, by_mech,
+            self.conductance_sum, store, wall_h,
+        )  # fmt: skip
+        self.term_ready[index] = store
 
+    def _contact_term(self, index: int, term: HeatTerm, frozen: bool) -> None:
+        sim = self.sim
+        p = sim.particles
+        pb, wb = sim.pairs, sim.walls
+        by_mech = p.heat_rate_by_mechanism
+        store = frozen
+        pair_h, wall_h = self._stored(index, pb.count if store else 0, wb.count if store else 0)
+        if store and self.term_ready[index]:
+            passes.pair_heat_from_conductance(
+                pb.i, pb.j, pb.group_start, pair_h, p.temperature, term.column, by_mech,
+                self.conductance_sum,
+            )  # fmt: skip
+            passes.wall_heat_from_conductance(
+                wb.j, sim.wall_row_start, sim.wall_rows, wall_h, p.temperature,
+                term.wall_column, by_mech, self.conductance_sum,
+            )  # fmt: skip
+            return
+        k_i, k_j = term.k_columns if self.override else (-1, -1)
+        rows = max(pb.ngroups, p.count // passes.WALL_CHUNK + 1)
+        scratch = self._term_rows(rows)
+        passes.contact_term_pair_pass(
+            p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.group_start,
+            pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
+            self.radius_id, self.radius_table, term.evaluator, term.model_id, term.table, k_i,
+            k_j, self.k_p, scratch, term.column, by_mech, self.conductance_sum, store, pair_h,
+        )  # fmt: skip
+        passes.contact_term_wall_pass(
+            p.position, p.radius, p.mass, p.temperature, p.type_id, wb.j, sim.wall_row_start,
+            wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
+            sim.wall_material, self.radius_id, self.radius_table, term.evaluator,
+            term.model_id, term.table, k_i, k_j, self.k_p, self.k_w, scratch, term.wall_column,
+            by_mech, self.conductance_sum, store, wall_h,
+        )  # fmt: skip
+        self.term_ready[index] = store
+
+    # ------------------------------------------------------------------------- the rates
     def compute_rates(self, time: float) -> np.ndarray:
         """Heat rates of the current state (fills particles.heat_rate and by_mechanism).
 
-        Returns the fixed-temperature mask.
+        Returns the fixed-temperature mask. The next thermal step evaluates every term again
+        (the rates of a fused contact pass, if one ran, are replaced).
         """
         self.prepare(time)
         self.conduction_passes()
-        return self.gather(time)
+        self.evaluate_terms()
+        self.fresh = False
+        return self.finish(time)
+
+    def finish(self, time: float) -> np.ndarray:
+        """Source column and total heat rate after the passes; returns the fixed mask."""
+        p = self.sim.particles
+        kernels.finish_heat(self.source, p.heat_rate, p.heat_rate_by_mechanism, self.sum_columns)
+        return self.fixed
 
     def specific_heat(self) -> np.ndarray:
         """c(T) of every particle [J/(kg K)]."""
@@ -410,31 +473,35 @@ class ThermalEngine:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler)."""
         sim = self.sim
         p = sim.particles
-        if self.fresh:  # the fused contact pass already computed the pair heat at this state
+        if self.fresh:  # the fused contact pass already computed the contact conduction
             fixed, source = self._fixed_and_sources(time)
         else:
-            fixed = self.compute_rates(time)
-            source = self.source
+            self.prepare(time)
+            self.conduction_passes()
+            fixed, source = self.fixed, self.source
         self.fresh = False
+        self.evaluate_terms()
+        by_mech = p.heat_rate_by_mechanism
         if self.has_c_table:
-            K.finish_heat(source, p.heat_rate, p.heat_rate_by_mechanism)
+            kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)
             c = self.specific_heat()
-            self.limit, where = K.stability_limit(p.mass, c, self.conductance_sum, fixed)
-            wall_q = float(np.sum(p.heat_rate_by_mechanism[:, K.M_WALL]))
-            source_q = float(np.sum(source))
-            absorbed, bad = K.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
-                                                    p.type_id, self.c_t, self.c_v, self.c_n,
-                                                    fixed, dt)  # fmt: skip
+            self.limit, where = kernels.stability_limit(p.mass, c, self.conductance_sum, fixed)
+            boundary = by_mech[:, self.boundary_columns].sum(axis=0)
+            absorbed, bad = kernels.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
+                                                          p.type_id, self.c_t, self.c_v,
+                                                          self.c_n, fixed, dt)  # fmt: skip
         else:
             # one fused pass: heat rate, Euler limit, update and the ledger sums
-            rows = p.count // K.EULER_CHUNK + 1
+            rows = p.count // kernels.EULER_CHUNK + 1
             if self.euler_partials.shape[0] < rows:
-                self.euler_partials = np.zeros((rows, 6))
-            self.limit, where, wall_q, source_q, absorbed, bad = K.euler_step(
-                p.temperature, p.heat_rate, p.heat_rate_by_mechanism, source, p.mass,
-                p.type_id, self.specific_heat_by_type, self.conductance_sum, fixed, dt,
+                self.euler_partials = np.zeros((rows, self.euler_partials.shape[1]))
+            self.limit, where, absorbed, bad = kernels.euler_step(
+                p.temperature, p.heat_rate, by_mech, self.sum_columns, source, p.mass, p.type_id,
+                self.specific_heat_by_type, self.conductance_sum, fixed, dt,
                 self.euler_partials,
             )  # fmt: skip
+            boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
+            boundary = boundary[self.boundary_columns]
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
         if dt > self.limit and not self.settings.stability.allow_unstable:
             raise SimulationError(
@@ -446,8 +513,8 @@ class ThermalEngine:
                 time,
                 self.limit_particle,
             )
-        self.cumulative["wall_heat"] += wall_q * dt
-        self.cumulative["source_heat"] += source_q * dt
+        for m, q in zip(self.boundary_columns, boundary, strict=True):
+            self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
         if bad >= 0:
@@ -472,41 +539,93 @@ class ThermalEngine:
         if mask is not None:
             t, m, ty = t[mask], m[mask], ty[mask]
         if self.has_c_table:
-            return K.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
+            return kernels.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
         return float(np.sum(m * self.specific_heat_by_type[ty] * t))
 
     def inserted(self, temperature: np.ndarray, mass: np.ndarray, type_id: np.ndarray) -> None:
         """Ledger the thermal energy that inserted particles bring in."""
         if self.has_c_table:
-            e = K.total_enthalpy(temperature, mass, type_id, self.c_t, self.c_v, self.c_n)
+            e = kernels.total_enthalpy(temperature, mass, type_id, self.c_t, self.c_v, self.c_n)
         else:
             e = float(np.sum(mass * self.specific_heat_by_type[type_id] * temperature))
         self.cumulative["inserted_heat"] += e
 
+    def boundary_heat(self) -> float:
+        """Heat that entered the particles through every boundary mechanism so far [J]."""
+        return sum(v for k, v in self.cumulative.items() if k.startswith("heat_in_"))
+
     def balance_error(self) -> float:
-        """U(t) - U(0) - wall heat - sources + heat absorbed by fixed particles - heat of
-        inserted particles - resets of newly fixed particles [J]; round-off."""
+        """U(t) - U(0) - boundary heat + heat absorbed by fixed particles - heat of inserted
+        particles - resets of newly fixed particles [J]; round-off."""
         cum = self.cumulative
-        return (self.thermal_energy() - self.initial_energy - cum["wall_heat"]
-                - cum["source_heat"] + cum["fixed_absorbed"] - cum["inserted_heat"]
-                - cum["fixed_reset"])  # fmt: skip
+        return (self.thermal_energy() - self.initial_energy - self.boundary_heat()
+                + cum["fixed_absorbed"] - cum["inserted_heat"] - cum["fixed_reset"])  # fmt: skip
 
     def summary(self) -> dict[str, float]:
-        """Temperature statistics, heat by mechanism [W] and the heat ledger [J]."""
+        """Temperature statistics, heat rates by mechanism [W] and the heat ledger [J].
+
+        ``heat_rate_<mechanism>``: for pairwise mechanisms the heat exchanged, ½ Σ|Q_i| (they
+        sum to zero); for boundary mechanisms the net heat into the particles, Σ Q_i.
+        """
         p = self.sim.particles
         out: dict[str, float] = {}
         if p.count:
             out.update(temperature_mean=float(p.temperature.mean()),
                        temperature_min=float(p.temperature.min()),
                        temperature_max=float(p.temperature.max()))  # fmt: skip
-        # absolute heat exchanged by mechanism (pairwise terms sum to zero, so report |Q|/2)
-        for k, name in enumerate(HEAT_MECHANISMS):
+        for k in self.in_use:
+            mech = heat.MECHANISMS[k]
             col = p.heat_rate_by_mechanism[:, k]
-            if np.any(col):
-                total = float(np.abs(col).sum())
-                out[f"heat_rate_{name}"] = 0.5 * total if name == "direct_conduction" else total
+            total = float(col.sum()) if mech.boundary else 0.5 * float(np.abs(col).sum())
+            out[f"heat_rate_{mech.name}"] = total
         out["thermal_energy"] = self.thermal_energy()
-        out.update({f"heat_{k}": v for k, v in self.cumulative.items()})
+        for k in self.in_use:
+            if heat.MECHANISMS[k].boundary:
+                name = f"heat_in_{heat.HEAT_MECHANISMS[k]}"
+                out[name] = self.cumulative[name]
+        out.update({k: v for k, v in self.cumulative.items() if not k.startswith("heat_in_")})
         out["heat_balance_error"] = self.balance_error()
         out["thermal_limit"] = self.limit
+        if self.range_set is not None:
+            out["range_pair_count"] = self.range_set.count
         return out
+
+    # ------------------------------------------------------------------------ checkpoints
+    def state_dict(self) -> dict[str, Any]:
+        """Scalars and arrays of the engine (the range set's under ``range_set`` and
+        ``range_set__<array>``), the layout the checkpoint writer stores."""
+        from thermodem.engine.restart import _object_state
+
+        state = _object_state(self, SKIP)
+        if self.range_set is not None:
+            rs = self.range_set.state_dict()
+            state["scalars"]["range_set"] = rs["scalars"]
+            state["arrays"].update({f"{RANGE_PREFIX}{k}": v for k, v in rs["arrays"].items()})
+        return state
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        scalars = dict(state["scalars"])
+        arrays = dict(state["arrays"])
+        range_scalars = scalars.pop("range_set", None)
+        range_arrays = {
+            k[len(RANGE_PREFIX) :]: arrays.pop(k)
+            for k in list(arrays)
+            if k.startswith(RANGE_PREFIX)
+        }
+        for name, value in scalars.items():
+            current = getattr(self, name, None)
+            if isinstance(current, float) and value is not None:
+                value = float(value)
+            if isinstance(current, dict):
+                value = {k: float(v) for k, v in value.items()}
+            setattr(self, name, value)
+        for name, value in arrays.items():
+            setattr(self, name, np.array(value, copy=True))
+        if self.range_set is not None:
+            if range_scalars is None:
+                raise ConfigError(
+                    "checkpoint has no range pair set but this case's thermal terms need one "
+                    "(thermal.indirect_conduction, or a direct model that conducts across gaps)"
+                )
+            self.range_set.load_state_dict({"scalars": range_scalars, "arrays": range_arrays})
+        self.conditions.invalidate()

@@ -93,16 +93,16 @@ def reduce_checks(chunk_check, n):
 @njit(cache=True, parallel=True, error_model="numpy")
 def reset_forces(force, torque, mass, gravity, heat_on, by_mechanism, conductance_sum):
     """Set each particle's force to its weight and its torque to zero before the pair passes
-    add the contacts; with ``heat_on`` also zero the conduction sums they add to (direct and
-    wall columns of ``by_mechanism``, ``conductance_sum``)."""
+    add the contacts; with ``heat_on`` also zero the heat sums the passes and the thermal terms
+    add to (every column of ``by_mechanism``, ``conductance_sum``)."""
     for i in prange(force.shape[0]):
         m = mass[i]
         for a in range(3):
             force[i, a] = m * gravity[a]
             torque[i, a] = 0.0
         if heat_on:
-            by_mechanism[i, 0] = 0.0
-            by_mechanism[i, 6] = 0.0
+            for m in range(by_mechanism.shape[1]):
+                by_mechanism[i, m] = 0.0
             conductance_sum[i] = 0.0
 
 

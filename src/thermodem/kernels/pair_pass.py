@@ -45,12 +45,9 @@ from thermodem.kernels.contact import (
 )
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.models import registry
+from thermodem.state.heat import M_DIRECT, M_WALL_DIRECT
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
-
-# per-particle heat mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
-M_DIRECT = 0
-M_WALL = 6
 
 
 #: history columns of the conductance reuse (last in the row, present only when
@@ -163,7 +160,7 @@ def _pw_conductance(
 def reusable(conduction_id: int) -> bool:
     """Whether the direct-conduction model of this id allows the conductance reuse."""
     specs = [m for m in registry.all_models() if m.family == "direct_conduction"]
-    return any(m.model_id == conduction_id and m.extra.get("conductance_from_force") for m in specs)
+    return any(m.model_id == conduction_id and m.conductance_from_force for m in specs)
 
 
 _PASSES: dict[tuple[bool, int, int, int], tuple] = {}
@@ -240,10 +237,10 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         """Contact forces of every listed particle pair, added to ``force`` and ``torque``
         (see module docstring; the caller sets them to their non-contact values first).
 
-        With ``heat_on`` the same pass evaluates the conduction of every touching and near pair
-        (see :func:`thermodem.kernels.conduction.pair_conductance`) with the temperatures of
-        this moment, and adds the heat rate to column 0 of ``by_mechanism`` and the conductance
-        to ``conductance_sum`` of both particles (the caller zeroes them first).
+        With ``heat_on`` the same pass evaluates the conduction of every touching pair (see
+        :func:`thermodem.kernels.conduction.pair_conductance`) with the temperatures of this
+        moment, and adds the heat rate to the direct-conduction column of ``by_mechanism`` and
+        the conductance to ``conductance_sum`` of both particles (the caller zeroes them first).
         """
         # the model choice as compile-time constants (see passes_for)
         heat_on = HEAT_ON
@@ -348,11 +345,10 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                         r_min = min(ri, rj)
                         if overlap > row[L_MAX_OVERLAP_RATIO] * r_min:  # (no division per contact)
                             row[L_MAX_OVERLAP_RATIO] = overlap / r_min
-                    # conduction of touching and near pairs (one call site: Numba's SSA check
-                    # warns when the inlined model selection appears twice in one function)
-                    if heat_on and out_state[k] != STATE_FAR:
-                        if out_state[k] != STATE_TOUCHING:
-                            eff_mass = mass[i] * mass[j] / (mass[i] + mass[j])
+                    # conduction of touching pairs (one call site: Numba's SSA check warns
+                    # when the inlined model selection appears twice in one function); pairs
+                    # across a gap are the range set's (engine/range_set.py)
+                    if heat_on and out_state[k] == STATE_TOUCHING:
                         h = _pp_conductance(
                             k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
@@ -419,7 +415,7 @@ def wall_pair_pass(
 
     Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
     ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
-    column 6 of ``by_mechanism`` and to ``conductance_sum``.
+    the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
     """
     n = radius.shape[0]
     nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
@@ -508,9 +504,9 @@ def wall_pair_pass(
                 ratio = overlap / ri
                 if ratio > row[L_MAX_OVERLAP_RATIO]:
                     row[L_MAX_OVERLAP_RATIO] = ratio
-            # conduction from fixed-temperature walls, touching and near pairs (one call site,
-            # as in the particle pass)
-            if heat_on and out_state[k] != STATE_FAR:
+            # conduction from fixed-temperature walls, touching pairs (one call site, as in the
+            # particle pass)
+            if heat_on and out_state[k] == STATE_TOUCHING:
                 h = 0.0
                 if wrow[COL_THERMAL_KIND] != 0.0:
                     h = _pw_conductance(
@@ -519,5 +515,5 @@ def wall_pair_pass(
                         conduction_table, override, k_particle, rhoc_particle, k_wall,
                         rhoc_wall, srow, tolerance,
                     )  # fmt: skip
-                by_mechanism[i, M_WALL] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
                 conductance_sum[i] += h

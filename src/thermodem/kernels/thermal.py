@@ -1,10 +1,12 @@
-"""Thermal passes: conduction per pair, then per-particle sums and explicit Euler.
+"""Thermal passes of the contact conduction, and the per-particle explicit Euler update.
 
-The pair pass computes, for each listed particle pair and particle–wall pair, the conductance
-H (the direct-conduction model evaluated at T_i = 0, T_j = 1: every model of the spec is linear
-in the temperature difference) and the heat rate into i, Q = H (T_j - T_i). It writes per-pair
-arrays; :func:`heat_scatter` adds them to both particles by slab group, so what i gains j loses
-exactly and the result does not depend on the number of threads.
+The heat-only contact passes compute, for each touching particle pair and particle–wall pair
+of the contact lists, the conductance H of the contact conduction (the direct-conduction model
+evaluated at T_i = 0, T_j = 1: every direct model of the spec is linear in the temperature
+difference) into per-pair arrays; ``kernels/heat_terms.py`` adds the heat rates
+Q = H (T_j - T_i) to both particles by slab group, so what i gains j loses exactly and the
+result does not depend on the number of threads. These passes serve frozen mechanics and the
+start of a run; otherwise the fused contact pass of the mechanics computes the same numbers.
 """
 
 from __future__ import annotations
@@ -14,16 +16,11 @@ from typing import Any
 
 from numba import njit, prange
 
-from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
-from thermodem.kernels.contact import CHUNK, STATE_FAR
+from thermodem.geometry.wall_layout import COL_THERMAL_KIND
+from thermodem.kernels.contact import CHUNK, STATE_TOUCHING
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance, reusable
-
-# per-particle mechanism columns (see thermodem.state.particles.HEAT_MECHANISMS)
-M_DIRECT = 0
-M_SOURCE = 5
-M_WALL = 6
-
+from thermodem.state.heat import M_SOURCE
 
 _CONDUCTION_PASSES: dict[tuple[int, int, int], Any] = {}
 
@@ -47,9 +44,9 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
     def conduction_pair_pass(
         position, radius, mass, temperature, type_id, pair_i, pair_j, npairs, state, normal_force,
         history, lower, upper, periodic, radius_id, radius_table, conduction_id, conduction_table,
-        override, k_particle, rhoc_particle, scratch, out_conductance, out_heat, tolerance,
+        override, k_particle, rhoc_particle, scratch, out_conductance, tolerance,
     ):  # fmt: skip
-        """Conductance and heat rate into i of every listed particle pair (near pairs included).
+        """Conductance of every listed particle pair (0 unless touching).
 
         With ``override`` > 0 the conductivity columns (0, 1) of the model's row are replaced by
         the particles' current k(T), and with ``override`` > 1 also the heat capacity columns
@@ -66,9 +63,8 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
         for c in prange(nchunks):
             row = scratch[c]
             for k in range(c * CHUNK, min(npairs, (c + 1) * CHUNK)):
-                if state[k] == STATE_FAR:
+                if state[k] != STATE_TOUCHING:
                     out_conductance[k] = 0.0
-                    out_heat[k] = 0.0
                     continue
                 i = pair_i[k]
                 j = pair_j[k]
@@ -83,7 +79,6 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
                     rhoc_particle, row, tolerance,
                 )  # fmt: skip
                 out_conductance[k] = h
-                out_heat[k] = h * (temperature[j] - temperature[i])
 
     return conduction_pair_pass
 
@@ -93,9 +88,9 @@ def conduction_wall_pass(
     position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
     normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
     conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
-    scratch, out_conductance, out_heat, tolerance,
+    scratch, out_conductance, tolerance,
 ):  # fmt: skip
-    """Heat from fixed-temperature walls into particles (adiabatic walls give zero).
+    """Conductance of touching particle–fixed-temperature-wall pairs (adiabatic walls: 0).
 
     ``override`` as in :func:`conduction_pair_pass`; the wall's values are ``k_wall[w]`` and
     ``rhoc_wall[w]`` (its material at the wall temperature).
@@ -106,9 +101,8 @@ def conduction_wall_pass(
         for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
             w = wall_pair_w[k]
             wrow = wall_rows[w]
-            if state[k] == STATE_FAR or wrow[COL_THERMAL_KIND] == 0.0:
+            if state[k] != STATE_TOUCHING or wrow[COL_THERMAL_KIND] == 0.0:
                 out_conductance[k] = 0.0
-                out_heat[k] = 0.0
                 continue
             i = wall_pair_i[k]
             d = wall_distance(wall_kind[w], wrow, position[i])[0]
@@ -120,89 +114,6 @@ def conduction_wall_pass(
                 rhoc_particle, k_wall, rhoc_wall, row, tolerance,
             )  # fmt: skip
             out_conductance[k] = h
-            out_heat[k] = h * (wrow[COL_TEMPERATURE] - temperature[i])
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def heat_from_conductance(
-    pair_i, pair_j, npairs, wall_pair_i, wall_pair_w, nwpairs, wall_rows, temperature,
-    pair_conductance, wall_conductance, out_pair_heat, out_wall_heat,
-):  # fmt: skip
-    """Pair and wall heat rates from conductances already computed for these same contacts:
-    Q = H (T_j - T_i), the expression of the conduction passes, so the result is the same to
-    the bit. Used with frozen mechanics and temperature-independent properties, where nothing
-    that H depends on changes between thermal steps."""
-    for c in prange((npairs + CHUNK - 1) // CHUNK):
-        for k in range(c * CHUNK, min(npairs, (c + 1) * CHUNK)):
-            h = pair_conductance[k]
-            out_pair_heat[k] = h * (temperature[pair_j[k]] - temperature[pair_i[k]]) if h else 0.0
-    for k in range(nwpairs):
-        h = wall_conductance[k]
-        t_wall = wall_rows[wall_pair_w[k], COL_TEMPERATURE]
-        out_wall_heat[k] = h * (t_wall - temperature[wall_pair_i[k]]) if h else 0.0
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def heat_scatter(
-    pair_i, pair_j, group_start, pair_conductance, pair_heat, wall_row_start, wall_conductance,
-    wall_heat, source, heat_rate, by_mechanism, conductance_sum,
-):  # fmt: skip
-    """Per-particle heat rate by mechanism and the sum of conductances from the per-pair arrays.
-
-    The pair heat is added to both particles by slab group, even groups then odd groups
-    (:mod:`thermodem.kernels.slabs`), in the order of the fused contact pass: what i gains j
-    loses exactly, and the sums do not depend on the number of threads.
-    """
-    n = heat_rate.shape[0]
-    for i in prange(n):
-        for m in range(by_mechanism.shape[1]):
-            by_mechanism[i, m] = 0.0
-        conductance_sum[i] = 0.0
-    ngroups = group_start.shape[0] - 1
-    for parity in range(2):
-        for half in prange((ngroups + 1 - parity) // 2):
-            g = 2 * half + parity
-            for k in range(group_start[g], group_start[g + 1]):
-                h = pair_conductance[k]
-                if h == 0.0:
-                    continue
-                i = pair_i[k]
-                j = pair_j[k]
-                q = pair_heat[k]
-                by_mechanism[i, M_DIRECT] += q
-                by_mechanism[j, M_DIRECT] -= q
-                conductance_sum[i] += h
-                conductance_sum[j] += h
-    for i in prange(n):
-        q_wall = 0.0
-        h_sum = conductance_sum[i]
-        for k in range(wall_row_start[i], wall_row_start[i + 1]):
-            q_wall += wall_heat[k]
-            h_sum += wall_conductance[k]
-        by_mechanism[i, M_WALL] = q_wall
-        by_mechanism[i, M_SOURCE] = source[i]
-        heat_rate[i] = by_mechanism[i, M_DIRECT] + q_wall + source[i]
-        conductance_sum[i] = h_sum
-
-
-@njit(cache=True, error_model="numpy")
-def euler_update(temperature, heat_rate, mass, specific_heat, fixed, dt):
-    """T += dt Q / (m c) except for fixed-temperature particles.
-
-    Returns (heat absorbed by fixed particles [W] summed, smallest m c / ΣH limit is not
-    computed here, index of the first non-finite or non-positive temperature or -1).
-    """
-    absorbed = 0.0
-    bad = -1
-    for i in range(temperature.shape[0]):
-        if fixed[i]:
-            absorbed += heat_rate[i]
-            continue
-        t = temperature[i] + dt * heat_rate[i] / (mass[i] * specific_heat[i])
-        temperature[i] = t
-        if bad < 0 and not (t > 0.0 and math.isfinite(t)):
-            bad = i
-    return absorbed, bad
 
 
 @njit(cache=True, error_model="numpy")
@@ -292,45 +203,56 @@ def total_enthalpy(temperature, mass, type_id, table_t, table_c, table_n):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def finish_heat(source, heat_rate, by_mechanism):
-    """Source column and total heat rate after the fused contact pass filled columns 0 and 6
-    (:func:`heat_scatter` fills them itself)."""
+def finish_heat(source, heat_rate, by_mechanism, columns):
+    """Source column and total heat rate: the sum of the mechanism columns ``columns`` (the
+    columns in use, ascending; the others are zero)."""
     for i in prange(heat_rate.shape[0]):
         by_mechanism[i, M_SOURCE] = source[i]
-        heat_rate[i] = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
+        q = 0.0
+        for m in columns:
+            q += by_mechanism[i, m]
+        heat_rate[i] = q
 
 
 EULER_CHUNK = 4096
+#: Columns of the per-chunk partial results of :func:`euler_step` before the per-mechanism sums.
+EULER_FIXED = 4
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def euler_step(temperature, heat_rate, by_mechanism, source, mass, type_id, c_by_type,
-               conductance_sum, fixed, dt, part):  # fmt: skip
+def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type_id,
+               c_by_type, conductance_sum, fixed, dt, part):  # fmt: skip
     """One fused per-particle thermal update with constant specific heats.
 
-    Fills the source column and the total heat rate, finds the explicit Euler limit
-    min m c / ΣH over free particles, applies T += dt Q / (m c) to free particles, and sums the
-    wall heat, source heat and heat absorbed by fixed particles [W].
-    Returns (limit, limit index, wall heat, source heat, absorbed, first bad index or -1).
+    Fills the source column and the total heat rate (the sum of the mechanism columns in use,
+    ``columns``, ascending: the others are zero), finds the explicit Euler limit min m c / ΣH
+    over free particles, applies T += dt Q / (m c) to free particles, and sums per chunk the
+    heat absorbed by fixed particles and every mechanism column in use [W]
+    (``part[c, EULER_FIXED + m]``).
+    Returns (limit, limit index, absorbed, first bad index or -1).
     Parallel over fixed chunks of EULER_CHUNK particles whose partial results are combined in
     chunk order, so the sums do not depend on the number of threads (``part``: at least
-    n // EULER_CHUNK + 1 rows of 6, scratch).
+    n // EULER_CHUNK + 1 rows of EULER_FIXED + the number of mechanisms, scratch).
     """
     n = temperature.shape[0]
+    nmech = by_mechanism.shape[1]
     nchunks = (n + EULER_CHUNK - 1) // EULER_CHUNK
     for c in prange(nchunks):
         limit = math.inf
         where = -1
-        wall_q = 0.0
-        source_q = 0.0
         absorbed = 0.0
         bad = -1
+        row = part[c]
+        for m in range(nmech):
+            row[EULER_FIXED + m] = 0.0
         for i in range(c * EULER_CHUNK, min(n, (c + 1) * EULER_CHUNK)):
             by_mechanism[i, M_SOURCE] = source[i]
-            q = by_mechanism[i, M_DIRECT] + by_mechanism[i, M_WALL] + source[i]
+            q = 0.0
+            for m in columns:
+                qm = by_mechanism[i, m]
+                q += qm
+                row[EULER_FIXED + m] += qm
             heat_rate[i] = q
-            wall_q += by_mechanism[i, M_WALL]
-            source_q += source[i]
             if fixed[i]:
                 absorbed += q
                 continue
@@ -344,25 +266,19 @@ def euler_step(temperature, heat_rate, by_mechanism, source, mass, type_id, c_by
             temperature[i] = t
             if bad < 0 and not (t > 0.0 and math.isfinite(t)):
                 bad = i
-        part[c, 0] = limit
-        part[c, 1] = where
-        part[c, 2] = wall_q
-        part[c, 3] = source_q
-        part[c, 4] = absorbed
-        part[c, 5] = bad
+        row[0] = limit
+        row[1] = where
+        row[2] = absorbed
+        row[3] = bad
     limit = math.inf
     where = -1
-    wall_q = 0.0
-    source_q = 0.0
     absorbed = 0.0
     bad = -1
     for c in range(nchunks):
         if part[c, 0] < limit:
             limit = part[c, 0]
             where = int(part[c, 1])
-        wall_q += part[c, 2]
-        source_q += part[c, 3]
-        absorbed += part[c, 4]
-        if bad < 0 and part[c, 5] >= 0:
-            bad = int(part[c, 5])
-    return limit, where, wall_q, source_q, absorbed, bad
+        absorbed += part[c, 2]
+        if bad < 0 and part[c, 3] >= 0:
+            bad = int(part[c, 3])
+    return limit, where, absorbed, bad

@@ -3,5 +3,6 @@
 from thermodem.models.thermal import (  # noqa: F401
     contact_radius,
     direct_conduction,
+    indirect_conduction,
     resistance_network,
 )

@@ -1,0 +1,154 @@
+"""Heat terms: every selected thermal model, built from the registry.
+
+A :class:`HeatTerm` is one registered model with its packed parameter table, where it runs
+(its ``target``: the touching pairs of the contact lists, the pairs of the range set, an
+external pair set, or single particles), which kernel evaluates it, and the mechanism
+columns it writes (``thermodem.state.heat``). The thermal engine loops over the terms; it
+names no model family.
+
+The conduction through the contact (the ``contact_radius`` × ``direct_conduction`` pair) is
+the :class:`ContactConduction` term: it runs inside the fused contact pass of the mechanics
+(``kernels/pair_pass.py``, compiled per combination of those two models), the fast path of a
+dense bed. Everything else is a :class:`HeatTerm` evaluated by the heat-only passes of
+``kernels/heat_terms.py`` at thermal steps.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from pydantic import BaseModel
+
+from thermodem.config.schema import Case, ModelChoice
+from thermodem.errors import ConfigError
+from thermodem.kernels.heat_terms import EVAL_INDIRECT, EVAL_SEPARATED
+from thermodem.models.registry import ModelSpec
+from thermodem.models.tables import pair_table
+from thermodem.state import heat
+
+
+@dataclass
+class ContactConduction:
+    """The contact radius and direct conduction models of the fused contact pass."""
+
+    radius: ModelChoice
+    direct: ModelChoice
+    radius_table: np.ndarray
+    direct_table: np.ndarray
+
+    @property
+    def radius_id(self) -> int:
+        return self.radius.spec.model_id
+
+    @property
+    def direct_id(self) -> int:
+        return self.direct.spec.model_id
+
+    @property
+    def active(self) -> bool:
+        """False when direct conduction is ``none`` (the fused pass then carries no heat)."""
+        return self.direct.model != "none"
+
+
+@dataclass
+class HeatTerm:
+    """One selected thermal model evaluated by a heat-only pass (see the module docstring)."""
+
+    key: str  # the case key that selects it, for messages ("thermal.indirect_conduction")
+    choice: ModelChoice
+    target: str  # "contacts" | "range" | "external" | "particles"
+    evaluator: int  # EVAL_* of kernels/heat_terms.py
+    table: np.ndarray  # [nmat, nmat, width]
+    column: int  # mechanism column of particle pairs
+    wall_column: int  # mechanism column of particle-wall pairs
+    k_columns: tuple[int, int]  # row columns replaced by k(T) of the two bodies, (-1, -1): none
+
+    @property
+    def spec(self) -> ModelSpec:
+        return self.choice.spec
+
+    @property
+    def params(self) -> BaseModel:
+        return self.choice.params
+
+    @property
+    def model_id(self) -> int:
+        return self.spec.model_id
+
+    def max_gap(self, radius: float) -> tuple[float, float]:
+        """Largest conducting surface gap [m] of particle pairs and particle-wall pairs for
+        particles up to ``radius`` (ranges grow with the radii: ratio × R*, ratio × R_k)."""
+        fn = self.spec.interaction_range
+        if fn is None:
+            return 0.0, 0.0
+        return float(fn(self.params, radius, radius)), float(fn(self.params, radius, np.inf))
+
+
+def _k_columns(spec: ModelSpec) -> tuple[int, int]:
+    cols = spec.columns or ()
+    if "k_i" in cols and "k_j" in cols:
+        return cols.index("k_i"), cols.index("k_j")
+    return -1, -1
+
+
+def build_terms(
+    case: Case,
+    names: list[str],
+    meets: Callable[[str, str], bool],
+    is_wall: Callable[[str, str], bool],
+) -> tuple[ContactConduction, list[HeatTerm]]:
+    """The contact conduction and the other heat terms of the case's thermal section."""
+    settings = case.thermal
+    radius, direct = settings.contact_radius, settings.direct_conduction
+
+    def table(choice: ModelChoice, key: str) -> np.ndarray:
+        return pair_table(choice, case, names, meets=meets, is_wall=is_wall, key=key)
+
+    contact = ContactConduction(
+        radius=radius,
+        direct=direct,
+        radius_table=table(radius, "thermal.contact_radius"),
+        direct_table=table(direct, "thermal.direct_conduction"),
+    )
+    terms: list[HeatTerm] = []
+    if direct.spec.interaction_range is not None:
+        # the separated-pair part of a direct model that conducts across a gap: range set
+        terms.append(
+            HeatTerm(
+                key="thermal.direct_conduction",
+                choice=direct,
+                target="range",
+                evaluator=EVAL_SEPARATED,
+                table=contact.direct_table,
+                column=heat.M_INDIRECT,
+                wall_column=heat.M_WALL_INDIRECT,
+                k_columns=_k_columns(direct.spec),
+            )
+        )
+    indirect = settings.indirect_conduction
+    if indirect.model != "none":
+        if direct.spec.interaction_range is not None or direct.model == "resistance_network":
+            raise ConfigError(
+                f"thermal.indirect_conduction = {indirect.model!r} cannot be combined with "
+                f"thermal.direct_conduction = {direct.model!r}: that model already includes the "
+                "conduction through the gas around the contact"
+                + (" and between separated particles" if direct.spec.interaction_range else "")
+                + ", which would be counted twice; choose a contact-only direct model (e.g. "
+                "batchelor_obrien_simple) with it, or indirect_conduction: none"
+            )
+        pair_col, wall_col = heat.FAMILY_COLUMNS["indirect_conduction"]
+        terms.append(
+            HeatTerm(
+                key="thermal.indirect_conduction",
+                choice=indirect,
+                target=indirect.spec.target,
+                evaluator=EVAL_INDIRECT,
+                table=table(indirect, "thermal.indirect_conduction"),
+                column=pair_col,
+                wall_column=wall_col,
+                k_columns=_k_columns(indirect.spec),
+            )
+        )
+    return contact, terms

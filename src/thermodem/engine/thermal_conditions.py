@@ -1,0 +1,276 @@
+"""Thermal conditions of a case: initial temperatures, wall temperatures, fixed-temperature
+particles and the heat sources (flux, volumetric, external).
+
+Selections (``thermal.fixed_temperature``, ``heat_flux``, ``volumetric_source``) hold by
+material, global ids and a box region; every given criterion must hold. The material and id
+criteria depend on the particles only, so they are evaluated once into a per-particle mask per
+entry and kept until the particles are reordered (a neighbour rebuild) or inserted; the region
+criterion follows the current positions and is tested at every thermal step inside one
+compiled parallel pass over the particles (:func:`apply_conditions`), which also writes the
+source powers and sets fixed particles to their bath temperature. External sources (a power
+shared by the particles in a box, uniform or Gaussian) take a second compiled pass over the
+particles in their box. Nothing here loops over particles in Python.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numba import njit, prange
+
+from thermodem.config.thermal import Selection
+from thermodem.engine.expressions import compile_expression
+from thermodem.geometry import wall_layout as wall_cols
+
+if TYPE_CHECKING:
+    from thermodem.config.thermal import ThermalSettings
+    from thermodem.engine.simulation import Simulation
+
+CHUNK = 4096  # particles per chunk of the condition passes
+
+# kinds of entries of the compiled pass
+FIXED = 0
+FLUX = 1
+VOLUMETRIC = 2
+
+
+def wall_temperature_function(spec: Any) -> Any:
+    """t -> T of a fixed-temperature wall (constant, table or expression)."""
+    value = spec.temperature
+    if isinstance(value, int | float):
+        return lambda t: float(value)
+    if isinstance(value, list):
+        times = np.array([a for a, _ in value])
+        temps = np.array([b for _, b in value])
+        return lambda t: float(np.interp(t, times, temps))
+    expr = compile_expression(value, ("t",))
+    return lambda t: float(expr(t))
+
+
+def in_box(position: np.ndarray, box: Any) -> np.ndarray:
+    """Mask of positions inside an axis-aligned box (bounds included)."""
+    lo = np.asarray(box.lower)
+    hi = np.asarray(box.upper)
+    return np.all((position >= lo) & (position <= hi), axis=1)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def apply_conditions(
+    position, radius, mass, type_id, temperature, c_by_type, static_mask, kinds, values,
+    has_region, boxes, fixed, source, part,
+):  # fmt: skip
+    """Fixed temperatures and flux/volumetric sources of every entry, in entry order.
+
+    Entry e (``kinds[e]``: FIXED, FLUX or VOLUMETRIC, ``values[e]``: its temperature, flux or
+    power density) holds for particle i when ``static_mask[i, e]`` and, if ``has_region[e]``,
+    the particle is inside ``boxes[e]`` (lower 0:3, upper 3:6). A fixed particle gets its bath
+    temperature (the last holding entry wins); ``part[c]`` collects per chunk the energy that
+    this reset adds, m c (T_bath - T), with the constant specific heats ``c_by_type``.
+    Rewrites ``fixed`` and ``source`` completely.
+    """
+    n = temperature.shape[0]
+    nentries = kinds.shape[0]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunks):
+        reset = 0.0
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            is_fixed = False
+            bath = 0.0
+            q = 0.0
+            x = position[i, 0]
+            y = position[i, 1]
+            z = position[i, 2]
+            for e in range(nentries):
+                if not static_mask[i, e]:
+                    continue
+                if has_region[e]:
+                    b = boxes[e]
+                    if not (b[0] <= x <= b[3] and b[1] <= y <= b[4] and b[2] <= z <= b[5]):
+                        continue
+                kind = kinds[e]
+                if kind == FIXED:
+                    is_fixed = True
+                    bath = values[e]
+                elif kind == FLUX:
+                    r = radius[i]
+                    q += values[e] * 4.0 * math.pi * r * r
+                else:
+                    r = radius[i]
+                    q += values[e] * 4.0 / 3.0 * math.pi * r * r * r
+            fixed[i] = is_fixed
+            source[i] = q
+            if is_fixed:
+                t_old = temperature[i]
+                temperature[i] = bath
+                reset += mass[i] * c_by_type[type_id[i]] * (bath - t_old)
+        part[c] = reset
+    total = 0.0
+    for c in range(nchunks):
+        total += part[c]
+    return total
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def external_weights(position, radius, lower, upper, gaussian, centre, axis, sigma, weight, part):
+    """Weights π R² (× exp(-r²/2σ²) for a Gaussian profile, r the distance from the line
+    through ``centre`` along ``axis``) of the particles inside the box, 0 outside; returns
+    their sum (chunk partial sums in ``part`` combined in order)."""
+    n = radius.shape[0]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunks):
+        s = 0.0
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            inside = True
+            for a in range(3):
+                if not (lower[a] <= position[i, a] <= upper[a]):
+                    inside = False
+            w = 0.0
+            if inside:
+                w = math.pi * radius[i] * radius[i]
+                if gaussian:
+                    rx = position[i, 0] - centre[0]
+                    ry = position[i, 1] - centre[1]
+                    rz = position[i, 2] - centre[2]
+                    dot = rx * axis[0] + ry * axis[1] + rz * axis[2]
+                    rx -= dot * axis[0]
+                    ry -= dot * axis[1]
+                    rz -= dot * axis[2]
+                    w *= math.exp(-(rx * rx + ry * ry + rz * rz) / (2.0 * sigma * sigma))
+            weight[i] = w
+            s += w
+        part[c] = s
+    total = 0.0
+    for c in range(nchunks):
+        total += part[c]
+    return total
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def add_weighted(source, weight, scale):
+    """source += scale × weight."""
+    for i in prange(source.shape[0]):
+        if weight[i] != 0.0:
+            source[i] += scale * weight[i]
+
+
+class ThermalConditions:
+    """The initial temperatures, wall temperatures, fixed particles and sources of a case."""
+
+    def __init__(self, sim: Simulation, settings: ThermalSettings) -> None:
+        self.sim = sim
+        self.settings = settings
+        self.wall_functions: list[Any] = []
+        for w in sim.case.walls:
+            fn = wall_temperature_function(w.thermal) if w.thermal.kind == "fixed" else None
+            count = 6 - int(w.open_top) if w.kind == "box" else 1
+            self.wall_functions.extend([fn] * count)
+        entries: list[tuple[int, float, Selection]] = []
+        entries += [(FIXED, f.temperature, f.select) for f in settings.fixed_temperature]
+        entries += [(FLUX, h.flux, h.select) for h in settings.heat_flux]
+        entries += [(VOLUMETRIC, v.power_density, v.select) for v in settings.volumetric_source]
+        self.selections = [sel for _, _, sel in entries]
+        self.kinds = np.array([k for k, _, _ in entries], np.int64)
+        self.values = np.array([v for _, v, _ in entries], np.float64)
+        self.has_region = np.array([sel.region is not None for sel in self.selections], np.bool_)
+        self.boxes = np.zeros((len(entries), 6))
+        for e, sel in enumerate(self.selections):
+            if sel.region is not None:
+                self.boxes[e, :3] = sel.region.lower
+                self.boxes[e, 3:] = sel.region.upper
+        self.static_mask = np.zeros((0, len(entries)), np.bool_)
+        self.static_valid = False
+        self.fixed = np.zeros(0, np.bool_)
+        self.source = np.zeros(0)
+        self._weight = np.zeros(0)
+        self._part = np.zeros(1)
+        self.active = bool(entries or settings.external_source)
+
+    def invalidate(self) -> None:
+        """The particles were reordered or inserted: recompute the static masks."""
+        self.static_valid = False
+
+    def _static_masks(self) -> None:
+        p = self.sim.particles
+        mask = np.ones((p.count, len(self.selections)), np.bool_)
+        for e, sel in enumerate(self.selections):
+            if sel.material is not None:
+                mask[:, e] &= p.type_id == self.sim.material_index[sel.material]
+            if sel.ids is not None:
+                mask[:, e] &= np.isin(p.global_id, np.asarray(sel.ids, np.int64))
+        self.static_mask = mask
+        self.static_valid = True
+
+    def apply(
+        self, time: float, specific_heat_by_type: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, float]:
+        """(fixed mask, source powers [W], energy added by resetting fixed particles [J]).
+
+        Fixed particles take their bath temperature; the reset energy is m c (T_bath - T)
+        with the constant specific heats (a tabulated c is handled by the caller).
+        """
+        p = self.sim.particles
+        n = p.count
+        if self.fixed.shape[0] != n:
+            self.fixed = np.zeros(n, np.bool_)
+            self.source = np.zeros(n)
+            self._weight = np.zeros(n)
+        if not self.active:
+            return self.fixed, self.source, 0.0
+        if not self.static_valid or self.static_mask.shape[0] != n:
+            self._static_masks()
+        rows = n // CHUNK + 1
+        if self._part.shape[0] < rows:
+            self._part = np.zeros(rows)
+        reset = apply_conditions(
+            p.position, p.radius, p.mass, p.type_id, p.temperature, specific_heat_by_type,
+            self.static_mask, self.kinds, self.values, self.has_region, self.boxes, self.fixed,
+            self.source, self._part,
+        )  # fmt: skip
+        for e in self.settings.external_source:
+            if not (e.start_time <= time < e.end_time):
+                continue
+            lower = np.asarray(e.region.lower, np.float64)
+            upper = np.asarray(e.region.upper, np.float64)
+            axis = np.asarray(e.axis, np.float64) / np.linalg.norm(e.axis)
+            centre = 0.5 * (lower + upper)
+            gaussian = e.profile == "gaussian"
+            total = external_weights(
+                p.position, p.radius, lower, upper, gaussian, centre, axis,
+                float(e.sigma or 1.0), self._weight, self._part,
+            )  # fmt: skip
+            if total > 0.0:
+                add_weighted(self.source, self._weight, e.power / total)
+        return self.fixed, self.source, reset
+
+    def update_walls(self, time: float) -> None:
+        """Wall rows: thermal kind and temperature at ``time``."""
+        rows = self.sim.wall_rows
+        for w, fn in enumerate(self.wall_functions):
+            if fn is None:
+                rows[w, wall_cols.COL_THERMAL_KIND] = 0.0
+            else:
+                rows[w, wall_cols.COL_THERMAL_KIND] = 1.0
+                rows[w, wall_cols.COL_TEMPERATURE] = fn(time)
+
+    def initial_temperature(self, position: np.ndarray, type_id: np.ndarray) -> np.ndarray:
+        """Initial temperatures [K] of new particles from ``thermal.initial_temperature``."""
+        rule = self.settings.initial_temperature
+        n = position.shape[0]
+        default = self.sim.case.simulation.initial_temperature
+        if rule is None:
+            return np.full(n, default)
+        if rule.kind == "uniform":
+            return np.full(n, rule.value)
+        if rule.kind == "per_material":
+            names = self.sim.material_names
+            values = np.array([rule.values.get(m, rule.default) for m in names])
+            return values[type_id]
+        if rule.kind == "regions":
+            out = np.full(n, rule.default)
+            for box, temp in rule.regions:
+                out[in_box(position, box)] = temp
+            return out
+        fn = compile_expression(rule.expression, ("x", "y", "z"))
+        return np.broadcast_to(fn(position[:, 0], position[:, 1], position[:, 2]), (n,)).copy()

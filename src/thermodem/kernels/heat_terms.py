@@ -1,0 +1,297 @@
+"""Heat-only passes of the thermal terms that are not the fused contact conduction.
+
+Every pass evaluates one term (a registered model, selected at run time by its evaluator and
+model id through an integer switch: one compiled kernel per pass kind serves every model, so
+compiled variants grow with the pass kinds, not with the model combinations) on one pair set,
+and **adds** the heat rate into its particles' mechanism column and the conductance into
+``conductance_sum`` (the explicit stability limit):
+
+- :func:`range_pair_pass`: pairs of the range set (surface gap within the term's interaction
+  range, touching pairs included), run by slab groups like the contact pass (even groups in
+  parallel, then odd ones; :mod:`thermodem.kernels.slabs`): race-free, and each particle
+  receives its contributions in an order fixed by the list, whatever the thread count;
+- :func:`range_wall_pass`: particle-wall pairs of the range set (fixed-temperature walls);
+- :func:`contact_term_pair_pass`, :func:`contact_term_wall_pass`: touching pairs of the
+  contact lists (terms that need the contact radius model and the normal force);
+- :func:`pair_heat_from_conductance`, :func:`wall_heat_from_conductance`: heat rates from
+  conductances stored by an earlier evaluation of the same pairs (frozen mechanics).
+
+Pairwise heat is antisymmetric by construction: one number q is added to i and subtracted
+from j. The conductance H of a pair is the model's value; the heat into i is H (T_j - T_i).
+With ``store`` the passes also write H per pair (``out_conductance``), which the frozen-
+mechanics path reuses and the per-contact output reads.
+
+The k(T) override: with ``k_col_i >= 0`` the row's columns ``k_col_i``, ``k_col_j`` are
+replaced by the two bodies' current conductivities (a scratch row per group or chunk).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit, prange
+
+from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
+from thermodem.kernels.contact import H_DURATION, H_IMPACT_VELOCITY, STATE_TOUCHING
+from thermodem.kernels.neighbors import minimum_image, pair_separation, wall_distance
+from thermodem.models.thermal.contact_radius import (
+    contact_radius_dispatch,
+    geometric_contact_radius,
+)
+from thermodem.models.thermal.direct_conduction import separated_conductance
+from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
+
+#: Evaluators of pair terms: an indirect_conduction model, or the separated-pair part of a
+#: direct_conduction model with an interaction range.
+EVAL_INDIRECT = 0
+EVAL_SEPARATED = 1
+
+WALL_CHUNK = 4096  # particles per chunk of the wall passes
+PARTICLE_CHUNK = 4096  # particles per chunk of the per-particle passes
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def term_conductance(evaluator, model_id, p, r_i, r_j, dist, r_c, f_n):
+    """Conductance [W/K] of one pair for a pair term (see the module docstring)."""
+    if evaluator == EVAL_SEPARATED:
+        return separated_conductance(model_id, p, r_i, r_j, dist)
+    return indirect_conduction_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _row(table_row, k_col_i, k_col_j, k_i, k_j, scratch_row):
+    """The parameter row, with the conductivity columns replaced when k_col_i >= 0."""
+    if k_col_i < 0:
+        return table_row
+    for q in range(table_row.shape[0]):
+        scratch_row[q] = table_row[q]
+    scratch_row[k_col_i] = k_i
+    scratch_row[k_col_j] = k_j
+    return scratch_row
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def range_pair_pass(
+    position, radius, temperature, type_id, pair_i, pair_j, group_start, lower, upper,
+    periodic, evaluator, model_id, table, k_col_i, k_col_j, k_particle, scratch, column,
+    by_mechanism, conductance_sum, store, out_conductance,
+):  # fmt: skip
+    """One pair term over the range pair set (slab groups; ``scratch``: a row per group)."""
+    length = upper - lower
+    ngroups = group_start.shape[0] - 1
+    for parity in range(2):
+        for half in prange((ngroups + 1 - parity) // 2):
+            g = 2 * half + parity
+            srow = scratch[g]
+            for k in range(group_start[g], group_start[g + 1]):
+                i = pair_i[k]
+                j = pair_j[k]
+                dist = pair_separation(position, i, j, length, periodic)[3]
+                ri = radius[i]
+                rj = radius[j]
+                r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+                ki = kj = 0.0
+                if k_col_i >= 0:
+                    ki = k_particle[i]
+                    kj = k_particle[j]
+                p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+                h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+                if store:
+                    out_conductance[k] = h
+                if h != 0.0:
+                    q = h * (temperature[j] - temperature[i])
+                    by_mechanism[i, column] += q
+                    by_mechanism[j, column] -= q
+                    conductance_sum[i] += h
+                    conductance_sum[j] += h
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def range_wall_pass(
+    position, radius, temperature, type_id, wall_pair_w, wall_row_start, wall_kind, wall_rows,
+    wall_material, evaluator, model_id, table, k_col_i, k_col_j, k_particle, k_wall, scratch,
+    column, by_mechanism, conductance_sum, store, out_conductance,
+):  # fmt: skip
+    """One pair term over the particle-wall pairs of the range set (``wall_row_start``: the
+    wall pairs of each particle); adiabatic walls give nothing."""
+    n = radius.shape[0]
+    nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
+    for c in prange(nchunks):
+        srow = scratch[c]
+        for i in range(c * WALL_CHUNK, min(n, (c + 1) * WALL_CHUNK)):
+            for k in range(wall_row_start[i], wall_row_start[i + 1]):
+                w = wall_pair_w[k]
+                wrow = wall_rows[w]
+                h = 0.0
+                if wrow[COL_THERMAL_KIND] != 0.0:
+                    d = wall_distance(wall_kind[w], wrow, position[i])[0]
+                    ri = radius[i]
+                    r_c = geometric_contact_radius(ri, math.inf, ri - d)
+                    ki = kw = 0.0
+                    if k_col_i >= 0:
+                        ki = k_particle[i]
+                        kw = k_wall[w]
+                    p = _row(table[type_id[i], wall_material[w]], k_col_i, k_col_j, ki, kw, srow)
+                    h = term_conductance(evaluator, model_id, p, ri, math.inf, d, r_c, 0.0)
+                if store:
+                    out_conductance[k] = h
+                if h != 0.0:
+                    by_mechanism[i, column] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    conductance_sum[i] += h
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def contact_term_pair_pass(
+    position, radius, mass, temperature, type_id, pair_i, pair_j, group_start, state,
+    normal_force, history, lower, upper, periodic, radius_id, radius_table, evaluator,
+    model_id, table, k_col_i, k_col_j, k_particle, scratch, column, by_mechanism,
+    conductance_sum, store, out_conductance,
+):  # fmt: skip
+    """One pair term over the touching pairs of the contact list, with the contact radius of
+    the case's contact_radius model and the pair's normal force."""
+    length = upper - lower
+    ngroups = group_start.shape[0] - 1
+    for parity in range(2):
+        for half in prange((ngroups + 1 - parity) // 2):
+            g = 2 * half + parity
+            srow = scratch[g]
+            for k in range(group_start[g], group_start[g + 1]):
+                h = 0.0
+                if state[k] == STATE_TOUCHING:
+                    i = pair_i[k]
+                    j = pair_j[k]
+                    dist = pair_separation(position, i, j, length, periodic)[3]
+                    ri = radius[i]
+                    rj = radius[j]
+                    m_eff = mass[i] * mass[j] / (mass[i] + mass[j])
+                    f_n = normal_force[k]
+                    r_c = contact_radius_dispatch(
+                        radius_id, radius_table[type_id[i], type_id[j]], ri, rj, dist,
+                        ri + rj - dist, f_n, history[k, H_DURATION], history[k, H_IMPACT_VELOCITY],
+                        m_eff,
+                    )  # fmt: skip
+                    ki = kj = 0.0
+                    if k_col_i >= 0:
+                        ki = k_particle[i]
+                        kj = k_particle[j]
+                    p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+                    h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, f_n)
+                    if h != 0.0:
+                        q = h * (temperature[j] - temperature[i])
+                        by_mechanism[i, column] += q
+                        by_mechanism[j, column] -= q
+                        conductance_sum[i] += h
+                        conductance_sum[j] += h
+                if store:
+                    out_conductance[k] = h
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def contact_term_wall_pass(
+    position, radius, mass, temperature, type_id, wall_pair_w, wall_row_start, state,
+    normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
+    evaluator, model_id, table, k_col_i, k_col_j, k_particle, k_wall, scratch, column,
+    by_mechanism, conductance_sum, store, out_conductance,
+):  # fmt: skip
+    """One pair term over the touching particle-wall pairs of the contact lists."""
+    n = radius.shape[0]
+    nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
+    for c in prange(nchunks):
+        srow = scratch[c]
+        for i in range(c * WALL_CHUNK, min(n, (c + 1) * WALL_CHUNK)):
+            for k in range(wall_row_start[i], wall_row_start[i + 1]):
+                w = wall_pair_w[k]
+                wrow = wall_rows[w]
+                h = 0.0
+                if state[k] == STATE_TOUCHING and wrow[COL_THERMAL_KIND] != 0.0:
+                    d = wall_distance(wall_kind[w], wrow, position[i])[0]
+                    ri = radius[i]
+                    tw = wall_material[w]
+                    f_n = normal_force[k]
+                    r_c = contact_radius_dispatch(
+                        radius_id, radius_table[type_id[i], tw], ri, math.inf, d, ri - d, f_n,
+                        history[k, H_DURATION], history[k, H_IMPACT_VELOCITY], mass[i],
+                    )  # fmt: skip
+                    ki = kw = 0.0
+                    if k_col_i >= 0:
+                        ki = k_particle[i]
+                        kw = k_wall[w]
+                    p = _row(table[type_id[i], tw], k_col_i, k_col_j, ki, kw, srow)
+                    h = term_conductance(evaluator, model_id, p, ri, math.inf, d, r_c, f_n)
+                    if h != 0.0:
+                        by_mechanism[i, column] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                        conductance_sum[i] += h
+                if store:
+                    out_conductance[k] = h
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def pair_heat_from_conductance(
+    pair_i, pair_j, group_start, conductance, temperature, column, by_mechanism,
+    conductance_sum,
+):  # fmt: skip
+    """Heat rates of a pair list from stored conductances, by slab groups (the order of the
+    passes that stored them): q = H (T_j - T_i) added to i, subtracted from j."""
+    ngroups = group_start.shape[0] - 1
+    for parity in range(2):
+        for half in prange((ngroups + 1 - parity) // 2):
+            g = 2 * half + parity
+            for k in range(group_start[g], group_start[g + 1]):
+                h = conductance[k]
+                if h != 0.0:
+                    i = pair_i[k]
+                    j = pair_j[k]
+                    q = h * (temperature[j] - temperature[i])
+                    by_mechanism[i, column] += q
+                    by_mechanism[j, column] -= q
+                    conductance_sum[i] += h
+                    conductance_sum[j] += h
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def wall_heat_from_conductance(
+    wall_pair_w, wall_row_start, wall_rows, conductance, temperature, column, by_mechanism,
+    conductance_sum,
+):  # fmt: skip
+    """Heat rates of particle-wall pairs from stored conductances (particle by particle)."""
+    n = temperature.shape[0]
+    for i in prange(n):
+        for k in range(wall_row_start[i], wall_row_start[i + 1]):
+            h = conductance[k]
+            if h != 0.0:
+                t_wall = wall_rows[wall_pair_w[k], COL_TEMPERATURE]
+                by_mechanism[i, column] += h * (t_wall - temperature[i])
+                conductance_sum[i] += h
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def zero_heat(by_mechanism, conductance_sum):
+    """Every mechanism column and the conductance sums to zero (before the terms add)."""
+    for i in prange(by_mechanism.shape[0]):
+        for m in range(by_mechanism.shape[1]):
+            by_mechanism[i, m] = 0.0
+        conductance_sum[i] = 0.0
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def largest_displacement(position, reference, lower, upper, periodic, part):
+    """Largest displacement since the reference positions (minimum image on periodic axes),
+    parallel over fixed chunks of PARTICLE_CHUNK (``part``: at least one scratch value per
+    chunk); the maximum does not depend on the thread count."""
+    length = upper - lower
+    n = position.shape[0]
+    nchunks = (n + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
+    for c in prange(nchunks):
+        local = 0.0
+        for i in range(c * PARTICLE_CHUNK, min(n, (c + 1) * PARTICLE_CHUNK)):
+            dx = minimum_image(position[i, 0] - reference[i, 0], length[0], periodic[0])
+            dy = minimum_image(position[i, 1] - reference[i, 1], length[1], periodic[1])
+            dz = minimum_image(position[i, 2] - reference[i, 2], length[2], periodic[2])
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 > local:
+                local = d2
+        part[c] = local
+    best = 0.0
+    for c in range(nchunks):
+        best = max(best, part[c])
+    return math.sqrt(best)

@@ -1,0 +1,224 @@
+"""Gap conduction on the range pair set (engine/range_set.py).
+
+Checked against things the engine does not compute itself: the closed form of Batchelor &
+O'Brien's separated-pair conductance, the exact solution of the explicit Euler recurrence of
+two spheres, an O(N²) brute-force pair sum with minimum images (which pairs conduct, and the
+per-particle sums) while particles move in and out of range, and the heat ledger.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermodem.config.load import case_from_dict
+from thermodem.engine.simulation import Simulation
+from thermodem.geometry.insertion import InsertedParticles, save_particle_file
+from thermodem.models import registry
+from thermodem.models.thermal.direct_conduction import separated_conductance
+from thermodem.state import heat
+
+K_GLASS = 1.0
+K_GAS = 0.0263
+GLASS = {
+    "density": 2500.0,
+    "youngs_modulus": 1e7,
+    "poisson_ratio": 0.3,
+    "restitution": 0.5,
+    "thermal_conductivity": K_GLASS,
+    "specific_heat": 800.0,
+}
+
+
+def _particles(path: Path, pos, radius, velocity=None, temperature=None) -> dict:
+    pos = np.asarray(pos, float)
+    rad = np.broadcast_to(np.asarray(radius, float), (len(pos),)).copy()
+    vel = np.zeros_like(pos) if velocity is None else np.asarray(velocity, float)
+    temp = None if temperature is None else np.asarray(temperature, float)
+    save_particle_file(path, InsertedParticles(pos, rad, vel, temp, "glass"))
+    return {"kind": "file", "material": "glass", "path": str(path)}
+
+
+def _two_spheres(tmp_path: Path, gap: float, radius: float, **thermal) -> dict:
+    x0, x1 = 0.005, 0.005 + 2 * radius + gap
+    entry = _particles(
+        tmp_path / "two.txt", [[x0, 0.005, 0.005], [x1, 0.005, 0.005]], radius, None, [300, 400]
+    )
+    return {
+        "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0, 0, 0]},
+        "domain": {"lower": [0, 0, 0], "upper": [0.012, 0.01, 0.01]},
+        "materials": {"glass": dict(GLASS)},
+        "insertion": [entry],
+        "thermal": {"direct_conduction": "batchelor_obrien_complete", **thermal},
+    }
+
+
+def _bob_separated(r_eff: float, gap: float, cylinder_ratio: float = 2.0) -> float:
+    """H of Batchelor & O'Brien (1977) for separated particles, Dai et al.'s minimum rule."""
+    kpf = K_GLASS / K_GAS
+    r_cyl = cylinder_ratio * r_eff
+    return (
+        2
+        * math.pi
+        * r_eff
+        * K_GAS
+        * min(2 * math.log(kpf), math.log1p(r_cyl**2 / (2 * r_eff * gap)))
+    )
+
+
+def test_two_spheres_a_gap_apart_conduct_with_the_default_neighbour_settings(
+    tmp_path: Path,
+) -> None:
+    """The silent gap of the first thermal engine: 1 mm spheres 0.1 mm apart with
+    batchelor_obrien_complete never exchanged heat with neighbors.extra_distance = 0."""
+    radius, gap, steps = 5e-4, 1e-4, 20
+    sim = Simulation(case_from_dict(_two_spheres(tmp_path, gap, radius)))
+    h = _bob_separated(radius / 2, gap)
+    p = sim.particles
+    order = np.argsort(p.global_id)
+    q = p.heat_rate_by_mechanism[order, heat.M_INDIRECT]
+    assert q[0] == pytest.approx(h * 100.0, rel=1e-12)
+    assert q[1] == pytest.approx(-h * 100.0, rel=1e-12)
+    assert np.all(p.heat_rate_by_mechanism[:, heat.M_DIRECT] == 0.0)
+    sim.run(steps=steps)
+    # explicit Euler of two equal capacities: ΔT_n = ΔT_0 (1 - 2 Δt H / (m c))^n
+    mc = GLASS["density"] * 4 / 3 * math.pi * radius**3 * GLASS["specific_heat"]
+    expected = 100.0 * (1.0 - 2 * sim.dt * h / mc) ** steps
+    t = sim.particles.temperature[np.argsort(sim.particles.global_id)]
+    assert t[1] - t[0] == pytest.approx(expected, rel=1e-10)
+    assert t[0] + t[1] == pytest.approx(700.0, rel=1e-14)
+
+
+def test_beyond_the_cutoff_nothing_is_listed_or_exchanged(tmp_path: Path) -> None:
+    radius = 5e-4
+    gap = 1.1 * radius / 2  # cutoff_gap_ratio 1.0 × R* = 0.25 mm < 0.275 mm
+    sim = Simulation(case_from_dict(_two_spheres(tmp_path, gap, radius)))
+    sim.run(steps=5)
+    assert np.all(sim.particles.heat_rate_by_mechanism == 0.0)
+    t = np.sort(sim.particles.temperature)
+    assert t.tolist() == [300.0, 400.0]
+
+
+def _moving_case(tmp_path: Path, model: dict, seed: int = 4) -> dict:
+    rng = np.random.default_rng(seed)
+    n, box = 160, 0.008
+    pos, rad = [], []
+    while len(pos) < n:  # random sequential placement, no overlaps, room for gaps
+        r = rng.uniform(4e-4, 6e-4)
+        x = rng.uniform([0, 0, r], [box, box, box - r])
+        if all(
+            np.linalg.norm(_minimum_image(x - y, box)) > r + s + 5e-5
+            for y, s in zip(pos, rad, strict=True)
+        ):
+            pos.append(x)
+            rad.append(r)
+    vel = rng.normal(0.0, 0.3, (n, 3))
+    temps = rng.uniform(300.0, 500.0, n)
+    return {
+        "simulation": {"time_step": 2e-6, "end_time": 1.0, "gravity": [0, 0, 0]},
+        "domain": {"lower": [0, 0, 0], "upper": [box, box, box], "periodic": [True, True, False]},
+        "materials": {"glass": dict(GLASS), "steel": dict(GLASS, thermal_conductivity=20.0)},
+        "walls": [
+            {
+                "kind": "plane",
+                "point": [0, 0, 0],
+                "normal": [0, 0, 1],
+                "material": "steel",
+                "thermal": {"kind": "fixed", "temperature": 350.0},
+            },
+            {"kind": "plane", "point": [0, 0, box], "normal": [0, 0, -1], "material": "steel"},
+        ],
+        "neighbors": {"skin": 5e-5},
+        "insertion": [_particles(tmp_path / "bed.txt", pos, rad, vel, temps)],
+        "thermal": {"direct_conduction": model, "range_skin": 1e-4},
+    }
+
+
+def _minimum_image(d: np.ndarray, box: float) -> np.ndarray:
+    d = d.copy()
+    d[..., :2] -= box * np.round(d[..., :2] / box)
+    return d
+
+
+def _brute_force(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
+    """Gap heat per particle (particle pairs, floor wall) by an O(N²) loop in the test."""
+    p = sim.particles
+    th = sim.thermal
+    term = th.terms[0]
+    box = sim.upper[0] - sim.lower[0]
+    n = p.count
+    pair_q = np.zeros(n)
+    wall_q = np.zeros(n)
+    listed = 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            d = np.linalg.norm(_minimum_image(p.position[j] - p.position[i], box))
+            row = term.table[p.type_id[i], p.type_id[j]]
+            h = separated_conductance(term.model_id, row, p.radius[i], p.radius[j], d)
+            if h:
+                listed += 1
+                q = h * (p.temperature[j] - p.temperature[i])
+                pair_q[i] += q
+                pair_q[j] -= q
+        z = p.position[i, 2]
+        steel = sim.material_index["steel"]
+        h = separated_conductance(
+            term.model_id, term.table[p.type_id[i], steel], p.radius[i], math.inf, z
+        )
+        wall_q[i] = h * (350.0 - p.temperature[i])
+    assert listed > 5  # the case has conducting gaps
+    return pair_q, wall_q
+
+
+@pytest.mark.parametrize("model", ["batchelor_obrien_complete", "batchelor_obrien_modified"])
+def test_range_set_equals_a_brute_force_pair_sum_while_pairs_enter_and_leave(
+    tmp_path: Path, model: str
+) -> None:
+    case = _moving_case(tmp_path, {"model": model, "cutoff_gap_ratio": 1.0})
+    sim = Simulation(case_from_dict(case))
+    th = sim.thermal
+    u0 = th.thermal_energy()
+    counts = set()
+    for _ in range(6):
+        sim.run(steps=40)
+        th.compute_rates(sim.time)  # the rates of the state now
+        pair_q, wall_q = _brute_force(sim)
+        got = sim.particles.heat_rate_by_mechanism
+        scale = np.abs(pair_q).max()
+        assert np.abs(got[:, heat.M_INDIRECT] - pair_q).max() <= 1e-12 * scale
+        assert np.abs(got[:, heat.M_WALL_INDIRECT] - wall_q).max() <= 1e-12 * max(
+            np.abs(wall_q).max(), 1e-30
+        )
+        # what i gains j loses: the pairwise column sums to round-off
+        assert abs(got[:, heat.M_INDIRECT].sum()) <= 1e-13 * np.abs(got[:, heat.M_INDIRECT]).sum()
+        counts.add(th.range_set.count)
+    assert th.range_set.builds > 2 and len(counts) > 2  # rebuilt; pairs entered and left
+    assert abs(th.balance_error()) <= 1e-12 * u0
+    assert th.cumulative["heat_in_wall_indirect_conduction"] != 0.0
+
+
+def test_every_range_model_is_covered_by_the_range_set() -> None:
+    """Every model that conducts across a gap declares its range and is evaluated on the range
+    set, so its range can never be missed by the neighbour machinery (the contact list holds
+    the touching pairs): the silent gap of ``neighbors.extra_distance`` cannot come back."""
+    checked = 0
+    for spec in registry.all_models():
+        if spec.family not in ("direct_conduction", "indirect_conduction") or spec.name == "none":
+            continue
+        if spec.target == "range":
+            assert spec.interaction_range is not None, spec.name
+        if spec.interaction_range is None:
+            continue
+        params = spec.params(**spec.example_params)
+        r = 1e-3
+        gap = spec.interaction_range(params, r, r)
+        wall_gap = spec.interaction_range(params, r, math.inf)
+        assert gap > 0.0 and wall_gap > 0.0, spec.name
+        # ranges grow with the radii (the set's cut-off is taken at the largest radius)
+        assert spec.interaction_range(params, 0.5 * r, 0.3 * r) <= gap, spec.name
+        assert spec.interaction_range(params, 0.5 * r, math.inf) <= wall_gap, spec.name
+        checked += 1
+    assert checked >= 2
