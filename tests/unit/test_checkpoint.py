@@ -157,6 +157,18 @@ def reuse_thermal_case() -> dict:
     return case
 
 
+def range_thermal_case() -> dict:
+    """The periodic bed with gap conduction on the range pair set (Batchelor & O'Brien's
+    separated pairs): its pair order fixes the sums, so it is part of the checkpoint."""
+    case = periodic_thermal_case()
+    case["thermal"].update(
+        direct_conduction={"model": "batchelor_obrien_complete", "cutoff_gap_ratio": 1.0},
+        substeps=2,
+        range_skin=5e-5,
+    )
+    return case
+
+
 def _assert_same(a: Simulation, b: Simulation) -> None:
     for name, arr in a.particles.arrays().items():
         assert np.array_equal(arr, getattr(b.particles, name)), name
@@ -176,8 +188,18 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
 
 @pytest.mark.parametrize(
     ("make", "stop", "total"),
-    [(drum_case, 230, 700), (periodic_thermal_case, 101, 400), (reuse_thermal_case, 101, 400)],
-    ids=["drum-pour-epsd-moving-wall", "periodic-thermal", "periodic-conductance-reuse"],
+    [
+        (drum_case, 230, 700),
+        (periodic_thermal_case, 101, 400),
+        (reuse_thermal_case, 101, 400),
+        (range_thermal_case, 101, 400),
+    ],
+    ids=[
+        "drum-pour-epsd-moving-wall",
+        "periodic-thermal",
+        "periodic-conductance-reuse",
+        "periodic-range-set",
+    ],
 )
 def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -> None:
     case = case_from_dict(make())
@@ -194,6 +216,11 @@ def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -
     assert second.step_count == stop
     second.run(steps=total - stop)
     _assert_same(reference, second)
+    if reference.thermal is not None and reference.thermal.range_set is not None:
+        ra, rb = reference.thermal.range_set, second.thermal.range_set
+        assert ra.builds > 1 and ra.count > 0  # rebuilt during the run, pairs in range
+        assert (ra.count, ra.builds) == (rb.count, rb.builds)
+        assert np.array_equal(ra.i[: ra.count], rb.i[: rb.count])
 
 
 def test_drum_case_exercises_pouring_and_rolling_history() -> None:

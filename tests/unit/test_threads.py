@@ -6,7 +6,8 @@ contributions in an order fixed by the list; each group and each chunk of partic
 its own ledger row. A run with 1 thread and a run with 2 threads must therefore be
 bit-identical. The bed below has more than 4096 particles and many slab groups, so every
 parallel loop is split between the threads. A second run adds heat (resistance network with
-the conductance reuse, whose per-pair state sits after the rolling model's history columns).
+the conductance reuse, whose per-pair state sits after the rolling model's history columns),
+a third gap conduction on the range pair set.
 """
 
 from __future__ import annotations
@@ -47,7 +48,7 @@ HEAT = {  # the resistance network with the conductance reuse (state in the pair
 }
 
 
-def run(path: Path, threads: int, steps: int, heat: bool = False) -> tuple[Simulation, list[int]]:
+def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulation, list[int]]:
     numba.set_num_threads(threads)
     upper = [SHAPE[0] * SPACING, SHAPE[1] * SPACING, 0.3]
     case = {
@@ -84,6 +85,13 @@ def run(path: Path, threads: int, steps: int, heat: bool = False) -> tuple[Simul
             "conductance_force_tolerance": 0.02,
             "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * x"},
         }
+    if heat == "range":  # gap conduction on the range pair set, rebuilt while the bed moves
+        case["neighbors"]["extra_distance"] = 0.0
+        case["thermal"].update(
+            direct_conduction={"model": "batchelor_obrien_complete", "cutoff_gap_ratio": 0.4},
+            conductance_force_tolerance=0.0,
+            range_skin=0.01 * R0,
+        )
     sim = Simulation(case_from_dict(case))
     seen: list[int] = []
     sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
@@ -96,7 +104,9 @@ def by_gid(sim: Simulation, name: str) -> np.ndarray:
 
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
-@pytest.mark.parametrize("heat", [False, True], ids=["mechanics", "conductance-reuse"])
+@pytest.mark.parametrize(
+    "heat", ["", "reuse", "range"], ids=["mechanics", "conductance-reuse", "range-set"]
+)
 def test_one_and_two_threads_bit_identical(tmp_path, heat):
     path = tmp_path / "bed.txt"
     write_bed(path)
@@ -115,7 +125,11 @@ def test_one_and_two_threads_bit_identical(tmp_path, heat):
     names = ["position", "velocity", "angular_velocity", "force", "torque"]
     if heat:
         names += ["temperature", "heat_rate_by_mechanism"]
+    if heat == "reuse":
         assert one.pairs.history_width == C.HISTORY_WIDTH_ROLLING + 3
+    if heat == "range":
+        rs = one.thermal.range_set
+        assert rs.count > 2 * C.CHUNK and rs.ngroups >= 8 and rs.builds > 1
     for name in names:
         a = by_gid(one, name)
         b = by_gid(two, name)

@@ -342,7 +342,9 @@ class ThermalEngine:
 
     def _range_gaps(self) -> tuple[float, float]:
         p = self.sim.particles
-        r_max = float(p.radius.max()) if p.count else 0.0
+        if p.count == 0:
+            return 0.0, 0.0
+        r_max = float(p.radius.max())
         gaps = [t.max_gap(r_max) for t in self.terms if t.target == "range"]
         return max(g for g, _ in gaps), max(w for _, w in gaps)
 

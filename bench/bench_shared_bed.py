@@ -1,0 +1,206 @@
+"""Benchmark on the bed settled by another code (``../shared/beds/bed50k.txt``).
+
+The standard comparison case of ``shared/beds/README.md``: 50,000 spheres of R = 1 mm in a
+0.09 × 0.09 m open box (floor and four side walls), Hertz–Mindlin, E = 1e7 Pa, ν = 0.3,
+e = 0.5, μ = 0.5, ρ = 2500 kg/m³, no rolling resistance, gravity, Δt = 5e-6 s, Verlet skin
+0.2 mm; with heat: k = 1 W/(m K), c = 800 J/(kg K), Batchelor & O'Brien simple with the
+geometric contact radius, the particles with centre z < 1.5 mm held at 400 K (selected by a
+region or by their material), the rest at 300 K, adiabatic walls, heat every step. 500
+untimed steps, then the timed steps; throughput = N × steps / loop seconds.
+
+    python bench/bench_shared_bed.py [--threads 1 2] [--steps 1000] [--warmup 500]
+        [--cases mechanics region material] [--indirect MODEL [--indirect-param KEY=VALUE ...]]
+        [--substeps N] [--json]
+
+Each (case, thread count) runs in a fresh process; prints particle-steps per second and the
+peak memory above the interpreter's baseline per particle.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+BED = Path(__file__).resolve().parents[2] / "shared" / "beds" / "bed50k.txt"
+CACHE = Path(__file__).parent / ".cache"
+SIDE = 0.09
+HEIGHT = 0.1
+HOT_Z = 1.5e-3
+
+
+def particle_files(tiny: bool = False) -> tuple[Path, Path, Path]:
+    """(all, hot, cold) particle files converted from the shared bed (cached); ``tiny``: the
+    same for the first 400 particles (the kernels are loaded on it before the baseline)."""
+    from thermodem.geometry.insertion import InsertedParticles, save_particle_file
+
+    CACHE.mkdir(parents=True, exist_ok=True)
+    tag = "tiny" if tiny else "bed50k"
+    paths = tuple(CACHE / f"shared_{tag}_{k}.txt" for k in ("all", "hot", "cold"))
+    if all(p.exists() for p in paths):
+        return paths
+    data = np.loadtxt(BED, comments="#")
+    if tiny:
+        data = data[:400]
+    pos, rad = data[:, :3], data[:, 3]
+    hot = pos[:, 2] < HOT_Z
+    for path, sel in zip(paths, (np.ones(len(pos), bool), hot, ~hot), strict=True):
+        save_particle_file(
+            path, InsertedParticles(pos[sel], rad[sel], np.zeros((sel.sum(), 3)), None, "glass")
+        )
+    return paths
+
+
+def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = False) -> dict:
+    all_path, hot_path, cold_path = particle_files(tiny)
+    material = {
+        "density": 2500.0,
+        "youngs_modulus": 1e7,
+        "poisson_ratio": 0.3,
+        "restitution": 0.5,
+        "sliding_friction": 0.5,
+    }
+    heat = kind != "mechanics"
+    if heat:
+        material.update(thermal_conductivity=1.0, specific_heat=800.0)
+    case = {
+        "simulation": {"time_step": 5e-6, "end_time": 1.0, "gravity": [0, 0, -9.81]},
+        "domain": {"lower": [0, 0, 0], "upper": [SIDE, SIDE, HEIGHT]},
+        "materials": {"glass": material},
+        "contact": {"normal": "hertz", "tangential": "mindlin", "rolling": "none"},
+        "neighbors": {"skin": 2e-4},
+        "walls": [
+            {
+                "kind": "box",
+                "lower": [0, 0, 0],
+                "upper": [SIDE, SIDE, HEIGHT],
+                "open_top": True,
+                "material": "glass",
+            }
+        ],
+        "insertion": [{"kind": "file", "material": "glass", "path": str(all_path)}],
+        "output": {"vtu": False},
+    }
+    if not heat:
+        return case
+    thermal = {
+        "direct_conduction": "batchelor_obrien_simple",
+        "contact_radius": "geometric",
+        "substeps": substeps,
+        "initial_temperature": {"kind": "uniform", "value": 300.0},
+    }
+    if kind == "region":
+        box = {"lower": [-1.0, -1.0, -1.0], "upper": [1.0, 1.0, HOT_Z]}
+        thermal["fixed_temperature"] = [{"select": {"region": box}, "temperature": 400.0}]
+    else:  # material
+        case["materials"]["hot"] = dict(material)
+        case["insertion"] = [
+            {"kind": "file", "material": "hot", "path": str(hot_path)},
+            {"kind": "file", "material": "glass", "path": str(cold_path)},
+        ]
+        thermal["fixed_temperature"] = [{"select": {"material": "hot"}, "temperature": 400.0}]
+    if indirect is not None:
+        thermal["indirect_conduction"] = indirect
+    case["thermal"] = thermal
+    return case
+
+
+def rss_bytes() -> int:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | None,
+          substeps: int) -> dict:  # fmt: skip
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+
+    # baseline: interpreter, libraries and the compiled kernels, loaded on a tiny bed
+    Simulation(case_from_dict(case_dict(kind, indirect, substeps, True)), threads=threads).run(
+        steps=5
+    )
+    baseline = rss_bytes()
+    sim = Simulation(case_from_dict(case_dict(kind, indirect, substeps)), threads=threads)
+    sim.run(steps=warmup)
+    t0 = time.perf_counter()
+    sim.run(steps=steps)
+    elapsed = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    n = sim.particles.count
+    out = {
+        "case": kind,
+        "threads": threads,
+        "n": n,
+        "steps": steps,
+        "particle_steps_per_s": n * steps / elapsed,
+        "seconds": elapsed,
+        "contacts_per_particle": 2 * sim.contact_count / n,
+        "bytes_per_particle_above_baseline": (peak - baseline) / n,
+    }
+    if sim.thermal is not None:
+        out["fixed"] = int(sim.thermal.fixed.sum())
+        out["temperature_max"] = float(sim.particles.temperature.max())
+        if sim.thermal.range_set is not None:
+            out["range_pairs_per_particle"] = sim.thermal.range_set.count / n
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--threads", type=int, nargs="*", default=[1, 2])
+    ap.add_argument("--steps", type=int, default=1000)
+    ap.add_argument("--warmup", type=int, default=500)
+    ap.add_argument("--cases", nargs="*", default=["mechanics", "region", "material"])
+    ap.add_argument("--indirect", default=None, help="an indirect_conduction model")
+    ap.add_argument("--indirect-param", nargs="*", default=[], help="KEY=VALUE parameters")
+    ap.add_argument("--substeps", type=int, default=1)
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    indirect = None
+    if args.indirect:
+        indirect = {"model": args.indirect}
+        for kv in args.indirect_param:
+            key, value = kv.split("=", 1)
+            indirect[key] = float(value)
+    if args.child:
+        kind, threads = args.child.split(":")
+        result = timed(kind, int(threads), args.steps, args.warmup, indirect, args.substeps)
+        print(json.dumps(result))
+        return
+    particle_files()
+    particle_files(tiny=True)
+    results = []
+    for kind in args.cases:
+        for threads in args.threads:
+            cmd = [sys.executable, __file__, "--child", f"{kind}:{threads}",
+                   "--steps", str(args.steps), "--warmup", str(args.warmup),
+                   "--substeps", str(args.substeps)]  # fmt: skip
+            if args.indirect:
+                cmd += ["--indirect", args.indirect, "--indirect-param", *args.indirect_param]
+            proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
+            result = json.loads(proc.stdout.strip().splitlines()[-1])
+            results.append(result)
+            if not args.json:
+                extra = ""
+                if "range_pairs_per_particle" in result:
+                    extra = f", {result['range_pairs_per_particle']:.2f} range pairs/particle"
+                print(
+                    f"{kind:10s} {threads} thread(s): "
+                    f"{result['particle_steps_per_s'] / 1e6:6.2f} M particle-steps/s, "
+                    f"{result['bytes_per_particle_above_baseline']:.0f} B/particle{extra}",
+                    flush=True,
+                )
+    if args.json:
+        print(json.dumps(results, indent=1))
+
+
+if __name__ == "__main__":
+    main()
