@@ -65,7 +65,7 @@ def imported_files(path: Path, root: Path = PACKAGE_ROOT) -> set[Path]:
     return found
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _installed_imports(path: Path) -> frozenset[Path]:
     return frozenset(imported_files(path, PACKAGE_ROOT))
 
@@ -93,7 +93,7 @@ def compute_stamp(path: Path, root: Path = PACKAGE_ROOT) -> str:
     return digest.hexdigest()
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def dependency_stamp(path: str) -> str:
     """:func:`compute_stamp` of a file of the installed package, once per process (the
     sources do not change while a process runs)."""

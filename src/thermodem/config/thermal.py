@@ -202,6 +202,11 @@ class ThermalSettings(StrictModel):
         description="indirect_conduction model (conduction through the fluid between near "
         "particles, evaluated on the range pair set)",
     )
+    radiation: Any = Field(
+        default="none",
+        validate_default=True,
+        description="radiation model (per-particle term)",
+    )
     range_skin: float | None = Field(
         default=None,
         gt=0,
@@ -250,6 +255,11 @@ class ThermalSettings(StrictModel):
     @classmethod
     def _ic(cls, v: Any):  # noqa: ANN206
         return parse_thermal_choice("indirect_conduction", v, "none")
+
+    @field_validator("radiation", mode="before")
+    @classmethod
+    def _rad(cls, v: Any):  # noqa: ANN206
+        return parse_thermal_choice("radiation", v, "none")
 
     @field_validator("substeps")
     @classmethod

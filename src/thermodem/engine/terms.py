@@ -23,9 +23,9 @@ from pydantic import BaseModel
 
 from thermodem.config.schema import Case, ModelChoice
 from thermodem.errors import ConfigError
-from thermodem.kernels.heat_terms import EVAL_INDIRECT, EVAL_SEPARATED
+from thermodem.kernels.heat_terms import EVAL_INDIRECT, EVAL_RADIATION, EVAL_SEPARATED
 from thermodem.models.registry import ModelSpec
-from thermodem.models.tables import pair_table
+from thermodem.models.tables import material_table, pair_table
 from thermodem.state import heat
 
 
@@ -60,7 +60,7 @@ class HeatTerm:
     choice: ModelChoice
     target: str  # "contacts" | "range" | "external" | "particles"
     evaluator: int  # EVAL_* of kernels/heat_terms.py
-    table: np.ndarray  # [nmat, nmat, width]
+    table: np.ndarray  # [nmat, nmat, width]; [nmat, width] for per-particle terms
     column: int  # mechanism column of particle pairs
     wall_column: int  # mechanism column of particle-wall pairs
     k_columns: tuple[int, int]  # row columns replaced by k(T) of the two bodies, (-1, -1): none
@@ -98,6 +98,7 @@ def build_terms(
     names: list[str],
     meets: Callable[[str, str], bool],
     is_wall: Callable[[str, str], bool],
+    particle_material: Callable[[str], bool],
 ) -> tuple[ContactConduction, list[HeatTerm]]:
     """The contact conduction and the other heat terms of the case's thermal section."""
     settings = case.thermal
@@ -149,6 +150,22 @@ def build_terms(
                 column=pair_col,
                 wall_column=wall_col,
                 k_columns=_k_columns(indirect.spec),
+            )
+        )
+    radiation = settings.radiation
+    if radiation.model != "none":
+        terms.append(
+            HeatTerm(
+                key="thermal.radiation",
+                choice=radiation,
+                target="particles",
+                evaluator=EVAL_RADIATION,
+                table=material_table(
+                    radiation, case, names, particle_material, "thermal.radiation"
+                ),
+                column=heat.M_RADIATION,
+                wall_column=-1,
+                k_columns=(-1, -1),
             )
         )
     return contact, terms

@@ -72,7 +72,9 @@ class ThermalEngine:
         def is_wall(a: str, b: str) -> bool:
             return b in hot_walls and b not in particle_mats
 
-        self.contact, self.terms = build_terms(case, names, meets, is_wall)
+        self.contact, self.terms = build_terms(
+            case, names, meets, is_wall, lambda name: name in particle_mats
+        )
         self.radius_id = self.contact.radius_id
         self.conduction_id = self.contact.direct_id
         self.radius_table = self.contact.radius_table
@@ -103,6 +105,10 @@ class ThermalEngine:
         self.term_conductance = [np.zeros(0) for _ in self.terms]
         self.term_wall_conductance = [np.zeros(0) for _ in self.terms]
         self.term_ready = np.zeros(len(self.terms), np.bool_)
+        #: per-particle fields read by per-particle terms, one column per field; filled by
+        #: their providers before the terms run (none of the present models reads one yet:
+        #: porosity and the fluid state come with convection)
+        self.fields = np.zeros((0, 0))
         self._empty = np.zeros(0)
         self.conductance_sum = np.zeros(0)
         #: cumulative ledger [J]: heat in through every boundary mechanism, heat absorbed by
@@ -362,8 +368,19 @@ class ThermalEngine:
                 self._range_term(index, term, frozen)
             elif term.target == "contacts":
                 self._contact_term(index, term, frozen)
-            else:  # pragma: no cover - external and particle terms come with their families
-                raise NotImplementedError(f"{term.key}: target {term.target!r}")
+            elif term.target == "particles":
+                self._particle_term(term)
+            else:  # the external pair set comes with the Voronoi models
+                raise ConfigError(f"{term.key}: no pair set of kind {term.target!r} yet")
+
+    def _particle_term(self, term: HeatTerm) -> None:
+        p = self.sim.particles
+        if self.fields.shape[0] != p.count:
+            self.fields = np.zeros((p.count, self.fields.shape[1]))
+        passes.particle_pass(
+            p.temperature, p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
+            term.table, term.column, p.heat_rate_by_mechanism, self.conductance_sum,
+        )  # fmt: skip
 
     def _stored(self, index: int, pairs: int, walls: int) -> tuple[np.ndarray, np.ndarray]:
         """The per-pair conductance arrays of term ``index`` with at least the given sizes."""

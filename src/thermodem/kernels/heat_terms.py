@@ -13,6 +13,8 @@ and **adds** the heat rate into its particles' mechanism column and the conducta
 - :func:`range_wall_pass`: particle-wall pairs of the range set (fixed-temperature walls);
 - :func:`contact_term_pair_pass`, :func:`contact_term_wall_pass`: touching pairs of the
   contact lists (terms that need the contact radius model and the normal force);
+- :func:`particle_pass`: per-particle terms (radiation), each returning a heat rate and a
+  linearised conductance G = -dQ/dT_i that the stability limit adds to ``conductance_sum``;
 - :func:`pair_heat_from_conductance`, :func:`wall_heat_from_conductance`: heat rates from
   conductances stored by an earlier evaluation of the same pairs (frozen mechanics).
 
@@ -40,11 +42,14 @@ from thermodem.models.thermal.contact_radius import (
 )
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
+from thermodem.models.thermal.radiation import radiation_dispatch
 
 #: Evaluators of pair terms: an indirect_conduction model, or the separated-pair part of a
 #: direct_conduction model with an interaction range.
 EVAL_INDIRECT = 0
 EVAL_SEPARATED = 1
+#: Evaluators of per-particle terms.
+EVAL_RADIATION = 2
 
 WALL_CHUNK = 4096  # particles per chunk of the wall passes
 PARTICLE_CHUNK = 4096  # particles per chunk of the per-particle passes
@@ -223,6 +228,29 @@ def contact_term_wall_pass(
                         conductance_sum[i] += h
                 if store:
                     out_conductance[k] = h
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def particle_term(evaluator, model_id, p, t_i, r_i, fields, i):
+    """(Q into particle i [W], G = -dQ/dT_i [W/K]) of a per-particle term."""
+    return radiation_dispatch(model_id, p, t_i, r_i, fields, i)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def particle_pass(
+    temperature, radius, type_id, fields, evaluator, model_id, table, column, by_mechanism,
+    conductance_sum,
+):  # fmt: skip
+    """One per-particle term over every particle (``table``: a row per material)."""
+    n = temperature.shape[0]
+    nchunks = (n + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
+    for c in prange(nchunks):
+        for i in range(c * PARTICLE_CHUNK, min(n, (c + 1) * PARTICLE_CHUNK)):
+            q, g = particle_term(
+                evaluator, model_id, table[type_id[i]], temperature[i], radius[i], fields, i
+            )
+            by_mechanism[i, column] += q
+            conductance_sum[i] += g
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

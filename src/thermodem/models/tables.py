@@ -60,3 +60,25 @@ def pair_table(
                 )
             table[a, b] = row
     return table
+
+
+def material_table(
+    choice: ModelChoice, case: Case, names: list[str], used: Callable[[str], bool], key: str
+) -> np.ndarray:
+    """[nmat, width] rows of a per-particle model, one per material (``used(name)``: the
+    materials particles are made of; the others stay zero). ``pack`` receives the material
+    as both sides of a PairContext, with the case gas."""
+    spec = choice.spec
+    table = np.zeros((len(names), spec.width))
+    gas = case.thermal.gas if case.thermal is not None else None
+    for a, name in enumerate(names):
+        if not used(name):
+            continue
+        material = case.materials[name]
+        try:
+            table[a] = spec.pack(choice.params, resolve_pair(material, material, gas=gas))
+        except ValueError as exc:
+            raise ConfigError(
+                f"{key} = {choice.model!r} cannot be set up for material {name!r}: {exc}"
+            ) from None
+    return table

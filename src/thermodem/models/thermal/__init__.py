@@ -4,5 +4,6 @@ from thermodem.models.thermal import (  # noqa: F401
     contact_radius,
     direct_conduction,
     indirect_conduction,
+    radiation,
     resistance_network,
 )
