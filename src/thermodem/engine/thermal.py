@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermodem.config.thermal import ThermalSettings
+from thermodem.engine.external_set import ExternalPairSet
 from thermodem.engine.range_set import RangePairSet
 from thermodem.engine.terms import HeatTerm, build_terms
 from thermodem.engine.thermal_conditions import ThermalConditions
@@ -46,9 +47,10 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
-SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "_empty")
-#: Prefix of the range set's arrays in the engine's checkpoint arrays.
+SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty")
+#: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
 RANGE_PREFIX = "range_set__"
+EXTERNAL_PREFIX = "external__"
 
 
 class ThermalEngine:
@@ -93,6 +95,9 @@ class ThermalEngine:
                 )
             self.specific_heat_by_type[t] = c or 0.0
         self.conditions = ThermalConditions(sim, settings)
+        #: the external pair set of terms with target "external" (set_external_term)
+        self.external: ExternalPairSet | None = None
+        self.external_term = ""
         self.range_set = (
             RangePairSet(settings.range_skin)
             if any(t.target == "range" for t in self.terms)
@@ -218,6 +223,8 @@ class ThermalEngine:
         self.conditions.invalidate()
         if self.range_set is not None:
             self.range_set.invalidate()
+        if self.external is not None:
+            self.external.invalidate()
         self.term_ready[:] = False
 
     def _fixed_and_sources(self, time: float) -> tuple[np.ndarray, np.ndarray]:
@@ -359,7 +366,8 @@ class ThermalEngine:
         if not self.terms:
             return
         sim = self.sim
-        if self.range_set is not None and self.range_set.due(sim):
+        ranged = any(t.target == "range" for t in self.terms)
+        if ranged and self.range_set.due(sim):
             self.range_set.build(sim, *self._range_gaps())
             self.term_ready[:] = False
         frozen = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
@@ -370,8 +378,42 @@ class ThermalEngine:
                 self._contact_term(index, term, frozen)
             elif term.target == "particles":
                 self._particle_term(term)
-            else:  # the external pair set comes with the Voronoi models
-                raise ConfigError(f"{term.key}: no pair set of kind {term.target!r} yet")
+            elif term.target == "external":
+                self._external_term(index, term)
+            else:  # pragma: no cover - the registry refuses other targets
+                raise ConfigError(f"{term.key}: no pair set of kind {term.target!r}")
+
+    def set_external_term(self, key: str, pairs: ExternalPairSet) -> None:
+        """Evaluate the term selected by case key ``key`` on an external pair set.
+
+        The pairs are given by global id (:meth:`ExternalPairSet.set_pairs`) and stay with
+        their particles through rebuilds; a provider (the Voronoi tessellation) or a script
+        may replace them between steps. Kept in checkpoints.
+        """
+        (term,) = [t for t in self.terms if t.key == key]
+        term.target = "external"
+        self.external = pairs
+        self.external_term = key
+        self.term_ready[:] = False
+        self.in_use = self._mechanisms_in_use()
+
+    def _external_term(self, index: int, term: HeatTerm) -> None:
+        sim = self.sim
+        p = sim.particles
+        ext = self.external
+        ext.prepare(sim)
+        h, _ = self._stored(index, ext.count, 0)
+        k_i, k_j = term.k_columns if self.override else (-1, -1)
+        rows = ext.count // passes.PARTICLE_CHUNK + 1
+        passes.external_pair_pass(
+            p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
+            sim.periodic, term.evaluator, term.model_id, term.table, k_i, k_j, self.k_p,
+            self._term_rows(rows), h,
+        )  # fmt: skip
+        passes.csr_heat(
+            ext.offsets, ext.entries, ext.i, ext.j, h, p.temperature, term.column,
+            p.heat_rate_by_mechanism, self.conductance_sum,
+        )  # fmt: skip
 
     def _particle_term(self, term: HeatTerm) -> None:
         p = self.sim.particles
@@ -616,10 +658,12 @@ class ThermalEngine:
         from thermodem.engine.restart import _object_state
 
         state = _object_state(self, SKIP)
-        if self.range_set is not None:
-            rs = self.range_set.state_dict()
-            state["scalars"]["range_set"] = rs["scalars"]
-            state["arrays"].update({f"{RANGE_PREFIX}{k}": v for k, v in rs["arrays"].items()})
+        for name, prefix in (("range_set", RANGE_PREFIX), ("external", EXTERNAL_PREFIX)):
+            pairs = getattr(self, name)
+            if pairs is not None:
+                sub = pairs.state_dict()
+                state["scalars"][name] = sub["scalars"]
+                state["arrays"].update({f"{prefix}{k}": v for k, v in sub["arrays"].items()})
         return state
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -630,6 +674,12 @@ class ThermalEngine:
             k[len(RANGE_PREFIX) :]: arrays.pop(k)
             for k in list(arrays)
             if k.startswith(RANGE_PREFIX)
+        }
+        external_scalars = scalars.pop("external", None)
+        external_arrays = {
+            k[len(EXTERNAL_PREFIX) :]: arrays.pop(k)
+            for k in list(arrays)
+            if k.startswith(EXTERNAL_PREFIX)
         }
         for name, value in scalars.items():
             current = getattr(self, name, None)
@@ -647,4 +697,8 @@ class ThermalEngine:
                     "(thermal.indirect_conduction, or a direct model that conducts across gaps)"
                 )
             self.range_set.load_state_dict({"scalars": range_scalars, "arrays": range_arrays})
+        if external_scalars is not None:
+            if self.external is None:  # a script had put a term on an external set
+                self.set_external_term(self.external_term, ExternalPairSet())
+            self.external.load_state_dict({"scalars": external_scalars, "arrays": external_arrays})
         self.conditions.invalidate()

@@ -13,6 +13,9 @@ and **adds** the heat rate into its particles' mechanism column and the conducta
 - :func:`range_wall_pass`: particle-wall pairs of the range set (fixed-temperature walls);
 - :func:`contact_term_pair_pass`, :func:`contact_term_wall_pass`: touching pairs of the
   contact lists (terms that need the contact radius model and the normal force);
+- :func:`external_pair_pass` and :func:`csr_heat`: pairs of an external pair set (not
+  bounded by a cell edge): a conductance per pair, then every particle sums its pairs
+  through a CSR index (``engine/external_set.py``);
 - :func:`particle_pass`: per-particle terms (radiation), each returning a heat rate and a
   linearised conductance G = -dQ/dT_i that the stability limit adds to ``conductance_sum``;
 - :func:`pair_heat_from_conductance`, :func:`wall_heat_from_conductance`: heat rates from
@@ -228,6 +231,73 @@ def contact_term_wall_pass(
                         conductance_sum[i] += h
                 if store:
                     out_conductance[k] = h
+
+
+@njit(cache=True, error_model="numpy")
+def pair_csr(pair_i, pair_j, n, offsets, entries):
+    """CSR index of a pair list by particle: ``entries[offsets[a]:offsets[a + 1]]`` are
+    2 k (particle a is pair k's i) or 2 k + 1 (it is its j), in pair order."""
+    offsets[:] = 0
+    npairs = pair_i.shape[0]
+    for k in range(npairs):
+        offsets[pair_i[k] + 1] += 1
+        offsets[pair_j[k] + 1] += 1
+    for a in range(n):
+        offsets[a + 1] += offsets[a]
+    fill = offsets[:n].copy()
+    for k in range(npairs):
+        entries[fill[pair_i[k]]] = 2 * k
+        fill[pair_i[k]] += 1
+        entries[fill[pair_j[k]]] = 2 * k + 1
+        fill[pair_j[k]] += 1
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def external_pair_pass(
+    position, radius, type_id, pair_i, pair_j, inputs, lower, upper, periodic, evaluator,
+    model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance,
+):  # fmt: skip
+    """Conductance of every pair of an external pair set (``inputs``: a row per pair, read
+    by the models made for such sets; the gap-conduction models ignore it)."""
+    length = upper - lower
+    npairs = pair_i.shape[0]
+    nchunks = (npairs + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
+    for c in prange(nchunks):
+        srow = scratch[c]
+        for k in range(c * PARTICLE_CHUNK, min(npairs, (c + 1) * PARTICLE_CHUNK)):
+            i = pair_i[k]
+            j = pair_j[k]
+            dist = pair_separation(position, i, j, length, periodic)[3]
+            ri = radius[i]
+            rj = radius[j]
+            r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+            ki = kj = 0.0
+            if k_col_i >= 0:
+                ki = k_particle[i]
+                kj = k_particle[j]
+            p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+            out_conductance[k] = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def csr_heat(
+    offsets, entries, pair_i, pair_j, conductance, temperature, column, by_mechanism,
+    conductance_sum,
+):  # fmt: skip
+    """Every particle sums its pairs' heat through the CSR index (pair order): the same
+    q = H (T_j - T_i) of pair k is added to its i and subtracted from its j."""
+    n = offsets.shape[0] - 1
+    for a in prange(n):
+        for e in range(offsets[a], offsets[a + 1]):
+            k = entries[e] >> 1
+            h = conductance[k]
+            if h != 0.0:
+                q = h * (temperature[pair_j[k]] - temperature[pair_i[k]])
+                if entries[e] & 1:
+                    by_mechanism[a, column] -= q
+                else:
+                    by_mechanism[a, column] += q
+                conductance_sum[a] += h
 
 
 @njit(cache=True, inline="always", error_model="numpy")
