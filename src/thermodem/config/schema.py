@@ -150,6 +150,11 @@ class SimulationSettings(StrictModel):
 class Output(StrictModel):
     interval: float | None = Field(default=None, gt=0, description="VTU interval [s]")
     vtu: bool = True
+    contacts: bool = Field(
+        default=False,
+        description="also write the touching contacts (lines with forces, contact radii, "
+        "conductances and heat rates) as vtk/contacts_*.vtu with contacts.pvd",
+    )
     wall_extent: float | None = Field(
         default=None, gt=0, description="half size drawn for infinite walls [m]"
     )

@@ -168,7 +168,9 @@ def _make_run(
     )
     frames = None
     if out.vtu:
-        frames = FrameWriter(output, extent, resume_time=sim.time if resume else None)
+        frames = FrameWriter(
+            output, extent, resume_time=sim.time if resume else None, contacts=out.contacts
+        )
     series = TimeseriesWriter(
         output / TIMESERIES_FILE, resume_step=sim.step_count if resume else None
     )

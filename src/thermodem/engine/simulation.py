@@ -456,6 +456,14 @@ class Simulation:
         gid = self.particles.global_id
         return gid[pb.i[: pb.count][mask]], gid[pb.j[: pb.count][mask]]
 
+    def contacts(self) -> dict[str, np.ndarray]:
+        """Per-contact arrays of the touching contacts: global ids, contact point, normal,
+        overlap, normal force, contact radius and, with heat, each thermal term's conductance
+        and heat rate (``thermodem.engine.contacts``)."""
+        from thermodem.engine.contacts import contact_data
+
+        return contact_data(self)
+
     def coordination_number(self) -> np.ndarray:
         """Touching contacts per particle (particle and wall contacts)."""
         n = self.particles.count

@@ -79,15 +79,29 @@ class RunLog:
 class FrameWriter:
     """Writes particle and wall frames and keeps the PVD indices valid after every frame."""
 
-    def __init__(self, out: Path, wall_extent: float, resume_time: float | None = None) -> None:
+    def __init__(
+        self,
+        out: Path,
+        wall_extent: float,
+        resume_time: float | None = None,
+        contacts: bool = False,
+    ) -> None:
         self.out = out
         (out / "vtk").mkdir(parents=True, exist_ok=True)
+        self.contacts_pvd = None
         if resume_time is None:
             self.particles_pvd = PVDWriter(out / "particles.pvd")
             self.walls_pvd = PVDWriter(out / "walls.pvd")
+            if contacts:
+                self.contacts_pvd = PVDWriter(out / "contacts.pvd")
         else:
             self.particles_pvd = PVDWriter.resume(out / "particles.pvd", resume_time)
             self.walls_pvd = PVDWriter.resume(out / "walls.pvd", resume_time)
+            if contacts:
+                path = out / "contacts.pvd"
+                self.contacts_pvd = (
+                    PVDWriter.resume(path, resume_time) if path.exists() else PVDWriter(path)
+                )
         self.wall_extent = wall_extent
         self.frames = len(self.particles_pvd.entries)
         self.last_step = -1
@@ -123,8 +137,25 @@ class FrameWriter:
                 self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows, None, self.wall_extent
             )
             self.walls_pvd.add(sim.time, f"vtk/{wname}")
+        if self.contacts_pvd is not None:
+            self._write_contacts(sim)
         self.frames = len(self.particles_pvd.entries)
         self.last_step = sim.step_count
+
+    def _write_contacts(self, sim: Simulation) -> None:
+        """``vtk/contacts_<step>.vtu``: the touching contacts as lines with their data."""
+        from thermodem.io.contacts_vtu import write_contacts_vtu
+
+        data = sim.contacts()
+        p = sim.particles
+        where = np.full(int(p.global_id.max()) + 1 if p.count else 0, -1, np.int64)
+        where[p.global_id] = np.arange(p.count)
+        centre_i = p.position[where[data["id_i"]]]
+        wall = data["wall"] >= 0
+        centre_j = np.where(wall[:, None], data["point"], p.position[where[data["id_j"]]])
+        name = f"contacts_{sim.step_count:09d}.vtu"
+        write_contacts_vtu(self.out / "vtk" / name, data, centre_i, centre_j)
+        self.contacts_pvd.add(sim.time, f"vtk/{name}")
 
 
 # ----------------------------------------------------------------------------- time series
