@@ -7,6 +7,9 @@ compiled kernels in a cache directory named after a hash of all of its own sourc
 gives a fresh cache, and an unchanged installation loads everything from disk. Setting
 ``NUMBA_CACHE_DIR`` yourself overrides this.
 
+Importing thermodem also selects Numba's threading layer (OpenMP, else workqueue; never TBB
+by accident) before any parallel kernel runs: see :mod:`thermodem.engine.threads`.
+
 The Python API (imported on first use, so ``import thermodem`` stays light)::
 
     import thermodem
@@ -46,6 +49,15 @@ def _configure_numba_cache() -> None:
 
 
 _configure_numba_cache()
+
+
+def _configure_threads() -> None:
+    from thermodem.engine.threads import configure_threading_layer
+
+    configure_threading_layer()
+
+
+_configure_threads()
 
 _API = {
     "Case": "thermodem.config.schema",

@@ -347,7 +347,8 @@ def _open(
 def _header(log: RunLog, sim: Simulation, threads: int | None, output: Path) -> None:
     from thermodem import __version__
 
-    estimate = estimate_resources(sim, threads)
+    _threads_line(log, sim, threads)
+    estimate = estimate_resources(sim, sim.threads)
     for warning in check_resources(estimate):
         log.warn(warning)
     log.info(
@@ -356,6 +357,15 @@ def _header(log: RunLog, sim: Simulation, threads: int | None, output: Path) -> 
     )
     for line in estimate.lines():
         log.info("  " + line)
+
+
+def _threads_line(log: RunLog, sim: Simulation, threads: int | None) -> None:
+    """Choose the thread count for the run (the request, or from the work) and log it with
+    the threading layer (engine/threads.py)."""
+    from thermodem.engine.threads import threading_layer
+
+    sim.set_threads(threads)
+    log.info(f"threads: {sim.threads} ({sim.threads_reason}); threading layer {threading_layer()}")
 
 
 def run_case(
