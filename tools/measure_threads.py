@@ -18,6 +18,7 @@ look worse than they are.
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import tempfile
 import time
@@ -63,8 +64,13 @@ def build(n: int, heat: bool, directory: Path) -> Simulation:
         "materials": {"grain": grain},
         "contact": {"normal": "hertz", "tangential": "mindlin"},
         "walls": [
-            {"kind": "box", "material": "grain", "lower": [0, 0, 0], "upper": upper,
-             "open_top": True}
+            {
+                "kind": "box",
+                "material": "grain",
+                "lower": [0, 0, 0],
+                "upper": upper,
+                "open_top": True,
+            }
         ],  # fmt: skip
         "insertion": [{"kind": "file", "material": "grain", "path": str(path)}],
     }
@@ -90,21 +96,23 @@ def main() -> None:
     parser.add_argument("--sizes", default="125,250,500,1000,2000,4000,8000,16000")
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--threads", default="1,2", help="thread counts to time (1,2 or 1)")
     args = parser.parse_args()
+    counts = [int(t) for t in args.threads.split(",")]
     sizes = [int(s) for s in args.sizes.split(",")]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in sizes:
             sim = build(n, args.heat, Path(tmp))
             sim.run(steps=50)
-            times: dict[int, list[float]] = {1: [], 2: []}
+            times: dict[int, list[float]] = {k: [] for k in (1, 2)}
             for _ in range(args.rounds):
-                for threads in (1, 2):
+                for threads in counts:
                     numba.set_num_threads(threads)
                     t0 = time.perf_counter()
                     sim.run(steps=args.steps)
                     times[threads].append(1e3 * (time.perf_counter() - t0) / args.steps)
-            t1, t2 = (statistics.median(times[k]) for k in (1, 2))
+            t1, t2 = (statistics.median(times[k] or [math.nan]) for k in (1, 2))
             rows.append((sim.particles.count, sim.pairs.count, sim.contact_count, t1, t2))
             print(
                 f"N = {sim.particles.count:6d}  pairs {sim.pairs.count:7d}  contacts "
@@ -114,11 +122,17 @@ def main() -> None:
             )
     ns = [r[0] for r in rows]
     for k, col in ((1, 3), (2, 4)):
+        if k not in counts:
+            continue
         a, b = fit(ns, [r[col] for r in rows])
         rate = 1e3 / max(b, 1e-12)
         print(f"{k} thread(s): t = {a:.4f} ms + {1e3 * b:.4f} µs × N ({rate:.3g} particle-steps/s)")
-    faster = [r[0] for r in rows if r[4] < r[3]]
-    first = min(faster) if faster else None
+    # the smallest N from which 2 threads are faster at every larger N measured
+    first = None
+    for r in reversed(rows):
+        if not r[4] < r[3]:
+            break
+        first = r[0]
     print(f"layer {numba.threading_layer()}; 2 threads faster from N = {first}")
 
 

@@ -181,6 +181,20 @@ def restart(
     )
 
 
+def _announce_compile(case: Path) -> None:
+    """'compiling kernels ...' on stderr when the cache is cold (a bad case says nothing here:
+    the validation that follows reports it)."""
+    from thermodem.config.load import load_case
+    from thermodem.engine.kernel_cache import compile_note
+
+    try:
+        note = compile_note(load_case(case))
+    except ConfigError:
+        return
+    if note:
+        typer.echo(f"# {note}", err=True)
+
+
 @app.command()
 def validate(
     case: Path = typer.Argument(..., help="case file (YAML)"),
@@ -190,6 +204,7 @@ def validate(
     from thermodem.config.dump import resolved_case_yaml
     from thermodem.engine.validation import gas_note, validate_case
 
+    _announce_compile(case)
     result = _guarded(validate_case, case, threads)
     for w in result.warnings:
         typer.echo(f"warning: {w}", err=True)

@@ -359,6 +359,15 @@ def _header(log: RunLog, sim: Simulation, threads: int | None, output: Path) -> 
         log.info("  " + line)
 
 
+def _compile_note(log: RunLog, case: Case) -> None:
+    """Say so before a simulation compiles its kernels (a cold cache; engine/kernel_cache.py)."""
+    from thermodem.engine.kernel_cache import compile_note
+
+    note = compile_note(case)
+    if note:
+        log.info(note)
+
+
 def _threads_line(log: RunLog, sim: Simulation, threads: int | None) -> None:
     """Choose the thread count for the run (the request, or from the work) and log it with
     the threading layer (engine/threads.py)."""
@@ -399,6 +408,7 @@ def run_case(
         old.unlink()
     (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
     runlog, status = _open(output, log, append=False, case_name=case_name)
+    _compile_note(runlog, case)
     try:
         sim = Simulation(case, threads=threads)
         for warning in check_simulation_time_step(sim):

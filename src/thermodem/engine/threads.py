@@ -86,9 +86,7 @@ def available_threads() -> int:
     return int(numba.config.NUMBA_NUM_THREADS)
 
 
-def choose_threads(
-    particles: float, pairs: int, requested: int | None = None
-) -> tuple[int, str]:
+def choose_threads(particles: float, pairs: int, requested: int | None = None) -> tuple[int, str]:
     """(thread count, why) for a simulation with ``particles`` particles (mean over the run)
     and ``pairs`` listed pairs; ``requested`` (a user's choice) wins."""
     if requested is not None:
