@@ -22,7 +22,7 @@ from typing import Any
 #: Seconds to compile the kernels of a mechanics-only case with an empty cache (2-core VM).
 COMPILE_SECONDS_MECHANICS = 60.0
 #: Extra seconds for the thermal kernels of a case with heat.
-COMPILE_SECONDS_HEAT = 40.0
+COMPILE_SECONDS_HEAT = 30.0
 
 
 def cache_directory() -> Path | None:

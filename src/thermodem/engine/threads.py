@@ -28,11 +28,12 @@ from __future__ import annotations
 
 import os
 
-#: The smallest mean particle count and listed pair count at which 2 threads are faster than
-#: 1 (tools/measure_threads.py on the 2-core VM, docs/architecture.md "Threads"): below both a
-#: simulation runs on 1 thread unless told otherwise.
-PARALLEL_MIN_PARTICLES = 8000
-PARALLEL_MIN_PAIRS = 3 * PARALLEL_MIN_PARTICLES
+#: The mean particle count and listed pair count from which 2 threads are faster than 1
+#: (tools/measure_threads.py on the 2-core VM, docs/architecture.md "Threads": 2 threads lose
+#: 6-14 % at 500-1000 particles and gain from about 2000): below both a simulation runs on 1
+#: thread unless told otherwise. The pair threshold is the jammed bed's 2.7 pairs per particle.
+PARALLEL_MIN_PARTICLES = 2000
+PARALLEL_MIN_PAIRS = 5500
 
 _layer_note = ""
 

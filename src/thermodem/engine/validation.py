@@ -178,7 +178,6 @@ class ResourceEstimate:
     memory_total: float
     memory_available: float
     step_seconds: float = 0.0  # the fixed part of run_seconds
-    compile_note: str | None = None
 
     def lines(self) -> list[str]:
         def gb(x: float) -> str:
@@ -191,8 +190,7 @@ class ResourceEstimate:
             f"available {gb(self.memory_available)})",
             f"estimated run time: {format_duration(self.run_seconds)} on {self.threads} "
             f"thread(s) ({format_duration(self.step_seconds)} of it a fixed cost per step, "
-            f"the rest per particle; measured on an idle 2-core VM, a busy machine is slower)"
-            + (f", plus {self.compile_note}" if self.compile_note else ""),
+            f"the rest per particle; measured on a 2-core VM, a busy machine is slower)",
         ]
 
 
@@ -253,14 +251,7 @@ def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceE
         memory_total=total,
         memory_available=avail,
         step_seconds=fixed,
-        compile_note=_compile_note(sim.case),
     )
-
-
-def _compile_note(case: Case) -> str | None:
-    from thermodem.engine.kernel_cache import compile_note
-
-    return compile_note(case)
 
 
 def run_time(
