@@ -293,3 +293,13 @@ def test_thermal_example_heats_in_its_first_steps(tmp_path: Path) -> None:
     assert np.all(mesh.cell_data["temperature"][0][plate] == 600.0)
     assert np.all(np.isnan(mesh.cell_data["temperature"][0][~plate]))  # adiabatic walls
     assert not math.isnan(float(last["temperature_mean"]))
+
+
+def test_validate_announces_a_cold_cache_on_stderr(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setattr(kernel_cache, "cold_parts", lambda heat: ["mechanics"])
+    result = CliRunner().invoke(app, ["validate", str(_case_file(tmp_path))])
+    assert result.exit_code == 0, result.output
+    seconds = kernel_cache.COMPILE_SECONDS_MECHANICS
+    assert f"# compiling kernels (first run only, ~{seconds:.0f} s" in result.stderr
+    assert "compiling" not in result.stdout  # stdout stays the resolved case (valid YAML)
+    yaml.safe_load(result.stdout)

@@ -4,8 +4,8 @@
 has (TBB, then OpenMP, then its own workqueue). Left to itself, a machine with Intel TBB
 installed (Debian's ``libtbb12``, conda, the ``tbb`` wheel) runs thermodem on TBB, and a
 process that used TBB can spin for minutes in TBB's shutdown at exit (issue 17). thermodem
-therefore selects the layer itself, when the package is imported and before any parallel
-kernel runs (:func:`configure_threading_layer`, called from ``thermodem/__init__.py``):
+therefore selects and launches the layer itself when the package is imported, before any
+parallel kernel runs (:func:`configure_threading_layer`, called from ``thermodem/__init__.py``):
 
 - ``omp`` (GNU OpenMP, ``libgomp``), the fastest measured, with ``OMP_WAIT_POLICY=passive``
   unless the environment sets a wait policy: a waiting OpenMP thread sleeps instead of
@@ -59,15 +59,20 @@ def configure_threading_layer() -> None:
         os.environ["OMP_WAIT_POLICY"] = "passive"  # read by libgomp when it loads (below)
     try:
         from numba.np.ufunc import omppool  # noqa: F401 (loads libgomp)
-    except ImportError as exc:
+
+        numba.config.THREADING_LAYER = "omp"
+        numba.get_num_threads()  # launch it now (below)
+        _layer_note = ""
+    except (ImportError, ValueError, OSError) as exc:
         numba.config.THREADING_LAYER = "workqueue"
         _layer_note = (
             f"the OpenMP layer could not be loaded ({exc}); workqueue is slower for small "
             "systems (install the OpenMP runtime, e.g. Debian's libgomp1)"
         )
-    else:
-        numba.config.THREADING_LAYER = "omp"
-        _layer_note = ""
+        numba.get_num_threads()
+    # Launched at import: Numba re-reads its configuration from the environment whenever a
+    # NUMBA_* variable changed, which would put the layer back to its default before the
+    # first parallel kernel; a launched layer stays.
 
 
 def threading_layer() -> str:
