@@ -7,13 +7,14 @@ process that used TBB can spin for minutes in TBB's shutdown at exit (issue 17).
 therefore selects and launches the layer itself when the package is imported, before any
 parallel kernel runs (:func:`configure_threading_layer`, called from ``thermodem/__init__.py``):
 
-- ``omp`` (GNU OpenMP, ``libgomp``), the fastest measured, with ``OMP_WAIT_POLICY=passive``
-  unless the environment sets a wait policy: a waiting OpenMP thread sleeps instead of
-  spinning, which costs little on an idle machine and keeps 2 threads from becoming several
-  times slower than 1 when another process shares the cores (docs/architecture.md,
-  "Threads");
+- ``omp`` (GNU OpenMP, ``libgomp``), the fastest measured;
 - ``workqueue`` (Numba's own) when OpenMP cannot be loaded; the run log then says why;
 - whatever ``NUMBA_THREADING_LAYER`` names, when the user set it.
+
+With any layer, ``OMP_WAIT_POLICY=passive`` is set unless the environment sets a wait policy
+(``OMP_WAIT_POLICY`` or ``GOMP_SPINCOUNT``): a waiting OpenMP thread sleeps instead of
+spinning, which costs little on an idle machine and keeps 2 threads from becoming many times
+slower than 1 when another process shares the cores (docs/architecture.md, "Threads").
 
 GNU OpenMP is not fork-safe: a process that forks after a parallel kernel ran must not run
 parallel kernels in the child (thermodem itself never forks; ``subprocess`` is fine).
@@ -51,12 +52,12 @@ def configure_threading_layer() -> None:
     else:
         _layer_note = "launched before thermodem was imported"
         return
+    if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
+        os.environ["OMP_WAIT_POLICY"] = "passive"  # read by libgomp when it loads
     chosen = os.environ.get("NUMBA_THREADING_LAYER", "").strip()
     if chosen and chosen.lower() != "default":
         _layer_note = f"set by NUMBA_THREADING_LAYER={chosen}"
         return
-    if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
-        os.environ["OMP_WAIT_POLICY"] = "passive"  # read by libgomp when it loads (below)
     try:
         from numba.np.ufunc import omppool  # noqa: F401 (loads libgomp)
 
