@@ -8,13 +8,18 @@ OUT ?= results/default
 
 .PHONY: run test venv lint bench clean-cache
 
+# pip -qq: errors only (no notices, no deprecation warnings of the build); an error still
+# prints and stops make
+PIP_QUIET := --quiet --quiet --disable-pip-version-check --no-warn-script-location
+
 $(BIN)/python:
+	@echo "creating $(VENV) and installing thermodem (about a minute, once)"
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
+	@$(BIN)/python -m pip install $(PIP_QUIET) --upgrade pip
 
 $(VENV)/.installed: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[test]"
-	touch $@
+	@$(BIN)/python -m pip install $(PIP_QUIET) -e ".[test]"
+	@touch $@
 
 venv: $(VENV)/.installed
 

@@ -8,6 +8,9 @@ edited module, and an unchanged installation loads everything from disk
 (``~/.cache/thermodem/numba``, or under ``$THERMODEM_CACHE_DIR``). Setting
 ``NUMBA_CACHE_DIR`` yourself overrides the directory.
 
+Importing thermodem also selects Numba's threading layer (OpenMP, else workqueue; never TBB
+by accident) before any parallel kernel runs: see :mod:`thermodem.engine.threads`.
+
 The Python API (imported on first use, so ``import thermodem`` stays light)::
 
     import thermodem
@@ -25,6 +28,15 @@ from thermodem import _numba_cache
 __version__ = "0.1.0"
 
 _numba_cache.configure()
+
+
+def _configure_threads() -> None:
+    from thermodem.engine.threads import configure_threading_layer
+
+    configure_threading_layer()
+
+
+_configure_threads()
 
 _API = {
     "Case": "thermodem.config.schema",

@@ -1,4 +1,5 @@
-"""Command line: ``thermodem run | validate | restart | info | plot | models``.
+"""Command line: ``thermodem run | validate | restart | info | plot | export | models``,
+``thermodem --version``.
 
 Exit codes: 0 success, 1 simulation failure, 2 bad input (case, arguments, files), 130 (143)
 when a run was stopped by SIGINT (SIGTERM) after writing a checkpoint.
@@ -28,6 +29,23 @@ _PROGRESS = typer.Option(
 _LOG_INTERVAL = typer.Option(
     10.0, "--log-interval", min=0.0, help="seconds between plain progress lines"
 )
+
+
+def _version(value: bool) -> None:
+    if value:
+        from thermodem import __version__
+
+        typer.echo(f"thermodem {__version__}")
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _main(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="print the version and exit"
+    ),
+) -> None:
+    """thermodem: thermal discrete element simulations."""
 
 
 def _fail(message: str, code: int) -> None:
@@ -61,6 +79,12 @@ def run(
     ),
     progress: bool | None = _PROGRESS,
     log_interval: float = _LOG_INTERVAL,
+    end_time: float | None = typer.Option(
+        None, "--end-time", help="stop at this simulated time [s] instead of the case's"
+    ),
+    steps: int | None = typer.Option(
+        None, "--steps", min=1, help="run this many steps only (a quick try of a case)"
+    ),
 ) -> None:
     """Run a case: VTU/PVD frames, timeseries.csv, checkpoints, run.log, status.json."""
     from thermodem.config.load import load_case
@@ -70,6 +94,12 @@ def run(
         if case is None and restart is None:
             raise ConfigError("give a case file, or --restart CHECKPOINT")
         loaded = load_case(case) if case is not None else None
+        if end_time is not None or steps is not None:
+            if loaded is None:
+                from thermodem.io.checkpoint import read_checkpoint
+
+                loaded = read_checkpoint(restart).case()
+            _shorten(loaded, end_time, steps, restart)
         name = case.stem if case is not None else None
         options = dict(progress=progress, log_interval=log_interval, case_name=name)
         if restart is not None:
@@ -78,6 +108,54 @@ def run(
             run_case(loaded, output, threads, overwrite, **options)
 
     _guarded(go)
+
+
+def _shorten(case, end_time: float | None, steps: int | None, restart: Path | None) -> None:  # noqa: ANN001
+    """``--end-time`` / ``--steps``: a new ``simulation.end_time`` (recorded in
+    case.resolved.yaml, so a restart continues to it)."""
+    import math
+
+    if end_time is not None and steps is not None:
+        raise ConfigError("give --end-time or --steps, not both")
+    start = 0.0
+    if restart is not None:
+        from thermodem.io.checkpoint import read_checkpoint
+
+        start = read_checkpoint(restart).time
+    if end_time is not None:
+        if not math.isfinite(end_time) or end_time <= start:
+            where = f"the checkpoint's time {start:g} s" if restart is not None else "0"
+            raise ConfigError(f"--end-time {end_time!r}: must be finite and greater than {where}")
+        case.simulation.end_time = float(end_time)
+        return
+    dt = case.simulation.time_step
+    thermal = getattr(case, "thermal", None)
+    if thermal is not None and getattr(thermal, "frozen_mechanics", False):
+        dt = thermal.time_step
+    case.simulation.end_time = start + int(steps) * float(dt)
+
+
+@app.command()
+def export(
+    directory: Path = typer.Argument(..., help="output directory of a run"),
+    frame: int | None = typer.Option(
+        None, "--frame", help="the N-th frame of particles.pvd (from 0; -1 is the last)"
+    ),
+    checkpoint: Path | None = typer.Option(
+        None, "--checkpoint", help="a checkpoint file (default: the newest in DIR/checkpoints)"
+    ),
+    out: Path | None = typer.Option(
+        None, "--out", "-o", help="CSV file, or - for standard output (default: in DIR)"
+    ),
+    overwrite: bool = typer.Option(False, "--overwrite", help="replace an existing --out file"),
+) -> None:
+    """Particle state as CSV (one row per particle: global id, material, position, velocity,
+    radius, temperature, heat rate), from a frame or a checkpoint."""
+    from thermodem.io.export import export_particles
+
+    where = _guarded(export_particles, directory, frame, checkpoint, out, overwrite)
+    if where != "standard output":
+        typer.echo(where)
 
 
 @app.command()
@@ -103,6 +181,20 @@ def restart(
     )
 
 
+def _announce_compile(case: Path) -> None:
+    """'compiling kernels ...' on stderr when the cache is cold (a bad case says nothing here:
+    the validation that follows reports it)."""
+    from thermodem.config.load import load_case
+    from thermodem.engine.kernel_cache import compile_note
+
+    try:
+        note = compile_note(load_case(case))
+    except ConfigError:
+        return
+    if note:
+        typer.echo(f"# {note}", err=True)
+
+
 @app.command()
 def validate(
     case: Path = typer.Argument(..., help="case file (YAML)"),
@@ -112,6 +204,7 @@ def validate(
     from thermodem.config.dump import resolved_case_yaml
     from thermodem.engine.validation import gas_note, validate_case
 
+    _announce_compile(case)
     result = _guarded(validate_case, case, threads)
     for w in result.warnings:
         typer.echo(f"warning: {w}", err=True)

@@ -8,6 +8,9 @@ bit-identical. The bed below has more than 4096 particles and many slab groups, 
 parallel loop is split between the threads. A second run adds heat (resistance network with
 the conductance reuse, whose per-pair state sits after the rolling model's history columns),
 a third gap conduction on the range pair set.
+
+Without a request the thread count is chosen from the work (engine/threads.py): 1 thread for
+small systems, every thread Numba has for large ones.
 """
 
 from __future__ import annotations
@@ -49,7 +52,7 @@ HEAT = {  # the resistance network with the conductance reuse (state in the pair
 
 
 def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulation, list[int]]:
-    numba.set_num_threads(threads)
+    numba.set_num_threads(1 if threads > 1 else 2)  # the simulation sets its own count
     upper = [SHAPE[0] * SPACING, SHAPE[1] * SPACING, 0.3]
     case = {
         "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0.0, 0.0, -9.81]},
@@ -92,7 +95,8 @@ def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulatio
             conductance_force_tolerance=0.0,
             range_skin=0.01 * R0,
         )
-    sim = Simulation(case_from_dict(case))
+    sim = Simulation(case_from_dict(case), threads=threads)
+    assert sim.threads == threads and sim.threads_reason == "as requested"
     seen: list[int] = []
     sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
     return sim, seen
@@ -135,3 +139,45 @@ def test_one_and_two_threads_bit_identical(tmp_path, heat):
         b = by_gid(two, name)
         assert np.array_equal(a, b), (name, np.abs(a - b).max())
     assert one.energies() == two.energies()
+
+
+def test_thread_count_chosen_from_the_work(monkeypatch):
+    from thermodem.engine import threads as T
+
+    monkeypatch.setattr(T, "available_threads", lambda: 2)
+    small, why = T.choose_threads(125, 300)
+    assert small == 1 and "1 thread is faster" in why and "125 particles" in why
+    assert T.choose_threads(T.PARALLEL_MIN_PARTICLES, 0)[0] == 2
+    assert T.choose_threads(10, T.PARALLEL_MIN_PAIRS)[0] == 2  # many pairs: work enough
+    assert T.choose_threads(1e6, 1e7, requested=1) == (1, "as requested")
+    monkeypatch.setattr(T, "available_threads", lambda: 1)
+    assert T.choose_threads(1e6, 1e7)[0] == 1
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
+def test_simulation_sets_its_thread_count(tmp_path):
+    path = tmp_path / "bed.txt"
+    write_bed(path)
+    numba.set_num_threads(2)
+    case = case_from_dict(
+        {
+            "simulation": {"time_step": 1e-5, "end_time": 1.0},
+            "domain": {"lower": [-0.01] * 3, "upper": [0.2, 0.2, 0.3]},
+            "materials": {
+                "grain": {"density": 2500.0, "youngs_modulus": 1e7, "poisson_ratio": 0.3}
+            },
+            "insertion": [{"kind": "file", "material": "grain", "path": str(path)}],
+        }
+    )
+    from thermodem.engine import threads as T
+
+    sim = Simulation(case)  # 4624 particles
+    small = sim.particles.count < T.PARALLEL_MIN_PARTICLES
+    expected = 1 if small and sim.pairs.count < T.PARALLEL_MIN_PAIRS else 2
+    assert sim.threads == expected and numba.get_num_threads() == expected
+    numba.set_num_threads(2)  # another simulation changed it: run() sets it back
+    sim.run(steps=1)
+    assert numba.get_num_threads() == expected
+    assert sim.set_threads(2) == 2 and numba.get_num_threads() == 2
+    sim.set_threads(None)  # keeps the request
+    assert sim.threads == 2

@@ -429,3 +429,116 @@ def test_pvd_with_real_frames_reads_back(tmp_path):
     for k, e in enumerate(_datasets(pvd_path)):
         mesh = meshio.read(pvd_path.parent / e["file"])
         np.testing.assert_array_equal(mesh.point_data["k"], k)
+
+
+# ---------------------------------------------------------------------------- name tables
+
+NAMES = ["glass", "steel beads", 'a = b <&> "q"', "Kupfer-Ø"]  # spaces, '=', XML, UTF-8
+
+
+def test_particle_material_names_in_field_data(tmp_path):
+    from thermodem.io.vtk import read_name_table
+
+    n = 6
+    ids = np.array([0, 1, 2, 3, 1, 0], dtype=np.int32)
+    path = tmp_path / "p.vtu"
+    write_particles_vtu(path, np.zeros((n, 3)), {"material_id": ids}, names={"material_id": NAMES})
+    mesh = meshio.read(path)  # a strict reader still opens the file
+    np.testing.assert_array_equal(mesh.point_data["material_id"], ids)
+    assert read_name_table(mesh.field_data, "material_id") == NAMES
+    assert mesh.field_data["material_id 1 = steel beads"].tolist() == [1]
+    assert read_name_table(mesh.field_data, "wall_id") == []
+    # VTK's reader (ParaView's) sees the same arrays, if VTK is installed
+    vtk = pytest.importorskip("vtk")
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    fd = reader.GetOutput().GetFieldData()
+    labels = [fd.GetArrayName(i) for i in range(fd.GetNumberOfArrays())]
+    assert labels == [f"material_id {k} = {name}" for k, name in enumerate(NAMES)]
+    assert reader.GetOutput().GetNumberOfPoints() == n
+
+
+def test_wall_names_and_temperature_in_the_walls_vtu(tmp_path):
+    from thermodem.io.vtk import read_name_table
+
+    rows = np.stack([plane_row([0, 0, 0], [0, 0, 1]), plane_row([0, 0, 1], [0, 0, -1])])
+    fields = {"temperature": np.array([600.0, np.nan]), "material_id": np.array([1, 0])}
+    path = tmp_path / "w.vtu"
+    write_walls_vtu(
+        path, np.array([PLANE, PLANE]), rows, fields, names=["hot plate", "lid"],
+        tables={"material_id": ["glass", "steel"]},
+    )  # fmt: skip
+    mesh = meshio.read(path)
+    assert read_name_table(mesh.field_data, "wall_id") == ["hot plate", "lid"]
+    assert read_name_table(mesh.field_data, "material_id") == ["glass", "steel"]
+    t = mesh.cell_data["temperature"][0]
+    np.testing.assert_array_equal(t[:2], [600.0, 600.0])
+    assert np.isnan(t[2:]).all()
+    with pytest.raises(ValueError, match="2 walls but 1 wall names"):
+        write_walls_vtu(path, np.array([PLANE, PLANE]), rows, None, names=["one"])
+
+
+def test_simulation_frames_carry_names_and_wall_temperatures(tmp_path):
+    """A run's frames: particle material names, wall names, the fixed wall's temperature
+    (from the case), NaN for adiabatic walls."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+    from thermodem.io.vtk import read_name_table, write_particle_frame, write_wall_frame
+
+    props = {"density": 2500, "youngs_modulus": 1e7, "poisson_ratio": 0.3,
+             "thermal_conductivity": 1.0, "specific_heat": 800.0}  # fmt: skip
+    lattice = {"kind": "lattice", "distribution": {"kind": "mono", "radius": 0.001},
+               "lower": [0, 0, 0], "upper": [0.01, 0.01, 0.004], "spacing": 0.0025}  # fmt: skip
+    case = case_from_dict(
+        {
+            "simulation": {"time_step": 1e-5, "end_time": 0.001},
+            "domain": {"lower": [0, 0, -0.001], "upper": [0.01, 0.01, 0.01]},
+            "materials": {"glass": props, "iron": props},
+            "walls": [
+                {
+                    "kind": "plane",
+                    "name": "heater",
+                    "point": [0, 0, 0],
+                    "normal": [0, 0, 1],
+                    "material": "iron",
+                    "thermal": {"kind": "fixed", "temperature": 450.0},
+                },
+                {
+                    "kind": "box",
+                    "lower": [0, 0, 0],
+                    "upper": [0.01, 0.01, 0.01],
+                    "material": "glass",
+                    "open_top": True,
+                },
+            ],  # fmt: skip
+            "insertion": [
+                {**lattice, "material": "glass"},
+                {
+                    **lattice,
+                    "material": "iron",
+                    "lower": [0, 0, 0.005],
+                    "upper": [0.01, 0.01, 0.009],
+                },
+            ],  # fmt: skip
+            "thermal": {"direct_conduction": "batchelor_obrien_simple"},
+        }
+    )
+    sim = Simulation(case)
+    write_particle_frame(tmp_path / "p.vtu", sim)
+    write_wall_frame(tmp_path / "w.vtu", sim, 0.02)
+    p = meshio.read(tmp_path / "p.vtu")
+    names = read_name_table(p.field_data, "material_id")
+    assert names == ["glass", "iron"]
+    got = [names[k] for k in p.point_data["material_id"]]
+    want = [sim.material_names[t] for t in sim.particles.type_id]
+    assert got == want and set(got) == {"glass", "iron"}
+    w = meshio.read(tmp_path / "w.vtu")
+    walls = read_name_table(w.field_data, "wall_id")
+    assert walls == list(sim.wall_labels) and walls[0] == "heater" and len(walls) == 6
+    wid = w.cell_data["wall_id"][0]
+    temperature = w.cell_data["temperature"][0]
+    assert np.all(temperature[wid == 0] == 450.0)
+    assert np.isnan(temperature[wid > 0]).all()
+    wall_materials = read_name_table(w.field_data, "material_id")
+    assert [wall_materials[k] for k in w.cell_data["material_id"][0][wid == 0]][0] == "iron"

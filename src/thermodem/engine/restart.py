@@ -103,6 +103,10 @@ DERIVED: tuple[str, ...] = (
     "chunk_check",
     "_no_heat",
     "mechanisms",
+    # the thread count: the new process's request or choice (results do not depend on it)
+    "requested_threads",
+    "threads",
+    "threads_reason",
 )
 #: Attributes of the thermal engine that are never saved (objects, back references).
 THERMAL_SKIP: tuple[str, ...] = ("sim", "settings", "wall_functions")

@@ -349,7 +349,8 @@ def _open(
 def _header(log: RunLog, sim: Simulation, threads: int | None, output: Path) -> None:
     from thermodem import __version__
 
-    estimate = estimate_resources(sim, threads)
+    _threads_line(log, sim, threads)
+    estimate = estimate_resources(sim, sim.threads)
     for warning in check_resources(estimate):
         log.warn(warning)
     log.info(
@@ -358,6 +359,24 @@ def _header(log: RunLog, sim: Simulation, threads: int | None, output: Path) -> 
     )
     for line in estimate.lines():
         log.info("  " + line)
+
+
+def _compile_note(log: RunLog, case: Case) -> None:
+    """Say so before a simulation compiles its kernels (a cold cache; engine/kernel_cache.py)."""
+    from thermodem.engine.kernel_cache import compile_note
+
+    note = compile_note(case)
+    if note:
+        log.info(note)
+
+
+def _threads_line(log: RunLog, sim: Simulation, threads: int | None) -> None:
+    """Choose the thread count for the run (the request, or from the work) and log it with
+    the threading layer (engine/threads.py)."""
+    from thermodem.engine.threads import threading_layer
+
+    sim.set_threads(threads)
+    log.info(f"threads: {sim.threads} ({sim.threads_reason}); threading layer {threading_layer()}")
 
 
 def run_case(
@@ -391,6 +410,7 @@ def run_case(
         old.unlink()
     (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
     runlog, status = _open(output, log, append=False, case_name=case_name)
+    _compile_note(runlog, case)
     try:
         sim = Simulation(case, threads=threads)
         for warning in check_simulation_time_step(sim):

@@ -72,8 +72,12 @@ class Simulation:
         """Build the simulation; ``insert_particles=False`` skips the static insertion entries
         (used when the state comes from a checkpoint, see :meth:`from_checkpoint`)."""
         fix_mmap_threshold()  # freed arrays go back to the system (engine/malloc.py)
-        if threads is not None:
-            numba.set_num_threads(int(threads))
+        # the thread count: the request, or chosen from the work once the particles are in
+        # (set_threads below; engine/threads.py)
+        self.requested_threads = None if threads is None else int(threads)
+        self.threads = self.requested_threads or 1
+        self.threads_reason = ""
+        numba.set_num_threads(self.threads)
         check_completeness(case)  # validation layer 2 (engine/validation.py)
         self.case = case
         sim = case.simulation
@@ -167,6 +171,31 @@ class Simulation:
             self.thermal.fresh = False
             self.thermal.initial_energy = self.thermal.thermal_energy()
             self.thermal.cumulative["fixed_reset"] = 0.0  # resets before t = 0 are the start
+        self.set_threads()
+
+    # ------------------------------------------------------------------------------ threads
+    def set_threads(self, threads: int | None = None) -> int:
+        """Set the Numba thread count: ``threads``, else the one given at construction, else
+        one chosen from the particles (mean over the rest of the run, pours included) and
+        the listed pairs (:func:`thermodem.engine.threads.choose_threads`). Returns it; the
+        reason is in ``threads_reason``. Results do not depend on it."""
+        from thermodem.engine.threads import choose_threads
+        from thermodem.engine.validation import poured_particles
+
+        if threads is not None:
+            self.requested_threads = int(threads)
+        end = self.case.simulation.end_time
+        remaining = max(end - self.time, 0.0)
+        particle_seconds = self.particles.count * remaining
+        for pourer in self.pourers:
+            particle_seconds += poured_particles(pourer.entry, self.time, end)[1]
+        mean = particle_seconds / remaining if remaining > 0 else float(self.particles.count)
+        mean = max(mean, float(self.particles.count))
+        self.threads, self.threads_reason = choose_threads(
+            mean, self.pairs.count, self.requested_threads
+        )
+        numba.set_num_threads(self.threads)
+        return self.threads
 
     # ------------------------------------------------------------------ particles in and out
     def add_particles(self, new: InsertedParticles) -> None:
@@ -343,6 +372,7 @@ class Simulation:
         """Advance ``steps`` steps, or until simulated time ``until`` [s]."""
         if (steps is None) == (until is None):
             raise ValueError("give exactly one of steps= or until=")
+        numba.set_num_threads(self.threads)  # another simulation may have changed it
         if until is not None:
             dt = self.dt
             if self.thermal is not None and self.thermal.settings.frozen_mechanics:
@@ -511,6 +541,7 @@ class Simulation:
         from thermodem.engine.restart import restore
 
         restore(self, state)
+        self.set_threads()  # the restored particles, not the empty start
 
     @classmethod
     def from_checkpoint(

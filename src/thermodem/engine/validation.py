@@ -31,13 +31,31 @@ if TYPE_CHECKING:
 
 MECHANICAL_FAMILIES = ("normal", "tangential", "rolling")
 
-#: Nominal throughput for the run time estimate: particle-steps per second per thread, and
-#: the cost of a step that does not grow with the particle count [s] (kernel launches, Python).
-#: Measured (2026-12-01): ~6e6 particle-steps/s per thread for the 50,000-sphere packed bed of
-#: bench/bench_packed_bed.py (Hertz-Mindlin, mechanics only), ~0.12 ms per step for a few
-#: hundred particles; the estimate takes half of that rate (heat, walls, denser contacts).
-PARTICLE_STEPS_PER_THREAD = 3.0e6
-SECONDS_PER_STEP = 1.5e-4
+#: The run time estimate: a fixed cost per step (Python orchestration and kernel launches,
+#: independent of the particle count) plus a cost per particle-step, each for mechanics and
+#: for heat, on 1 thread; 2 or more threads divide the per-particle part by THREAD_SPEED_UP
+#: and add THREAD_STEP_SECONDS per step (waking the threads). Measured on the 2-core VM
+#: (2026-12-02; tools/measure_threads.py, jammed beds of 8 to 16,000 spheres, Hertz-Mindlin,
+#: and whole runs of the examples): 1 thread, 0.04-0.05 ms per step below 125 spheres,
+#: 0.19-0.22 µs per particle-step; heat (batchelor_obrien_simple every step) +0.015 ms per
+#: step, +0.03 µs per particle-step; the 50,000-sphere bench bed: 6 M particle-steps/s on 1
+#: thread, 11 M on 2 (docs/STATUS.md). Estimated / measured: default example 9 s / 11 s,
+#: heated_bed 13 s / 10 s, two spheres with heat (100,000 steps) 6 s / 6 s. A machine shared
+#: with other processes is slower: the progress lines' ETA then tells the truth.
+STEP_SECONDS = 4.5e-5
+PARTICLE_STEP_SECONDS = 2.0e-7
+HEAT_STEP_SECONDS = 1.5e-5
+HEAT_PARTICLE_STEP_SECONDS = 3.0e-8
+#: Per-particle-step heat cost of the direct conduction models that cost more than the
+#: default's (bench/bench_packed_bed.py --heat: resistance_network +130 % over mechanics).
+HEAT_PARTICLE_STEP_SECONDS_BY_MODEL = {"resistance_network": 2.2e-7}
+THREAD_SPEED_UP = 1.8
+THREAD_STEP_SECONDS = 2.0e-5
+#: Writing outputs: a time-series row; a frame or checkpoint file, and per particle in it [s]
+#: (VTU of 200,000 particles: 0.11-0.15 s, io/vtk.py).
+ROW_SECONDS = 2.0e-4
+FILE_SECONDS = 3.0e-3
+FILE_SECONDS_PER_PARTICLE = 1.0e-6
 #: Memory model: bytes per particle (state arrays, neighbour index, copies while sorting) and
 #: per listed pair (indices, history, dissipation, normal force, state, and a rebuild's new
 #: indices; ×1.25 growth margin), and pairs per particle in a dense bed (3.6 measured in the
@@ -159,6 +177,7 @@ class ResourceEstimate:
     threads: int
     memory_total: float
     memory_available: float
+    step_seconds: float = 0.0  # the fixed part of run_seconds
 
     def lines(self) -> list[str]:
         def gb(x: float) -> str:
@@ -170,7 +189,8 @@ class ResourceEstimate:
             f"estimated memory: {gb(self.memory_bytes)} (physical memory {gb(self.memory_total)}, "
             f"available {gb(self.memory_available)})",
             f"estimated run time: {format_duration(self.run_seconds)} on {self.threads} "
-            f"thread(s) (nominal {PARTICLE_STEPS_PER_THREAD:.2g} particle-steps/s per thread)",
+            f"thread(s) ({format_duration(self.step_seconds)} of it a fixed cost per step, "
+            f"the rest per particle; measured on a 2-core VM, a busy machine is slower)",
         ]
 
 
@@ -201,7 +221,7 @@ def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceE
     """Rough memory and run time of running ``sim`` from its current step to end_time."""
     import numba
 
-    threads = int(threads or numba.get_num_threads())
+    threads = int(threads or getattr(sim, "threads", 0) or numba.get_num_threads())
     end = sim.case.simulation.end_time
     steps = max(0, total_steps(sim) - sim.step_count)
     dt_run = end / max(total_steps(sim), 1)
@@ -218,7 +238,7 @@ def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceE
     if sim.thermal is not None:
         pair_bytes += 16  # conductance and heat rate (heat-only passes)
     memory = BASELINE_BYTES + final * (BYTES_PER_PARTICLE + PAIRS_PER_PARTICLE * pair_bytes)
-    seconds = steps * SECONDS_PER_STEP + particle_steps / (PARTICLE_STEPS_PER_THREAD * threads)
+    fixed, variable = run_time(sim, steps, particle_steps, threads)
     total, avail = physical_memory()
     return ResourceEstimate(
         particles_now=n_now,
@@ -226,11 +246,44 @@ def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceE
         steps=steps,
         particle_steps=particle_steps,
         memory_bytes=memory,
-        run_seconds=seconds,
+        run_seconds=fixed + variable,
         threads=threads,
         memory_total=total,
         memory_available=avail,
+        step_seconds=fixed,
     )
+
+
+def run_time(
+    sim: Simulation, steps: int, particle_steps: float, threads: int
+) -> tuple[float, float]:
+    """(fixed seconds, per-particle seconds) of ``steps`` steps and ``particle_steps``
+    particle-steps of ``sim`` on ``threads`` threads (the constants above), outputs included."""
+    th = sim.thermal
+    per_step, per_particle = STEP_SECONDS, PARTICLE_STEP_SECONDS
+    if th is not None:
+        model = th.settings.direct_conduction.model
+        heat = HEAT_PARTICLE_STEP_SECONDS_BY_MODEL.get(model, HEAT_PARTICLE_STEP_SECONDS)
+        if th.settings.frozen_mechanics:  # thermal steps only
+            per_step, per_particle = HEAT_STEP_SECONDS, heat
+        else:
+            every = max(1, int(th.substeps))
+            per_step += HEAT_STEP_SECONDS / every
+            per_particle += heat / every
+    if threads > 1:
+        per_step += THREAD_STEP_SECONDS
+        per_particle /= THREAD_SPEED_UP
+    out = sim.case.output
+    end = sim.case.simulation.end_time
+
+    def count(interval: float | None, default: int) -> int:  # default: end_time / default
+        return min(default if interval is None else int(end / interval), steps) + 1
+
+    rows = count(out.timeseries_interval, 1000)
+    files = count(out.checkpoint_interval, 10) + (count(out.interval, 20) if out.vtu else 0)
+    n = sim.particles.count + sum(poured_particles(p.entry, sim.time, end)[0] for p in sim.pourers)
+    writing = rows * ROW_SECONDS + files * (FILE_SECONDS + n * FILE_SECONDS_PER_PARTICLE)
+    return steps * per_step + writing, particle_steps * per_particle
 
 
 def check_resources(estimate: ResourceEstimate) -> list[str]:
@@ -266,7 +319,7 @@ def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> V
 
     case = load_case(path)
     check_completeness(case)
-    sim = Simulation(case)
+    sim = Simulation(case, threads=threads)
     warnings = check_simulation_time_step(sim)
     estimate = estimate_resources(sim, threads)
     warnings += check_resources(estimate)

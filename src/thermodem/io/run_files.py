@@ -16,7 +16,7 @@ import numpy as np
 
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import ConfigError
-from thermodem.io.vtk import PVDWriter, write_particles_vtu, write_walls_vtu
+from thermodem.io.vtk import PVDWriter, write_particle_frame, write_wall_frame
 
 CHECKPOINT_DIR = "checkpoints"
 STATUS_FILE = "status.json"
@@ -107,35 +107,12 @@ class FrameWriter:
         self.last_step = -1
 
     def write(self, sim: Simulation) -> None:
-        p = sim.particles
         name = f"particles_{sim.step_count:09d}.vtu"
-        fields = {
-            "global_id": p.global_id,
-            "type_id": p.type_id,
-            "radius": p.radius,
-            "mass": p.mass,
-            "velocity": p.velocity,
-            "angular_velocity": p.angular_velocity,
-            "force": p.force,
-            "torque": p.torque,
-            "temperature": p.temperature,
-            "heat_rate": p.heat_rate,
-            "coordination_number": sim.coordination_number().astype(np.int32),
-        }
-        if sim.thermal is not None:
-            from thermodem.state.particles import HEAT_MECHANISMS
-
-            for k, mech in enumerate(HEAT_MECHANISMS):
-                col = p.heat_rate_by_mechanism[:, k]
-                if np.any(col):
-                    fields[f"heat_rate_{mech}"] = np.ascontiguousarray(col)
-        write_particles_vtu(self.out / "vtk" / name, p.position, fields)
+        write_particle_frame(self.out / "vtk" / name, sim)
         self.particles_pvd.add(sim.time, f"vtk/{name}")
         if sim.wall_rows.shape[0]:
             wname = f"walls_{sim.step_count:09d}.vtu"
-            write_walls_vtu(
-                self.out / "vtk" / wname, sim.wall_kind, sim.wall_rows, None, self.wall_extent
-            )
+            write_wall_frame(self.out / "vtk" / wname, sim, self.wall_extent)
             self.walls_pvd.add(sim.time, f"vtk/{wname}")
         if self.contacts_pvd is not None:
             self._write_contacts(sim)

@@ -1,0 +1,113 @@
+"""Threads: which Numba threading layer thermodem uses, and how many threads a run gets.
+
+**Layer.** Numba picks its threading layer at the first parallel kernel from what the machine
+has (TBB, then OpenMP, then its own workqueue). Left to itself, a machine with Intel TBB
+installed (Debian's ``libtbb12``, conda, the ``tbb`` wheel) runs thermodem on TBB, and a
+process that used TBB can spin for minutes in TBB's shutdown at exit (issue 17). thermodem
+therefore selects and launches the layer itself when the package is imported, before any
+parallel kernel runs (:func:`configure_threading_layer`, called from ``thermodem/__init__.py``):
+
+- ``omp`` (GNU OpenMP, ``libgomp``), the fastest measured;
+- ``workqueue`` (Numba's own) when OpenMP cannot be loaded; the run log then says why;
+- whatever ``NUMBA_THREADING_LAYER`` names, when the user set it.
+
+With any layer, ``OMP_WAIT_POLICY=passive`` is set unless the environment sets a wait policy
+(``OMP_WAIT_POLICY`` or ``GOMP_SPINCOUNT``): a waiting OpenMP thread sleeps instead of
+spinning, which costs little on an idle machine and keeps 2 threads from becoming many times
+slower than 1 when another process shares the cores (docs/architecture.md, "Threads").
+
+GNU OpenMP is not fork-safe: a process that forks after a parallel kernel ran must not run
+parallel kernels in the child (thermodem itself never forks; ``subprocess`` is fine).
+
+**Count.** Small systems do not pay for threads: without a request (``--threads``,
+``Simulation(threads=...)``) a simulation takes 1 thread below :data:`PARALLEL_MIN_PARTICLES`
+particles (and :data:`PARALLEL_MIN_PAIRS` listed pairs), and every thread Numba has above
+(:func:`choose_threads`). Results do not depend on the thread count (tests/unit/test_threads.py).
+"""
+
+from __future__ import annotations
+
+import os
+
+#: The mean particle count and listed pair count from which 2 threads are faster than 1
+#: (tools/measure_threads.py on the 2-core VM, docs/architecture.md "Threads": 2 threads lose
+#: 6-14 % at 500-1000 particles and gain from about 2000): below both a simulation runs on 1
+#: thread unless told otherwise. The pair threshold is the jammed bed's 2.7 pairs per particle.
+PARALLEL_MIN_PARTICLES = 2000
+PARALLEL_MIN_PAIRS = 5500
+
+_layer_note = ""
+
+
+def configure_threading_layer() -> None:
+    """Select the threading layer (``omp``, else ``workqueue``) unless it is already
+    launched or the user chose one with ``NUMBA_THREADING_LAYER``."""
+    global _layer_note
+    import numba
+
+    try:
+        numba.threading_layer()
+    except ValueError:
+        pass  # not launched yet: the choice is still open
+    else:
+        _layer_note = "launched before thermodem was imported"
+        return
+    if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
+        os.environ["OMP_WAIT_POLICY"] = "passive"  # read by libgomp when it loads
+    chosen = os.environ.get("NUMBA_THREADING_LAYER", "").strip()
+    if chosen and chosen.lower() != "default":
+        _layer_note = f"set by NUMBA_THREADING_LAYER={chosen}"
+        return
+    try:
+        from numba.np.ufunc import omppool  # noqa: F401 (loads libgomp)
+
+        numba.config.THREADING_LAYER = "omp"
+        numba.get_num_threads()  # launch it now (below)
+        _layer_note = ""
+    except (ImportError, ValueError, OSError) as exc:
+        numba.config.THREADING_LAYER = "workqueue"
+        _layer_note = (
+            f"the OpenMP layer could not be loaded ({exc}); workqueue is slower for small "
+            "systems (install the OpenMP runtime, e.g. Debian's libgomp1)"
+        )
+        numba.get_num_threads()
+    # Launched at import: Numba re-reads its configuration from the environment whenever a
+    # NUMBA_* variable changed, which would put the layer back to its default before the
+    # first parallel kernel; a launched layer stays.
+
+
+def threading_layer() -> str:
+    """The layer in use (launching it if no parallel kernel ran yet), with the reason when it
+    is not thermodem's first choice: ``'omp'``, ``'workqueue (the OpenMP layer ...)'``."""
+    import numba
+
+    numba.get_num_threads()  # launches the layer
+    name = numba.threading_layer()
+    return f"{name} ({_layer_note})" if _layer_note else name
+
+
+def available_threads() -> int:
+    """Threads Numba has (``NUMBA_NUM_THREADS``, default: the CPU count)."""
+    import numba
+
+    return int(numba.config.NUMBA_NUM_THREADS)
+
+
+def choose_threads(particles: float, pairs: int, requested: int | None = None) -> tuple[int, str]:
+    """(thread count, why) for a simulation with ``particles`` particles (mean over the run)
+    and ``pairs`` listed pairs; ``requested`` (a user's choice) wins."""
+    if requested is not None:
+        return int(requested), "as requested"
+    most = available_threads()
+    n = int(round(particles))
+    if most <= 1:
+        return 1, f"{n} particles; Numba has 1 thread"
+    if particles < PARALLEL_MIN_PARTICLES and pairs < PARALLEL_MIN_PAIRS:
+        return 1, (
+            f"chosen for {n} particles and {pairs} pairs: below {PARALLEL_MIN_PARTICLES} "
+            "particles 1 thread is faster; --threads N to change"
+        )
+    return most, (
+        f"chosen for {n} particles and {pairs} pairs (2 threads pay from about "
+        f"{PARALLEL_MIN_PARTICLES} particles); --threads N to change"
+    )

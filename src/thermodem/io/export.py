@@ -1,0 +1,208 @@
+"""``thermodem export``: the particle state of an output directory as CSV.
+
+One row per particle, sorted by global id, with the columns :data:`COLUMNS`: global id,
+material name, position, velocity, radius, temperature and heat rate (the sum over the
+mechanisms). The state comes from an output frame (``--frame N``, the N-th entry of
+``particles.pvd``, counted from 0; negative counts from the end) or from a checkpoint
+(``--checkpoint PATH``; by default the newest checkpoint of the directory). Nothing is
+compiled or simulated: the VTU or HDF5 file is read as it is.
+
+The first line is a comment with the source file, the step (checkpoints) and the time, so a
+CSV reader that skips ``#`` lines (``pandas.read_csv(path, comment="#")``,
+``numpy.genfromtxt``) reads the table; ``--out -`` writes to standard output.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from thermodem.errors import ConfigError
+
+COLUMNS = (
+    "global_id",
+    "material",
+    "x",
+    "y",
+    "z",
+    "vx",
+    "vy",
+    "vz",
+    "radius",
+    "temperature",
+    "heat_rate",
+)
+UNITS = "positions [m], velocities [m/s], radius [m], temperature [K], heat_rate [W]"
+
+
+class ParticleTable:
+    """Particle arrays for the CSV (any order; :func:`write_csv` sorts by global id)."""
+
+    def __init__(
+        self,
+        global_id: np.ndarray,
+        material: list[str],
+        position: np.ndarray,
+        velocity: np.ndarray,
+        radius: np.ndarray,
+        temperature: np.ndarray,
+        heat_rate: np.ndarray,
+        source: str,
+    ) -> None:
+        self.global_id = np.asarray(global_id, np.int64)
+        self.material = material
+        self.position = np.asarray(position, float).reshape(-1, 3)
+        self.velocity = np.asarray(velocity, float).reshape(-1, 3)
+        self.radius = np.asarray(radius, float)
+        self.temperature = np.asarray(temperature, float)
+        self.heat_rate = np.asarray(heat_rate, float)
+        self.source = source
+
+
+def from_frame(directory: Path, frame: int) -> ParticleTable:
+    """The particles of frame ``frame`` of ``directory/particles.pvd``."""
+    import meshio
+
+    from thermodem.io.vtk import PVDWriter, read_name_table
+
+    pvd = directory / "particles.pvd"
+    if not pvd.is_file():
+        raise ConfigError(f"{pvd} does not exist: no frames to export (try --checkpoint)")
+    entries = [e for e in PVDWriter.read(pvd) if e[1] == 0]
+    if not entries:
+        raise ConfigError(f"{pvd} lists no frames")
+    if not -len(entries) <= frame < len(entries):
+        raise ConfigError(
+            f"--frame {frame}: {pvd} has {len(entries)} frames (0 to {len(entries) - 1}, or "
+            "negative from the end: -1 is the last)"
+        )
+    time, _, file = entries[frame]
+    path = directory / file
+    try:
+        mesh = meshio.read(path)
+    except Exception as exc:  # noqa: BLE001 (any reader failure is one message)
+        raise ConfigError(f"frame {frame} ({path}) cannot be read: {exc}") from None
+    data = mesh.point_data
+    n = mesh.points.shape[0]
+    names = read_name_table(mesh.field_data, "material_id")
+    ids = data.get("material_id", data.get("type_id", np.zeros(n, np.int32)))
+    material = [names[k] if 0 <= k < len(names) else str(int(k)) for k in np.asarray(ids)]
+
+    def column(name: str, shape: tuple[int, ...] = ()) -> np.ndarray:
+        return data[name] if name in data else np.full((n, *shape), np.nan)
+
+    return ParticleTable(
+        data.get("global_id", np.arange(n)),
+        material,
+        mesh.points,
+        column("velocity", (3,)),
+        column("radius"),
+        column("temperature"),
+        column("heat_rate"),
+        f"frame {frame % len(entries)} of {pvd} ({file}), t = {time!r} s",
+    )
+
+
+def from_checkpoint(path: Path) -> ParticleTable:
+    """The particles of a checkpoint file."""
+    from thermodem.io.checkpoint import read_checkpoint
+
+    ckpt = read_checkpoint(path)
+    p = ckpt.state["particles"]
+    names = list(ckpt.state["scalars"].get("material_names", []))
+    material = [names[k] if 0 <= k < len(names) else str(int(k)) for k in p["type_id"]]
+    return ParticleTable(
+        p["global_id"],
+        material,
+        p["position"],
+        p["velocity"],
+        p["radius"],
+        p["temperature"],
+        p["heat_rate"],
+        f"checkpoint {ckpt.path} ({ckpt.kind}), step {ckpt.step}, t = {ckpt.time!r} s",
+    )
+
+
+def _rows(table: ParticleTable) -> list[list[str]]:
+    order = np.argsort(table.global_id, kind="stable")
+    rows = []
+    for i in order:
+        x, v = table.position[i], table.velocity[i]
+        values = (x[0], x[1], x[2], v[0], v[1], v[2], table.radius[i])
+        rows.append(
+            [str(int(table.global_id[i])), table.material[i]]
+            + [repr(float(a)) for a in values]
+            + [repr(float(table.temperature[i])), repr(float(table.heat_rate[i]))]
+        )
+    return rows
+
+
+def write_csv(table: ParticleTable, out: Path | None, overwrite: bool = True) -> str:
+    """Write the table to ``out`` (None: standard output); returns where it went. An existing
+    ``out`` is replaced only with ``overwrite``."""
+    buffer = io.StringIO()
+    buffer.write(f"# thermodem export: {table.source}; {UNITS}\n")
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(COLUMNS)
+    writer.writerows(_rows(table))
+    if out is None:
+        sys.stdout.write(buffer.getvalue())
+        return "standard output"
+    if out.is_dir():
+        raise ConfigError(f"--out {out}: is a directory; give a file name")
+    if out.exists() and not overwrite:
+        raise ConfigError(f"--out {out}: the file exists; give --overwrite to replace it")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
+    tmp.write_text(buffer.getvalue())
+    os.replace(tmp, out)
+    return str(out)
+
+
+def export_particles(
+    directory: str | os.PathLike[str],
+    frame: int | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    out: str | os.PathLike[str] | None = None,
+    overwrite: bool = False,
+) -> str:
+    """Export one state of an output directory as CSV; returns where it was written.
+
+    ``frame`` (an index into particles.pvd) or ``checkpoint`` (a path, or None for the newest
+    checkpoint of the directory); ``out``: a file, ``"-"`` for standard output, or None for
+    ``DIR/particles_frame_N.csv`` / ``DIR/particles_step_NNNNNNNNN.csv`` (files of
+    thermodem's own, replaced when exported again). A file given as ``out`` that exists is
+    replaced only with ``overwrite``.
+    """
+    from thermodem.io.checkpoint import list_checkpoints
+
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise ConfigError(f"{str(directory)!r} is not an output directory")
+    if frame is not None and checkpoint is not None:
+        raise ConfigError("give --frame or --checkpoint, not both")
+    if frame is not None:
+        table = from_frame(directory, int(frame))
+        default = directory / f"particles_frame_{int(frame)}.csv"
+    else:
+        if checkpoint is None:
+            found = list_checkpoints(directory / "checkpoints")
+            if not found:
+                raise ConfigError(
+                    f"no checkpoints in {directory / 'checkpoints'}; give --frame N or "
+                    "--checkpoint PATH"
+                )
+            checkpoint = found[-1]
+        table = from_checkpoint(Path(checkpoint))
+        stem = Path(checkpoint).stem.replace("checkpoint", "step")
+        default = directory / f"particles_{stem}.csv"
+    if out is None:
+        return write_csv(table, default)
+    if str(out) == "-":
+        return write_csv(table, None)
+    return write_csv(table, Path(out), overwrite)
