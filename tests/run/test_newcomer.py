@@ -139,10 +139,23 @@ def test_compile_note_when_the_cache_is_cold(tmp_path: Path, monkeypatch) -> Non
     assert note == f"compiling kernels (first run only, ~{seconds:.0f} s; kept in {empty})"
     sub = empty / "kernels_0123"
     sub.mkdir()
-    (sub / "integrate.kick_drift-20.py311.nbi").write_bytes(b"")
+
+    def index(name: str, source: str, fresh: bool = True) -> None:
+        """An index file as Numba writes it: a pickled version, then (stamp, overloads)."""
+        import pickle
+
+        from thermodem import _numba_cache
+
+        stamp = _numba_cache.dependency_stamp(str(_numba_cache.PACKAGE_ROOT / source))
+        data = pickle.dumps("version") + pickle.dumps((stamp if fresh else "old", {}))
+        (sub / name).write_bytes(data)
+
+    index("integrate.kick_drift-20.py311.nbi", "kernels/integrate.py", fresh=False)
+    assert kernel_cache.cold_parts(False) == ["mechanics"]  # a stale entry is cold
+    index("integrate.kick_drift-20.py311.nbi", "kernels/integrate.py")
     assert kernel_cache.compile_note(mech) is None
     assert kernel_cache.cold_parts(True) == ["heat"]
-    (sub / "thermal.euler_step-306.py311.nbi").write_bytes(b"")
+    index("thermal.euler_step-306.py311.nbi", "kernels/thermal.py")
     assert kernel_cache.compile_note(heat) is None
 
 
@@ -280,7 +293,7 @@ def test_thermal_example_heats_in_its_first_steps(tmp_path: Path) -> None:
     assert len(rows) >= 40  # a row every 0.5 ms
     last = rows[-1]
     assert float(last["temperature_max"]) > 310.0
-    assert float(last["heat_wall_heat"]) > 0.0
+    assert float(last["heat_in_wall_direct_conduction"]) > 0.0
     walls = sorted((out / "vtk").glob("walls_*.vtu"))
     import meshio
 
