@@ -47,7 +47,8 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
-SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty")
+SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty",
+        "_conditions_key")  # fmt: skip
 #: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
 RANGE_PREFIX = "range_set__"
 EXTERNAL_PREFIX = "external__"
@@ -95,6 +96,7 @@ class ThermalEngine:
                 )
             self.specific_heat_by_type[t] = c or 0.0
         self.conditions = ThermalConditions(sim, settings)
+        self._conditions_key: tuple = ()
         #: the external pair set of terms with target "external" (set_external_term)
         self.external: ExternalPairSet | None = None
         self.external_term = ""
@@ -228,7 +230,14 @@ class ThermalEngine:
         self.term_ready[:] = False
 
     def _fixed_and_sources(self, time: float) -> tuple[np.ndarray, np.ndarray]:
+        """Fixed particles at their bath temperature and the source powers at ``time``; once
+        per state (the contact pass's prepare and the thermal step that follows it see the
+        same positions and time)."""
         p = self.sim.particles
+        key = (self.sim.step_count, time, p.count)
+        if key == self._conditions_key and self.conditions.static_valid:
+            return self.fixed, self.source
+        self._conditions_key = key
         if self.has_c_table and self.conditions.active:
             before = p.temperature.copy()
             fixed, source, _ = self.conditions.apply(time, self.specific_heat_by_type)

@@ -63,10 +63,15 @@ class ThermalConditions:
         self.sim = sim
         self.settings = settings
         self.wall_functions: list[Any] = []
+        constant = True
         for w in sim.case.walls:
             fn = wall_temperature_function(w.thermal) if w.thermal.kind == "fixed" else None
             count = 6 - int(w.open_top) if w.kind == "box" else 1
             self.wall_functions.extend([fn] * count)
+            constant &= not isinstance(getattr(w.thermal, "temperature", None), list | str)
+        #: no wall temperature depends on time: the rows are written once
+        self.walls_constant = constant
+        self._walls_written = False
         entries: list[tuple[int, float, Selection]] = []
         entries += [(FIXED, f.temperature, f.select) for f in settings.fixed_temperature]
         entries += [(FLUX, h.flux, h.select) for h in settings.heat_flux]
@@ -146,7 +151,10 @@ class ThermalConditions:
         return self.fixed, self.source, reset
 
     def update_walls(self, time: float) -> None:
-        """Wall rows: thermal kind and temperature at ``time``."""
+        """Wall rows: thermal kind and temperature at ``time`` (once if none depends on t)."""
+        if self.walls_constant and self._walls_written:
+            return
+        self._walls_written = True
         rows = self.sim.wall_rows
         for w, fn in enumerate(self.wall_functions):
             if fn is None:
