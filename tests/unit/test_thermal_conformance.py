@@ -1,5 +1,7 @@
-"""Every registered contact_radius and direct_conduction model: dispatcher == own kernel, row
-shape, swap/symmetry, required properties named in errors, a docs page."""
+"""Every registered thermal pair model (contact_radius, direct_conduction, indirect_conduction):
+dispatcher == own kernel, row shape, swap/symmetry, required properties named in errors, a docs
+page. The family list is registry.FAMILIES: a family with models but no dispatcher here (or in
+test_registry_conformance.py for the mechanical ones) fails."""
 
 from __future__ import annotations
 
@@ -12,13 +14,16 @@ import pytest
 from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
 from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch, swap_row
+from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.state.materials import Material, resolve_pair
 
-FAMILIES = ("contact_radius", "direct_conduction")
 DISPATCH = {
     "contact_radius": contact_radius_dispatch,
     "direct_conduction": direct_conduction_dispatch,
+    "indirect_conduction": indirect_conduction_dispatch,
 }
+MECHANICAL = ("normal", "tangential", "rolling")  # tests/unit/test_registry_conformance.py
+FAMILIES = tuple(f for f in registry.FAMILIES if f in DISPATCH)
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "models"
 
 
@@ -87,11 +92,25 @@ def call(spec, fn, p, x, swap=False):
     tail = (x["f_n"], x["t_contact"], x["v"], x["m"])
     if spec.family == "contact_radius":
         return fn(p, *geo, *tail)
+    if spec.family == "indirect_conduction":
+        return fn(p, x[f"r_{i}"], x[f"r_{j}"], x["dist"], x["r_c"], x["f_n"])
     return fn(p, x[f"t_{i}"], x[f"t_{j}"], *geo, x["r_c"], *tail)
+
+
+def row_width(spec) -> int:
+    """len(columns) for a family whose rows are named (no padding), else PARAM_WIDTH."""
+    columns = spec.extra.get("columns")
+    return registry.PARAM_WIDTH if columns is None else len(columns)
 
 
 def same(a: float, b: float) -> bool:
     return a == b or (math.isnan(a) and math.isnan(b))
+
+
+def test_every_family_with_models_is_checked_by_a_conformance_test():
+    for family in registry.FAMILIES:
+        if registry.names(family):
+            assert family in DISPATCH or family in MECHANICAL, family
 
 
 def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
@@ -105,13 +124,15 @@ def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
     unknown = len(registry.names("direct_conduction"))
     q = direct_conduction_dispatch(unknown, p, 300, 310, 1e-3, 1e-3, 2e-3, 1e-6, 1e-5, 1, 0, 0, 1)
     assert math.isnan(q)
+    unknown = len(registry.names("indirect_conduction"))
+    assert math.isnan(indirect_conduction_dispatch(unknown, p, 1e-3, 1e-3, 2e-3, 1e-5, 1.0))
 
 
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
 @pytest.mark.parametrize("wall", [False, True])
 def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
     p = spec.pack(params_of(spec), resolve_pair(MAT_I, MAT_J, is_wall=wall))
-    assert p.dtype == np.float64 and p.shape == (registry.PARAM_WIDTH,)
+    assert p.dtype == np.float64 and p.shape == (row_width(spec),)
     rng = np.random.default_rng(spec.model_id + 100 * wall)
     dispatch = DISPATCH[spec.family]
     for _ in range(60):
@@ -125,6 +146,10 @@ def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
         if spec.antisymmetric:
             swapped = call(spec, spec.kernel, swap_row(p, spec.extra["swap_pairs"]), x, swap=True)
             assert swapped == -own
+        elif spec.family == "indirect_conduction":  # a conductance: symmetric to the bit
+            assert spec.extra.get("symmetric")
+            swapped = call(spec, spec.kernel, swap_row(p, spec.extra["swap_pairs"]), x, swap=True)
+            assert swapped == own and own >= 0.0
         else:
             assert spec.extra.get("symmetric")
             assert call(spec, spec.kernel, p, x, swap=True) == pytest.approx(own, rel=1e-12)

@@ -3,5 +3,8 @@
 from thermodem.models.thermal import (  # noqa: F401
     contact_radius,
     direct_conduction,
+    indirect_conduction,
     resistance_network,
+    surrounding_layer,
+    vargas_mccarthy,
 )
