@@ -26,7 +26,6 @@ INF = math.inf
 FAMILY = "indirect_conduction"
 RANGE_MODELS = ("batchelor_obrien_separated", "rong_horio1999", "musser2011")
 ALL_MODELS = (*RANGE_MODELS, "vargas_mccarthy2002")
-LONG = np.longdouble
 
 
 def material(**kw) -> Material:
@@ -88,7 +87,9 @@ def bisect(g, lo: float, hi: float) -> float:
 def musser_reference(r_i, r_j, d, r_c, ratio, s_min) -> float:
     """Spec (Musser 2011): ∫_{R_c}^{R_f} 2πr / max(S, d - √(R_i² - r²) - √(R_j² - r²)) dr.
 
-    d_f is evaluated in long double from the same gap d - (R_i + R_j) the kernel sees.
+    d_f = (d - R_i - R_j) + (R_i - √(R_i² - r²)) + (R_j - √(R_j² - r²)), each R - √(R² - r²)
+    written r²/(R + √(R² - r²)) (no cancellation near the axis), from the same gap
+    d - (R_i + R_j) the kernel sees.
     """
     r_k, r_l = max(r_i, r_j), min(r_i, r_j)
     gap = d - (r_i + r_j)
@@ -100,13 +101,12 @@ def musser_reference(r_i, r_j, d, r_c, ratio, s_min) -> float:
     else:
         r_f = math.sqrt(a * a - ((a * a - r_l * r_l + d * d) / (2 * d)) ** 2)
     lo = r_c if gap <= 0 else 0.0
-    ri, rj, g = LONG(r_i), LONG(r_j), LONG(gap)
 
     def d_f(r: float) -> float:
-        x = LONG(r)
-        s_i = np.sqrt(max(ri * ri - x * x, LONG(0)))
-        s_j = np.sqrt(max(rj * rj - x * x, LONG(0)))
-        return float(g + (ri - s_i) + (rj - s_j))
+        r2 = r * r
+        s_i = math.sqrt(max((r_i - r) * (r_i + r), 0.0))
+        s_j = math.sqrt(max((r_j - r) * (r_j + r), 0.0))
+        return gap + r2 / (r_i + s_i) + r2 / (r_j + s_j)
 
     return _split_at_s(lambda r: 2 * PI * r / max(s_min, d_f(r)), d_f, lo, r_f, s_min)
 
@@ -129,11 +129,9 @@ def musser_wall_reference(r, d, r_c, ratio, s_min) -> float:
         return 0.0
     r_f = min(r, math.sqrt((r + ratio * r) ** 2 - d * d))
     lo = r_c if gap <= 0 else 0.0
-    rr, g = LONG(r), LONG(gap)
 
     def d_f(x: float) -> float:
-        xl = LONG(x)
-        return float(g + (rr - np.sqrt(max(rr * rr - xl * xl, LONG(0)))))
+        return gap + x * x / (r + math.sqrt(max((r - x) * (r + x), 0.0)))
 
     return _split_at_s(lambda x: 2 * PI * x / max(s_min, d_f(x)), d_f, lo, r_f, s_min)
 
@@ -152,10 +150,10 @@ def rong_horio_reference(r_p, d, ratio, s_min, contact_term, regularised=True) -
         theta1 = max(theta_c, 2 * math.asin(math.sqrt(s_min / (4 * r_p))))
     else:
         theta1 = 0.0
-    gap_l = LONG(d) - 2 * LONG(r_p)
+    gap = d - 2 * r_p
 
     def path(t: float) -> float:  # d - 2R cos θ = gap + 2R (1 - cos θ) = gap + 4R sin²(θ/2)
-        return float(gap_l + 4 * LONG(r_p) * LONG(math.sin(0.5 * t)) ** 2)
+        return gap + 4 * r_p * math.sin(0.5 * t) ** 2
 
     def f(t: float) -> float:
         y = max(s_min, path(t)) if regularised else path(t)
@@ -185,11 +183,9 @@ def wall_analytic_reference(r, d, ratio, s_min) -> float:
     gap = d - r
     r_out = min(r, math.sqrt((r + ratio * r) ** 2 - d * d))
     r_in = 0.0 if gap > s_min else math.sqrt((r - d + s_min) * (r + d - s_min))
-    rr, g = LONG(r), LONG(gap)
 
     def d_f(x: float) -> float:
-        xl = LONG(x)
-        return float(g + (rr - np.sqrt(max(rr * rr - xl * xl, LONG(0)))))
+        return gap + x * x / (r + math.sqrt(max((r - x) * (r + x), 0.0)))
 
     return quad_pieces(lambda x: 2 * PI * x / d_f(x), r_in, r_out)
 
@@ -218,6 +214,8 @@ def random_pair(rng, equal: bool, wall: bool = False):
     d = r_i + gap if wall else r_i + r_j + gap
     overlap = (r_i - d) if wall else (r_i + r_j) - d
     r_c = geometric_contact_radius(r_i, r_j, overlap) if overlap > 0 else 0.0
+    if rng.random() < 0.2:  # another contact radius model (a contacts pair set)
+        r_c *= rng.uniform(0.5, 1.5)
     return r_i, r_j, d, r_c, ratio, s_min
 
 
@@ -316,10 +314,11 @@ def test_rong_horio_equals_musser_for_equal_radii_except_near_contact():
     (θ_S for overlaps below S) differs from the contact circle, and by the contact term."""
     rng = np.random.default_rng(7)
     for _ in range(300):
-        r_i, _, d, r_c, ratio, s_min = random_pair(rng, equal=True)
+        r_i, _, d, _, ratio, s_min = random_pair(rng, equal=True)
         overlap = 2 * r_i - d
         if 0 < overlap <= s_min:
             continue
+        r_c = geometric_contact_radius(r_i, r_i, overlap) if overlap > 0 else 0.0
         rh = conductance(
             "rong_horio1999", layer_row("rong_horio1999", 1, ratio, s_min), r_i, r_i, d
         )
@@ -457,6 +456,18 @@ def test_bob_separated_regimes_by_hand(regime, gap, which, cylinder):
     x = {"near": near, "far": far, "min": min(near, far)}[which]
     h = bob_h(gap, regime=regime, cylinder_radius=cylinder)
     assert h == pytest.approx(2 * PI * R_BAR * 0.1 * x, rel=1e-13)
+
+
+def test_bob_separated_dai_thresholds_with_a_thin_cylinder():
+    """r̄ = 0.1 R̄: the minimum is the far form already at λ = 0.009, so only the λ < 0.01 rule
+    gives the near form there (the thresholds matter, not only the minimum)."""
+    near = math.log(1e4)
+    for lam, expected in ((0.009, near), (0.015, None), (150.0, None)):
+        gap = lam / 1e7
+        far = math.log1p(0.01 * R_BAR**2 / (2 * R_BAR * gap))
+        x = expected if expected is not None else (far if lam > 100 else min(near, far))
+        assert bob_h(gap, cylinder_radius=0.1) == pytest.approx(2 * PI * R_BAR * 0.1 * x, rel=1e-13)
+    assert far < near
 
 
 def test_bob_separated_regime_boundaries():
