@@ -114,6 +114,10 @@ def test_every_gas_property_a_model_reads_is_a_gas_key():
         "direct_conduction.resistance_network",
         "direct_conduction.batchelor_obrien_complete",
         "direct_conduction.batchelor_obrien_modified",
+        "indirect_conduction.batchelor_obrien_separated",
+        "indirect_conduction.rong_horio1999",
+        "indirect_conduction.musser2011",
+        "indirect_conduction.vargas_mccarthy2002",
     }
     for names in users.values():
         assert set(names) <= set(GasProperties.model_fields)

@@ -1,5 +1,7 @@
-"""Every registered contact_radius and direct_conduction model: dispatcher == own kernel, row
-shape, swap/symmetry, required properties named in errors, a docs page."""
+"""Every registered thermal pair model (contact_radius, direct_conduction, indirect_conduction):
+dispatcher == own kernel, row shape, swap/symmetry, required properties named in errors, a docs
+page. The family list is registry.FAMILIES: a family with models but no dispatcher here (or in
+test_registry_conformance.py for the mechanical ones) fails."""
 
 from __future__ import annotations
 
@@ -12,13 +14,19 @@ import pytest
 from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
 from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch, swap_row
+from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
+from thermodem.models.thermal.radiation import radiation_dispatch
 from thermodem.state.materials import Material, resolve_pair
 
-FAMILIES = ("contact_radius", "direct_conduction")
 DISPATCH = {
     "contact_radius": contact_radius_dispatch,
     "direct_conduction": direct_conduction_dispatch,
+    "indirect_conduction": indirect_conduction_dispatch,
+    "radiation": radiation_dispatch,
 }
+PARTICLE_FAMILIES = ("radiation",)  # per-particle terms: (p, T_i, R_i, fields, i) -> (Q, G)
+MECHANICAL = ("normal", "tangential", "rolling")  # tests/unit/test_registry_conformance.py
+FAMILIES = tuple(f for f in registry.FAMILIES if f in DISPATCH)
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "models"
 
 
@@ -34,6 +42,7 @@ def material(**kw) -> Material:
         surface_slope=0.05,
         thermal_accommodation=0.8,
         youngs_modulus_real=6e10,
+        emissivity=0.8,
     )
     base.update(kw)
     return Material(**base)
@@ -87,11 +96,23 @@ def call(spec, fn, p, x, swap=False):
     tail = (x["f_n"], x["t_contact"], x["v"], x["m"])
     if spec.family == "contact_radius":
         return fn(p, *geo, *tail)
+    if spec.family == "indirect_conduction":
+        return fn(p, x[f"r_{i}"], x[f"r_{j}"], x["dist"], x["r_c"], x["f_n"])
+    if spec.family in PARTICLE_FAMILIES:
+        return fn(p, x[f"t_{i}"], x[f"r_{i}"], np.zeros((1, 0)), 0)
     return fn(p, x[f"t_{i}"], x[f"t_{j}"], *geo, x["r_c"], *tail)
 
 
-def same(a: float, b: float) -> bool:
+def same(a, b) -> bool:  # noqa: ANN001
+    if isinstance(a, tuple):
+        return all(same(x, y) for x, y in zip(a, b, strict=True))
     return a == b or (math.isnan(a) and math.isnan(b))
+
+
+def test_every_family_with_models_is_checked_by_a_conformance_test():
+    for family in registry.FAMILIES:
+        if registry.names(family):
+            assert family in DISPATCH or family in MECHANICAL, family
 
 
 def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
@@ -105,6 +126,8 @@ def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
     unknown = len(registry.names("direct_conduction"))
     q = direct_conduction_dispatch(unknown, p, 300, 310, 1e-3, 1e-3, 2e-3, 1e-6, 1e-5, 1, 0, 0, 1)
     assert math.isnan(q)
+    unknown = len(registry.names("indirect_conduction"))
+    assert math.isnan(indirect_conduction_dispatch(unknown, p, 1e-3, 1e-3, 2e-3, 1e-5, 1.0))
 
 
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
@@ -119,12 +142,22 @@ def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
         own = call(spec, spec.kernel, p, x)
         via = call(spec, lambda *a: dispatch(spec.model_id, *a), p, x)
         assert same(own, via), (own, via)
-        assert np.isfinite(own)
+        assert np.all(np.isfinite(own))
+        if spec.family in PARTICLE_FAMILIES:  # (Q, G): G = -dQ/dT_i >= 0, by differences
+            q, g = own
+            x_up = dict(x, t_i=x["t_i"] * (1 + 1e-6))
+            q_up = call(spec, spec.kernel, p, x_up)[0]
+            assert g >= 0.0 and -(q_up - q) / (x["t_i"] * 1e-6) == pytest.approx(g, rel=1e-4)
+            continue
         if wall:
             continue
         if spec.antisymmetric:
             swapped = call(spec, spec.kernel, swap_row(p, spec.swap_pairs), x, swap=True)
             assert swapped == -own
+        elif spec.family == "indirect_conduction":  # a conductance: symmetric to the bit
+            assert spec.symmetric
+            swapped = call(spec, spec.kernel, swap_row(p, spec.swap_pairs), x, swap=True)
+            assert swapped == own and own >= 0.0
         else:
             assert spec.symmetric
             assert call(spec, spec.kernel, p, x, swap=True) == pytest.approx(own, rel=1e-12)

@@ -17,7 +17,8 @@ Order inside one step (``Simulation.step``):
    pair passes: geometry and contact forces of every particle and wall pair, added straight
    into the particles by slab group (``thermodem.kernels.slabs``), dissipation per mechanism,
    history, ledger rows per group; when a thermal step follows, the same passes evaluate the
-   contact conduction of the touching pairs;
+   contact conduction of the touching pairs, and the other heat terms are evaluated right
+   after them on the same state (so the heat rates are complete at the end of the step);
 5. the second half kick;
 6. overlap check; 7. writers on their triggers (owned by the caller, see
    ``thermodem.engine.runner``).
@@ -165,10 +166,8 @@ class Simulation:
         self._compute_forces(kick=False, contact_dt=0.0)
         self.initial_energy = self.total_energy()
         if self.thermal is not None:
-            # the heat rates of the initial state (every term); the first thermal step
-            # evaluates them again from this same state
-            self.thermal.compute_rates(self.time)
-            self.thermal.fresh = False
+            if not self.thermal.fresh:  # (else the contact pass computed every rate)
+                self.thermal.compute_rates(self.time)
             self.thermal.initial_energy = self.thermal.thermal_energy()
             self.thermal.cumulative["fixed_reset"] = 0.0  # resets before t = 0 are the start
         self.set_threads()
@@ -287,6 +286,8 @@ class Simulation:
             self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
             wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat,
         )  # fmt: skip
+        if heat_due:  # the other heat terms of this state, so the rates are complete now
+            th.after_contact_pass(self.time)
         if kick:
             final_kick(p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
                        p.moment_of_inertia, self.dt)  # fmt: skip

@@ -526,6 +526,13 @@ class ThermalEngine:
         self.fresh = False
         return self.finish(time)
 
+    def after_contact_pass(self, time: float) -> None:
+        """The fused contact pass has added the contact conduction of this state: add every
+        other term and form the total heat rates, for the thermal step that follows."""
+        self._fixed_and_sources(time)
+        self.evaluate_terms()
+        self.finish(time)
+
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
@@ -543,14 +550,14 @@ class ThermalEngine:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler)."""
         sim = self.sim
         p = sim.particles
-        if self.fresh:  # the fused contact pass already computed the contact conduction
+        if self.fresh:  # the contact pass and after_contact_pass computed every rate
             fixed, source = self._fixed_and_sources(time)
         else:
             self.prepare(time)
             self.conduction_passes()
+            self.evaluate_terms()
             fixed, source = self.fixed, self.source
         self.fresh = False
-        self.evaluate_terms()
         by_mech = p.heat_rate_by_mechanism
         if self.has_c_table:
             kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)

@@ -6,4 +6,6 @@ from thermodem.models.thermal import (  # noqa: F401
     indirect_conduction,
     radiation,
     resistance_network,
+    surrounding_layer,
+    vargas_mccarthy,
 )
