@@ -5,11 +5,15 @@ The standard comparison case of ``shared/beds/README.md``: 50,000 spheres of R =
 e = 0.5, μ = 0.5, ρ = 2500 kg/m³, no rolling resistance, gravity, Δt = 5e-6 s, Verlet skin
 0.2 mm; with heat: k = 1 W/(m K), c = 800 J/(kg K), Batchelor & O'Brien simple with the
 geometric contact radius, the particles with centre z < 1.5 mm held at 400 K (selected by a
-region or by their material), the rest at 300 K, adiabatic walls, heat every step. 500
+region or by their material), the rest at 300 K, adiabatic walls, heat every step (case
+``heat``: no fixed particles, T = 300 K + 1000 K/m × z instead). ``--indirect`` adds an
+indirect_conduction model on the range pair set (the issue-10 benchmark: rong_horio1999
+with layer_thickness_ratio 0.25 and 0.5, i.e. gaps of 0.5 R̄ and 1.0 R̄). 500
 untimed steps, then the timed steps; throughput = N × steps / loop seconds.
 
     python bench/bench_shared_bed.py [--threads 1 2] [--steps 1000] [--warmup 500]
-        [--cases mechanics region material] [--indirect MODEL [--indirect-param KEY=VALUE ...]]
+        [--cases mechanics heat region material]
+        [--indirect MODEL [--indirect-param KEY=VALUE ...]]
         [--substeps N] [--json]
 
 Each (case, thread count) runs in a fresh process; prints particle-steps per second and the
@@ -96,10 +100,12 @@ def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = Fals
         "substeps": substeps,
         "initial_temperature": {"kind": "uniform", "value": 300.0},
     }
-    if kind == "region":
+    if kind == "heat":  # no fixed particles: a temperature gradient over the height
+        thermal["initial_temperature"] = {"kind": "expression", "expression": "300 + 1000 * z"}
+    elif kind == "region":
         box = {"lower": [-1.0, -1.0, -1.0], "upper": [1.0, 1.0, HOT_Z]}
         thermal["fixed_temperature"] = [{"select": {"region": box}, "temperature": 400.0}]
-    else:  # material
+    elif kind == "material":
         case["materials"]["hot"] = dict(material)
         case["insertion"] = [
             {"kind": "file", "material": "hot", "path": str(hot_path)},

@@ -16,6 +16,7 @@ import pytest
 
 from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
+from thermodem.errors import ConfigError
 from thermodem.geometry.insertion import InsertedParticles, save_particle_file
 from thermodem.models import registry
 from thermodem.models.thermal.direct_conduction import separated_conductance
@@ -224,3 +225,11 @@ def test_every_range_model_is_covered_by_the_range_set() -> None:
         assert spec.interaction_range(params, 0.5 * r, math.inf) <= wall_gap, spec.name
         checked += 1
     assert checked >= 2
+
+
+def test_a_range_larger_than_the_domain_is_refused_naming_the_key(tmp_path: Path) -> None:
+    case = _two_spheres(tmp_path, 1e-4, 5e-4)
+    case["thermal"]["direct_conduction"] = {"model": "batchelor_obrien_complete",
+                                            "cutoff_gap_ratio": 1e3}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"thermal.direct_conduction.*exceeds the domain"):
+        Simulation(case_from_dict(case))

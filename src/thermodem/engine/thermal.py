@@ -367,8 +367,21 @@ class ThermalEngine:
         if p.count == 0:
             return 0.0, 0.0
         r_max = float(p.radius.max())
-        gaps = [t.max_gap(r_max) for t in self.terms if t.target == "range"]
-        return max(g for g, _ in gaps), max(w for _, w in gaps)
+        extent = float(np.min(self.sim.upper - self.sim.lower))
+        gap = wall_gap = 0.0
+        for term in self.terms:
+            if term.target != "range":
+                continue
+            g, w = term.max_gap(r_max)
+            if max(g, w) > extent:
+                raise ConfigError(
+                    f"{term.key} = {term.choice.model!r}: its largest conducting gap "
+                    f"{max(g, w):.6g} m (for particles of radius {r_max:.6g} m) exceeds the "
+                    f"domain's smallest extent {extent:.6g} m; check its range parameters "
+                    f"({term.params.model_dump()})"
+                )
+            gap, wall_gap = max(gap, g), max(wall_gap, w)
+        return gap, wall_gap
 
     def evaluate_terms(self) -> None:
         """Add the heat of every term other than the contact conduction (at this state)."""
