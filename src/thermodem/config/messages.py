@@ -287,6 +287,10 @@ def format_error(err: dict[str, Any], data: Any) -> str:
     own = re.match(r"^([A-Za-z_][\w]*(?:\.[\w]+)*): ", msg)
     if own and "." in own.group(1) and (not dotted or own.group(1).startswith(dotted)):
         return msg
+    # ... or the key of the section they check ('radii: 3 values for 4 positions')
+    keys = _allowed_keys(where) or []
+    if own and dotted and own.group(1).split(".")[0] in keys:
+        return f"{dotted}.{msg}"
     shown = (
         "" if isinstance(value, dict | list) or repr(value) in msg else f" (got {_shown(value)})"
     )
