@@ -143,10 +143,11 @@ def walk(loc: tuple[Any, ...], data: Any) -> tuple[list[str], _Where | None]:
         members = _members(tp)
         tags = _tagged(members)
         if len(tags) > 1:
+            is_dict = isinstance(value, dict)
             if (
                 isinstance(elem, str)
                 and elem in tags
-                and not (isinstance(value, dict) and elem in value)
+                and (not (is_dict and elem in value) or (is_dict and value.get("kind") == elem))
             ):
                 where = _Where(tags[elem], value)  # a union tag: not part of the case file
                 continue

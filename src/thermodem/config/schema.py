@@ -230,6 +230,7 @@ class Case(StrictModel):
                             f"allowed: {allowed}"
                         )
             self._check_conductance_reuse(th)
+            self._probe_temperature_expressions(th)
             rule = th.initial_temperature
             if rule is not None and rule.kind == "per_material":
                 for m in rule.values:
@@ -271,6 +272,40 @@ class Case(StrictModel):
                     f"against {dom.lower[a]:g} .. {dom.upper[a]:g}); particles must start "
                     "inside the domain: move the region or enlarge domain"
                 )
+
+    def _probe_temperature_expressions(self, th: ThermalSettings) -> None:
+        """Temperature expressions evaluated before the run: the initial temperature on a
+        21 × 21 × 21 grid spanning the domain, each wall temperature at 2001 times from 0 to
+        end_time; every value must be finite and > 0 K."""
+        import numpy as np
+
+        from thermodem.engine.expressions import probe_expression
+
+        rule = th.initial_temperature
+        if rule is not None and rule.kind == "expression":
+            axes = [
+                np.linspace(lo, hi, 21)
+                for lo, hi in zip(self.domain.lower, self.domain.upper, strict=True)
+            ]
+            x, y, z = np.meshgrid(*axes, indexing="ij")
+            try:
+                probe_expression(rule.expression, ("x", "y", "z"), (x, y, z), 0.0)
+            except ValueError as exc:
+                raise ValueError(
+                    f"thermal.initial_temperature.expression: {exc} (an initial temperature "
+                    "[K] of every point of the domain)"
+                ) from None
+        times = np.linspace(0.0, self.simulation.end_time, 2001)
+        for k, wall in enumerate(self.walls):
+            value = wall.thermal.temperature
+            if wall.thermal.kind == "fixed" and isinstance(value, str):
+                try:
+                    probe_expression(value, ("t",), (times,), 0.0)
+                except ValueError as exc:
+                    raise ValueError(
+                        f"walls.{k}.thermal.temperature: {exc} (a wall temperature [K] from "
+                        "t = 0 to simulation.end_time)"
+                    ) from None
 
     def _check_conductance_reuse(self, th: ThermalSettings) -> None:
         """The reuse holds a conductance for a given normal force: the model must depend on
