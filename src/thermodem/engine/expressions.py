@@ -131,7 +131,8 @@ def compile_expression(text: str, variables: tuple[str, ...]) -> Callable[..., n
             if isinstance(exc, OverflowError):
                 reason = "overflow (a value beyond 1.8e308)"
             raise ExpressionError(
-                f"expression {_shown(text)} cannot be evaluated at {_where(variables, values)}: {reason}"
+                f"expression {_shown(text)} cannot be evaluated at "
+                f"{_where(variables, values)}: {reason}"
             ) from None
         if not np.all(np.isfinite(result)):
             k = int(np.flatnonzero(~np.isfinite(np.broadcast_to(result, np.shape(result))))[0])
