@@ -157,8 +157,8 @@ class Checkpoint:
             data = yaml.safe_load(self.case_yaml)
         except yaml.YAMLError as exc:
             raise ConfigError(
-                f"checkpoint {self.path}: the stored case is not valid YAML ({exc}); the file "
-                "is damaged"
+                f"checkpoint {self.path}: the stored case is not valid YAML "
+                f"({_yaml_problem(exc)}); the file is damaged"
             ) from None
         return case_from_dict(data, f"{self.path} (stored case)")
 
@@ -169,6 +169,29 @@ def _read_group(group: Any) -> dict[str, np.ndarray]:
 
 def _text(value: Any) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _yaml_problem(exc: Exception) -> str:
+    """One line for a YAML error: the problem and where."""
+    import yaml
+
+    if isinstance(exc, yaml.MarkedYAMLError) and exc.problem_mark is not None:
+        mark = exc.problem_mark
+        return f"{exc.problem} at line {mark.line + 1}, column {mark.column + 1}"
+    return " ".join(str(exc).split())
+
+
+def _check_case_yaml(text: str, damaged: str) -> None:
+    import yaml
+
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(
+            f"{damaged}: the stored case is not valid YAML ({_yaml_problem(exc)})"
+        ) from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{damaged}: the stored case is not a mapping of sections")
 
 
 def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
@@ -223,6 +246,7 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
             raise ConfigError(f"{damaged}: kind {kind!r} is not one of {', '.join(KINDS)}")
     from thermodem.engine.restart import check_state
 
+    _check_case_yaml(case_yaml, damaged)
     try:
         check_state(state)
     except ConfigError as exc:
