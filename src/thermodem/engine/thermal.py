@@ -63,6 +63,7 @@ class ThermalEngine:
         particle_mats = set(self._particle_materials(case))
         hot_walls = {w.material for w in case.walls if w.thermal.kind == "fixed"}
         n = len(names)
+        overrides = {frozenset(o.materials): o for o in case.interactions}
         self.radius_table = np.zeros((n, n, 16))
         self.conduction_table = np.zeros((n, n, 16))
         for a, na in enumerate(names):
@@ -75,6 +76,7 @@ class ThermalEngine:
                 pair = resolve_pair(
                     case.materials[na],
                     case.materials[nb],
+                    overrides.get(frozenset((na, nb))),
                     is_wall=nb in hot_walls and nb not in particle_mats,
                     gas=settings.gas,
                 )

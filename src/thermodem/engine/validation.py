@@ -31,6 +31,9 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 MECHANICAL_FAMILIES = ("normal", "tangential", "rolling")
+#: Material properties an ``interactions`` entry may give for the pair instead (equivalent
+#: values): a material need not give them when every pair it forms has them.
+PAIR_PROPERTIES = ("surface_roughness", "surface_slope")
 
 #: Nominal throughput for the run time estimate: particle-steps per second per thread, and
 #: the cost of a step that does not grow with the particle count [s] (kernel launches, Python).
@@ -81,6 +84,18 @@ def meeting_materials(case: Case) -> tuple[set[str], set[str], set[str]]:
 def check_completeness(case: Case) -> None:
     """Raise ConfigError naming ``materials.NAME.PROPERTY`` for each missing property."""
     particles, walls, hot = meeting_materials(case)
+    overrides = {frozenset(o.materials): o for o in case.interactions}
+
+    def given_per_pair(name: str, prop: str, partners: set[str]) -> bool:
+        """Every pair of ``name`` with its partners has an interactions entry giving
+        ``prop`` (pair properties: the equivalent surface roughness and slope)."""
+        if prop not in PAIR_PROPERTIES:
+            return False
+        return all(
+            getattr(overrides.get(frozenset((name, other))), prop, None) is not None
+            for other in partners
+        )
+
     problems: list[str] = []
     for path, choice in model_choices(case):
         spec = choice.spec
@@ -90,8 +105,11 @@ def check_completeness(case: Case) -> None:
             meets = sorted(particles | (hot if particles else set()))
         for name in meets:
             material = case.materials[name]
+            partners = (set(meets) if name in particles else set(particles)) or {name}
             for prop in spec.requires:
-                if getattr(material, prop, None) is None:
+                if getattr(material, prop, None) is None and not given_per_pair(
+                    name, prop, partners
+                ):
                     role = "particles" if name in particles else "walls"
                     problems.append(
                         f"materials.{name}.{prop}: missing; required by {path} = "
