@@ -974,3 +974,28 @@ def test_pour_does_nothing_before_start():
 def test_box_region_validation():
     with pytest.raises(ValidationError, match="on the x axis lower=2.0 and upper=1.0"):
         BoxRegion(lower=(2, 0, 0), upper=(1, 1, 1))
+
+
+def test_a_pour_batch_tries_at_most_what_half_the_region_holds():
+    """rate × interval = 1e6 particles for a box that holds 119 at half its volume: the batch
+    tries 119 (the work is bounded), the rest are skipped and counted."""
+    import time
+
+    entry = pour_entry(
+        region={"kind": "box", "lower": (0, 0, 0), "upper": (0.01, 0.01, 0.01)},
+        distribution={"kind": "mono", "radius": 0.001},
+        rate=1e9,
+        start_time=0.0,
+        end_time=None,
+        interval=0.001,
+    )
+    pourer = Pourer(entry, np.random.default_rng(46))
+    assert pourer.batch_cap == int(0.5 * 1e-6 / (4.0 / 3.0 * math.pi * 1e-9))
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        new = pourer.emit(0.001, None, None)
+    assert time.perf_counter() - start < 10.0
+    assert 0 < len(new) <= pourer.batch_cap
+    assert pourer.inserted + pourer.skipped == 1_000_000
+    assert count_overlaps(new.position, new.radius) == 0

@@ -477,7 +477,9 @@ class PourInsertion(_EntryBase):
     ``t`` a total of ``floor(rate (t - start_time))`` particles has been requested. Each batch is
     placed by random sequential addition without overlapping particles already in the region or
     each other; particles that cannot be placed in ``max_attempts`` tries are skipped with a
-    warning (they are not carried over to the next batch).
+    warning (they are not carried over to the next batch). A batch tries at most as many
+    particles as would fill half the region (more cannot be placed at random); the rest of it
+    is skipped at once, so the work of a batch is bounded whatever the rate.
     """
 
     kind: Literal["pour"] = "pour"

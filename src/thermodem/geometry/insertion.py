@@ -319,6 +319,13 @@ class Pourer:
         """Particles requested but not placed (the region was too full)."""
         self.last_time = float(entry.start_time)
         """Time up to which particles have been requested [s]."""
+        self.batch_cap = max(
+            1,
+            int(RSA_MAX_FRACTION * self._region.volume() / mean_sphere_volume(entry.distribution)),
+        )
+        """Most particles one batch tries to place: more than :data:`RSA_MAX_FRACTION` of the
+        region could not be placed anyway (the rest of the batch is skipped at once, which
+        bounds the work of a batch whatever the rate)."""
 
     @property
     def finished(self) -> bool:
@@ -365,6 +372,8 @@ class Pourer:
         self.last_time = max(self.last_time, t)
         if n <= 0:
             return InsertedParticles.empty(entry.material, entry.temperature is not None)
+        requested = n
+        n = min(n, self.batch_cap)
         radii = sample_radii(entry.distribution, n, self.rng)
         self._region.check_fits(float(radii.max()), "pour insertion")
         positions, placed = _random_fill(
@@ -378,6 +387,7 @@ class Pourer:
         )
         n_placed = int(placed.sum())
         self.inserted += n_placed
+        n = requested
         if n_placed < n:
             self.skipped += n - n_placed
             warnings.warn(
