@@ -210,6 +210,11 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
     with f:
         if _text(f.attrs.get("format", "")) != FORMAT:
             raise ConfigError(f"{path} is not a thermodem checkpoint")
+        absent = [
+            k for k in ("format_version", "kind", "step", "time", "created") if k not in f.attrs
+        ]
+        if absent:
+            raise ConfigError(f"{damaged}: attribute(s) {', '.join(absent)} missing")
         try:
             version = int(f.attrs["format_version"])
             attrs = {k: f.attrs[k] for k in ("kind", "step", "time", "created")}
@@ -224,6 +229,8 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
             )
         required = ("case_yaml", "scalars_json", "particles", "pairs", "walls", "arrays")
         lacking = [name for name in required if name not in f]
+        if "thermal" in f:
+            lacking += [f"thermal/{n}" for n in ("scalars_json", "arrays") if n not in f["thermal"]]
         if lacking:
             raise ConfigError(f"{damaged}: it has no {', '.join(lacking)}")
         try:
