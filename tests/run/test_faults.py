@@ -392,3 +392,14 @@ def test_walls_vtu_without_walls_reads_back(tmp_path: Path) -> None:
     mesh = read_vtu(path)
     assert mesh.points.shape == (0, 3) and mesh.cells[0].type == "triangle"
     assert set(mesh.cell_data) == {"wall_id", "t"}
+
+
+def test_a_broken_pvd_index_is_refused_before_the_restart_touches_anything(
+    tmp_path: Path, finished: Path
+) -> None:
+    out = _copy(finished, tmp_path / "out")
+    (out / "particles.pvd").write_text("<VTKFile type='Collection'><Collection>")  # cut off
+    before = _snapshot(out)
+    result = _invoke("restart", str(out), "--end-time", "0.0003", "--no-progress")
+    assert result.exit_code == 2 and "particles.pvd cannot be read" in result.output
+    assert _snapshot(out) == before

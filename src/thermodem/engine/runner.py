@@ -485,6 +485,15 @@ def restart_run(
     sim = _restored(ckpt, threads, case)
     check_resources(estimate_resources(sim, threads))  # refuses before anything is written
     series_repair = _timeseries_repair(output / TIMESERIES_FILE)
+    for pvd in ("particles.pvd", "walls.pvd"):
+        if (output / pvd).exists():
+            try:
+                PVDWriter.read(output / pvd)
+            except (ValueError, OSError, SyntaxError) as exc:  # ParseError: a SyntaxError
+                raise ConfigError(
+                    f"{output / pvd} cannot be read ({exc}); restart refused, nothing was "
+                    "changed: repair or delete it"
+                ) from None
     # nothing above wrote to the directory
     lock = _RunLock(output)
     lock.acquire()
@@ -635,7 +644,11 @@ def _refuse_if_busy(output: Path, what: str) -> None:
     pid = previous.get("pid")
     if previous.get("status") == "running" and pid and pid != os.getpid() and _alive(pid):
         if previous.get("host") in (None, socket.gethostname()):
-            raise ConfigError(f"{output} is still being written by a running process (pid {pid})")
+            raise ConfigError(
+                f"{output} is still being written by a running process (pid {pid}, according "
+                f"to its status.json); {what} refused (if pid {pid} is not a thermodem run, "
+                f"delete {output / STATUS_FILE})"
+            )
 
 
 class _RunLock:
