@@ -814,6 +814,21 @@ def test_given_particles_inside_the_domain_and_not_coincident(tmp_path):
     with pytest.raises(ConfigError, match=r"positions.1: .* overlaps .*by 0.3 of the smaller"):
         insert(deep, None, None, None)
     assert len(insert(deep, None, None, None, max_overlap_ratio=0.35)) == 2
+    # overlap_check: false takes deep overlaps, even a small sphere inside a large one ...
+    inside = list_entry(
+        positions=[(0.004, 0.005, 0.005), (0.0042, 0.005, 0.005)],
+        radius=None,
+        radii=[0.002, 0.0005],
+        overlap_check=False,
+    )
+    assert len(insert(inside, None, None, None)) == 2
+    # ... but never coincident centres
+    same = list_entry(positions=[(0.004, 0.005, 0.005)] * 2, overlap_check=False)
+    with pytest.raises(ConfigError, match=r"same position .*even with overlap_check: false"):
+        insert(same, None, None, None)
+    with pytest.raises(ConfigError, match=r"same position"):
+        insert(list_entry(positions=[(0.004, 0.005, 0.005)], overlap_check=False), None,
+               np.array([[0.004, 0.005, 0.005]]), np.array([0.003]))  # fmt: skip
     # against the particles of an earlier entry
     with pytest.raises(ConfigError, match=r"earlier insertion entry at \[0.004, 0.005, 0.005\]"):
         insert(list_entry(positions=[(0.0041, 0.005, 0.005)]), None,

@@ -518,6 +518,12 @@ class FileInsertion(_EntryBase):
 
     kind: Literal["file"] = "file"
     path: Path = Field(description="path of the particle file")
+    overlap_check: bool = Field(
+        default=True,
+        description="false: given particles may overlap deeply (the run still stops at its "
+        "first step when an overlap exceeds simulation.max_overlap_ratio); coincident "
+        "particles and centres outside the domain are refused regardless",
+    )
 
 
 PositiveTemperature = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -543,6 +549,12 @@ class ListInsertion(_EntryBase):
     velocities: list[Vec3] | None = Field(default=None, description="one velocity each [m/s]")
     temperatures: list[PositiveTemperature] | None = Field(
         default=None, description="one temperature each [K]"
+    )
+    overlap_check: bool = Field(
+        default=True,
+        description="false: given particles may overlap deeply (the run still stops at its "
+        "first step when an overlap exceeds simulation.max_overlap_ratio); coincident "
+        "particles and centres outside the domain are refused regardless",
     )
 
     @model_validator(mode="after")

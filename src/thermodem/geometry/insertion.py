@@ -56,6 +56,11 @@ RSA_MAX_FRACTION = 0.5
 #: particles (file, list) when the caller does not pass the case's value.
 DEFAULT_MAX_OVERLAP_RATIO = 0.2
 
+#: Two given particles whose centres are closer than this fraction of the larger radius are
+#: coincident: refused even with ``overlap_check: false``, since such a pair never interacts
+#: (it has no contact normal).
+COINCIDENT_DISTANCE = 1e-9
+
 WallsOk = Callable[[np.ndarray, np.ndarray], np.ndarray]
 """Predicate ``walls_ok(positions (n, 3), radii (n,)) -> bool (n,)``: True where a sphere is
 acceptable (e.g. it does not cut through a wall). Candidates for which it is False are rejected.
@@ -511,7 +516,14 @@ def _check_given(
                 f"[{_vec(lower)}, {_vec(upper)}] ({bad.size} of {len(p)} particles are); move "
                 "the particles or enlarge domain"
             )
-    found = _deepest_overlap(p.position, p.radius, limit, existing_positions, existing_radii)
+    found = _deepest_overlap(
+        p.position,
+        p.radius,
+        limit,
+        existing_positions,
+        existing_radii,
+        coincident_only=not entry.overlap_check,
+    )
     if found is None:
         return
     i, j, ratio, other_entry = found
@@ -524,17 +536,21 @@ def _check_given(
         other_pos, other_rad = p.position[j], float(p.radius[j])
         other = f"the particle of {given.where(j)}" if sep != "." else f"{key}.{given.where(j)}"
     distance = float(np.linalg.norm(p.position[i] - other_pos))
-    if distance <= 1e-9 * min(float(p.radius[i]), other_rad):
+    if distance <= COINCIDENT_DISTANCE * max(float(p.radius[i]), other_rad):
         what = f"is at the same position as {other} (a duplicate row?)"
     else:
         what = (
             f"overlaps {other} by {ratio:.3g} of the smaller radius (centres {distance:.6g} m "
             "apart)"
         )
+    rule = (
+        f"given particles may overlap by at most simulation.max_overlap_ratio = {limit:g} of the "
+        "smaller radius (two coincident particles never interact)"
+        if entry.overlap_check
+        else "coincident particles are refused even with overlap_check: false (they never interact)"
+    )
     raise ConfigError(
-        f"{at(i)}: the particle at {_vec(p.position[i])} {what}; given particles may overlap by "
-        f"at most simulation.max_overlap_ratio = {limit:g} of the smaller radius (two "
-        "coincident particles never interact); remove or move one of them"
+        f"{at(i)}: the particle at {_vec(p.position[i])} {what}; {rule}; remove or move one of them"
     )
 
 
@@ -544,9 +560,11 @@ def _deepest_overlap(
     limit: float,
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
+    coincident_only: bool = False,
 ) -> tuple[int, int, float, bool] | None:
     """The first pair (in the order given) whose overlap exceeds ``limit`` × the smaller
-    radius: (i, j, overlap ratio, j is an existing particle), or None.
+    radius (``coincident_only``: whose centres are within :data:`COINCIDENT_DISTANCE` × the
+    larger radius): (i, j, overlap ratio, j is an existing particle), or None.
 
     Pairs come from a k-d tree (scipy.spatial.cKDTree) within ``r_i + r_max``: O(n log n).
     """
@@ -555,31 +573,42 @@ def _deepest_overlap(
     n = rad.shape[0]
     if n == 0:
         return None
+
+    def bad_pairs(pa, ra, pb, rb):  # noqa: ANN001, ANN202
+        if coincident_only:
+            d = np.sqrt(np.einsum("ij,ij->i", pa - pb, pa - pb))
+            return d <= COINCIDENT_DISTANCE * np.maximum(ra, rb)
+        return _overlap_ratio(pa, ra, pb, rb) > limit
+
     tree = cKDTree(pos)
     candidates: list[tuple[int, int, float, bool]] = []
+    reach = float(rad.max())
     if n > 1:
-        pairs = tree.query_pairs(2.0 * float(rad.max()), output_type="ndarray")
+        cut = COINCIDENT_DISTANCE * reach if coincident_only else 2.0 * reach
+        pairs = tree.query_pairs(cut, output_type="ndarray")
         if pairs.size:
             a, b = pairs[:, 0], pairs[:, 1]
-            ratio = _overlap_ratio(pos[a], rad[a], pos[b], rad[b])
-            bad = np.flatnonzero(ratio > limit)
+            bad = np.flatnonzero(bad_pairs(pos[a], rad[a], pos[b], rad[b]))
             if bad.size:
                 late = np.maximum(a[bad], b[bad])
                 k = bad[np.lexsort((np.minimum(a[bad], b[bad]), late))[0]]
                 i, j = max(int(a[k]), int(b[k])), min(int(a[k]), int(b[k]))
-                candidates.append((i, j, float(ratio[k]), False))
+                ratio = float(_overlap_ratio(pos[[i]], rad[[i]], pos[[j]], rad[[j]])[0])
+                candidates.append((i, j, ratio, False))
     if existing_positions is not None and existing_radii is not None and len(existing_radii):
         ex_pos = np.asarray(existing_positions, dtype=np.float64).reshape(-1, 3)
         ex_rad = np.asarray(existing_radii, dtype=np.float64).reshape(-1)
-        reach = float(rad.max()) + float(ex_rad.max())
-        m = tree.sparse_distance_matrix(cKDTree(ex_pos), reach, output_type="ndarray")
+        reach = max(reach, float(ex_rad.max()))
+        cut = COINCIDENT_DISTANCE * reach if coincident_only else float(rad.max() + ex_rad.max())
+        m = tree.sparse_distance_matrix(cKDTree(ex_pos), cut, output_type="ndarray")
         if m.size:
             a, b = m["i"].astype(np.int64), m["j"].astype(np.int64)
-            ratio = _overlap_ratio(pos[a], rad[a], ex_pos[b], ex_rad[b])
-            bad = np.flatnonzero(ratio > limit)
+            bad = np.flatnonzero(bad_pairs(pos[a], rad[a], ex_pos[b], ex_rad[b]))
             if bad.size:
                 k = bad[np.argmin(a[bad])]
-                candidates.append((int(a[k]), int(b[k]), float(ratio[k]), True))
+                i, j = int(a[k]), int(b[k])
+                ratio = float(_overlap_ratio(pos[[i]], rad[[i]], ex_pos[[j]], ex_rad[[j]])[0])
+                candidates.append((i, j, ratio, True))
     if not candidates:
         return None
     return min(candidates, key=lambda c: c[0])
