@@ -403,3 +403,34 @@ def test_a_broken_pvd_index_is_refused_before_the_restart_touches_anything(
     result = _invoke("restart", str(out), "--end-time", "0.0003", "--no-progress")
     assert result.exit_code == 2 and "particles.pvd cannot be read" in result.output
     assert _snapshot(out) == before
+
+
+def test_read_vtu_keeps_the_field_data_of_an_empty_frame(tmp_path: Path) -> None:
+    """Name tables stored as FieldData (ascii Int32 arrays, one per name) come back for an
+    empty frame as meshio gives them for a non-empty one."""
+    table = (
+        '<FieldData><DataArray type="Int32" Name="material_id 0 = glass" NumberOfTuples="1" '
+        'format="ascii">0</DataArray><DataArray type="Int32" Name="material_id 1 = steel" '
+        'NumberOfTuples="1" format="ascii">1</DataArray></FieldData>'
+    )
+    meshes = []
+    for n in (0, 2):
+        path = tmp_path / f"p{n}.vtu"
+        write_particles_vtu(path, np.zeros((n, 3)), {"radius": np.ones(n)})
+        text = path.read_text().replace("<UnstructuredGrid>", "<UnstructuredGrid>" + table, 1)
+        path.write_text(text)
+        meshes.append(read_vtu(path))
+    empty, full = meshes
+    assert (
+        empty.field_data.keys()
+        == full.field_data.keys()
+        == {
+            "material_id 0 = glass",
+            "material_id 1 = steel",
+        }
+    )
+    for key, value in full.field_data.items():
+        assert (
+            np.array_equal(empty.field_data[key], value)
+            and empty.field_data[key].dtype == value.dtype
+        )

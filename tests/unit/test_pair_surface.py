@@ -12,6 +12,7 @@ from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import ConfigError
 from thermodem.models import registry
+from thermodem.models.tables import pair_table
 from thermodem.models.thermal import resistance_network as rn
 from thermodem.state.gas import GasProperties
 from thermodem.state.materials import InteractionOverride, Material, resolve_pair
@@ -66,11 +67,12 @@ PAIR = {"materials": ["glass", "glass"], "surface_roughness": SIGMA, "surface_sl
 def test_pair_roughness_and_slope_from_an_interaction_reach_the_network():
     """Materials without σ and τ: the interactions entry's equivalent values are the row's σ, τ
     (not √2 × them, which the material rule would give), and a thermal step conducts."""
-    sim = Simulation(case_from_dict(_two_spheres([PAIR])))
-    row = sim.thermal.conduction_table[0, 0]
+    case = case_from_dict(_two_spheres([PAIR]))
+    row = pair_table(case.thermal.direct_conduction, case, list(case.materials))[0, 0]
     assert (row[7], row[8]) == (SIGMA, TAU)
     pr = 1.85e-5 * 1006.0 / 0.027
     assert row[10] == pytest.approx(2.0 * (2.0 - ALPHA) / ALPHA * 68e-9 / pr, rel=1e-15)
+    sim = Simulation(case)
     sim.run(steps=1)
     q = sim.particles.heat_rate
     assert np.all(np.isfinite(q)) and q.max() > 0 and q.sum() == pytest.approx(0.0, abs=1e-12)

@@ -341,6 +341,29 @@ _VTK_DTYPES = {
 }
 
 
+def _field_data(root: ET.Element) -> dict[str, np.ndarray]:
+    """The FieldData arrays of an uncompressed VTU (ascii or base64 binary), as meshio
+    returns them; {} for a compressed file (not written by default)."""
+    import base64
+
+    if root.get("compressor"):
+        return {}
+    header = np.dtype(_VTK_DTYPES[root.get("header_type", "UInt32")]).newbyteorder("<")
+    out: dict[str, np.ndarray] = {}
+    for da in root.iterfind("UnstructuredGrid/FieldData/DataArray"):
+        dtype = np.dtype(_VTK_DTYPES.get(da.get("type", "Float64"), np.float64))
+        text = (da.text or "").strip()
+        if da.get("format") == "ascii":
+            values = np.array(text.split(), dtype=dtype)
+        else:
+            raw = base64.b64decode(text)
+            nbytes = int(np.frombuffer(raw[: header.itemsize], header)[0])
+            values = np.frombuffer(raw[header.itemsize : header.itemsize + nbytes], dtype).copy()
+        k = int(da.get("NumberOfComponents", "1"))
+        out[da.get("Name", "")] = values.reshape(-1, k) if k > 1 else values
+    return out
+
+
 def read_vtu(path: str | os.PathLike[str]) -> meshio.Mesh:
     """Read a VTU written here, including an empty frame (no particles yet, or none left).
 
@@ -348,8 +371,9 @@ def read_vtu(path: str | os.PathLike[str]) -> meshio.Mesh:
     ``vtkXMLUnstructuredGridReader`` reads it with its arrays), but meshio 5.3's VTU reader
     fails on any file without cells (IndexError, meshio issue #1412). For such a file this
     returns a mesh with no points, one empty cell block (``triangle`` for a walls file, which
-    has cell data, else ``vertex``) and every point and cell array, empty, with its dtype and
-    number of components; other files go to :func:`meshio.read`.
+    has cell data, else ``vertex``), every point and cell array, empty, with its dtype and
+    number of components, and the field data (name tables); other files go to
+    :func:`meshio.read`.
     """
     p = Path(path)
     root = ET.parse(p).getroot()
@@ -366,6 +390,7 @@ def read_vtu(path: str | os.PathLike[str]) -> meshio.Mesh:
         return out
 
     cell_data = {name: [value] for name, value in empty("CellData").items()}
+    field_data = _field_data(root)
     points = np.zeros((int(piece.get("NumberOfPoints", "0")), 3))
     if points.shape[0]:  # points but no cells: not something written here
         return meshio.read(p)
@@ -376,7 +401,13 @@ def read_vtu(path: str | os.PathLike[str]) -> meshio.Mesh:
         if cell_data
         else ("vertex", np.zeros((0, 1), np.int64))
     )
-    return meshio.Mesh(points, [block], point_data=empty("PointData"), cell_data=cell_data or None)
+    return meshio.Mesh(
+        points,
+        [block],
+        point_data=empty("PointData"),
+        cell_data=cell_data or None,
+        field_data=field_data,
+    )
 
 
 # --------------------------------------------------------------------------------------------
