@@ -53,6 +53,30 @@ def _fail(message: str, code: int) -> None:
     raise typer.Exit(code)
 
 
+def _threads(requested: int | None) -> int | None:
+    """``--threads`` above the cores this process may use is clamped, with a message (Numba
+    refuses more threads than ``NUMBA_NUM_THREADS``, which defaults to the core count)."""
+    if requested is None:
+        return None
+    import os
+
+    import numba
+
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        cores = os.cpu_count() or 1
+    limit = max(1, min(cores, int(numba.config.NUMBA_NUM_THREADS)))
+    if requested > limit:
+        typer.echo(
+            f"warning: --threads {requested} is more than the {limit} core(s) this process can "
+            f"use; using {limit}",
+            err=True,
+        )
+        return limit
+    return requested
+
+
 def _guarded(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
     """Map thermodem's exceptions to messages and exit codes (never a traceback)."""
     try:
@@ -89,6 +113,8 @@ def run(
     """Run a case: VTU/PVD frames, timeseries.csv, checkpoints, run.log, status.json."""
     from thermodem.config.load import load_case
     from thermodem.engine.runner import run_case, run_from_checkpoint
+
+    threads = _threads(threads)
 
     def go() -> None:
         if case is None and restart is None:
@@ -174,7 +200,7 @@ def restart(
     _guarded(
         restart_run,
         directory,
-        threads,
+        _threads(threads),
         end_time=end_time,
         progress=progress,
         log_interval=log_interval,
@@ -205,7 +231,7 @@ def validate(
     from thermodem.engine.validation import gas_note, validate_case
 
     _announce_compile(case)
-    result = _guarded(validate_case, case, threads)
+    result = _guarded(validate_case, case, _threads(threads))
     for w in result.warnings:
         typer.echo(f"warning: {w}", err=True)
     typer.echo(f"# {case}: valid (schema, completeness, time step, resources)")

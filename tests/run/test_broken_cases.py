@@ -51,6 +51,34 @@ def _file(directory: Path, name: str, content: bytes) -> Path:
     return path
 
 
+def _big_vector(directory: Path) -> Path:
+    """A case whose gravity is a 50 MB vector (refused by its size, before YAML parses it)."""
+    path = directory / "big.yaml"
+    with path.open("w") as f:
+        f.write("simulation: {time_step: 1.0e-5, end_time: 0.001, gravity: [")
+        chunk = "0.0, " * 100_000
+        while f.tell() < 50_000_000:
+            f.write(chunk)
+        f.write("0.0]}\n")
+    return path
+
+
+def test_aliases_within_the_limit_still_work(tmp_path: Path) -> None:
+    """Anchors and aliases that repeat a material are fine; only the expansion is bounded."""
+    from thermodem.config.load import load_case
+
+    path = _file(
+        tmp_path,
+        "alias.yaml",
+        b"simulation: {time_step: 1.0e-5, end_time: 0.001}\n"
+        b"domain: {lower: [0, 0, 0], upper: [0.01, 0.01, 0.01]}\n"
+        b"materials:\n  glass: &g {density: 2500, youngs_modulus: 1.0e7, poisson_ratio: 0.3}\n"
+        b"  steel: *g\n",
+    )
+    case = load_case(path)
+    assert case.materials["steel"] == case.materials["glass"]
+
+
 @pytest.mark.parametrize(
     ("make", "expected"),
     [
@@ -59,8 +87,9 @@ def _file(directory: Path, name: str, content: bytes) -> Path:
         (lambda d: _file(d, "empty.yaml", b""), "is empty"),
         (lambda d: _file(d, "blank.yaml", b"\n  \n# only a comment\n"), "is empty"),
         (lambda d: _file(d, "binary.yaml", b"\xff\xfe\x00x"), "not UTF-8"),
+        (lambda d: _big_vector(d), "is 50 MB; a case file may have at most 5 MB"),
     ],
-    ids=["missing", "directory", "empty", "blank", "binary"],
+    ids=["missing", "directory", "empty", "blank", "binary", "50MB-vector"],
 )
 def test_bad_files_give_one_line(tmp_path: Path, make, expected: str) -> None:  # noqa: ANN001
     path = make(tmp_path)

@@ -306,3 +306,56 @@ def test_restore_with_another_time_step_keeps_the_time(tmp_path: Path) -> None:
     odd["simulation"]["time_step"] = 3.0e-6
     with pytest.raises(ConfigError, match="not a whole number of steps"):
         Simulation.from_checkpoint(path, case=case_from_dict(odd))
+
+
+@pytest.fixture(scope="module")
+def good_checkpoint(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    sim = Simulation(case_from_dict(periodic_thermal_case()))
+    sim.run(steps=3)
+    assert sim.pairs.count > 0
+    return write_checkpoint(sim, tmp_path_factory.mktemp("ckpt") / "good.h5")
+
+
+def _damaged(src: Path, dst: Path, change) -> Path:  # noqa: ANN001
+    import h5py
+
+    dst.write_bytes(src.read_bytes())
+    with h5py.File(dst, "a") as f:
+        change(f)
+    return dst
+
+
+def _replace(f, name: str, value) -> None:  # noqa: ANN001
+    import h5py
+
+    del f[name]
+    dtype = h5py.string_dtype() if isinstance(value, str) else None
+    f.create_dataset(name, data=value, dtype=dtype)
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (lambda f: f.attrs.__delitem__("kind"), "attribute(s) kind missing"),
+        (lambda f: f.__delitem__("walls"), "it has no walls"),
+        (lambda f: _replace(f, "scalars_json", "{not json"), "scalars are not valid JSON"),
+        (lambda f: _replace(f, "case_yaml", "a: [1,"), "stored case is not valid YAML"),
+        (lambda f: _replace(f, "case_yaml", "- just\n- a list\n"), "not a mapping of sections"),
+        (lambda f: _replace(f, "scalars_json", '{"time": 0.0}'), "scalar(s) step_count"),
+        (lambda f: _replace(f, "particles/velocity", np.zeros((3, 3))), "'velocity' has shape"),
+        (lambda f: _replace(f, "pairs/history", np.zeros((0, 6))), "'history' has 0 rows"),
+        (lambda f: _replace(f, "pairs/group_start", np.array([0, 5, 2])), "out of order"),
+        (lambda f: f.__delitem__("thermal/arrays"), "it has no thermal/arrays"),
+    ],
+    ids=["attr", "group", "json", "yaml", "yaml-list", "scalar", "short", "pairs", "groups",
+         "thermal"],
+)  # fmt: skip
+def test_damaged_checkpoints_are_refused_when_read(
+    tmp_path: Path, good_checkpoint: Path, change, expected
+) -> None:
+    """Every kind of damage is one ConfigError naming the file (before anything is built)."""
+    read_checkpoint(good_checkpoint)  # the undamaged file passes
+    bad = _damaged(good_checkpoint, tmp_path / "bad.h5", change)
+    with pytest.raises(ConfigError, match="damaged or incomplete") as err:
+        read_checkpoint(bad)
+    assert expected in str(err.value) and str(bad) in str(err.value)

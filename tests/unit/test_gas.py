@@ -56,8 +56,8 @@ def test_mean_free_path_from_kinetic_theory_by_hand():
     [
         ({"thermal_conductivity": 0.0}, "thermal.gas.thermal_conductivity: Input should be "
          "greater than 0 (got 0.0)"),
-        ({"heat_capacity_ratio": 1.0}, "thermal.gas.heat_capacity_ratio: Input should be greater "
-         "than 1 (got 1.0)"),
+        ({"heat_capacity_ratio": 0.99}, "thermal.gas.heat_capacity_ratio: Input should be "
+         "greater than or equal to 1 (got 0.99)"),
         ({"pressure": -1.0}, "thermal.gas.pressure: Input should be greater than 0 (got -1.0)"),
         ({"mean_free_path": 1e-7, "temperature": 400.0}, "thermal.gas: give either "
          "mean_free_path or pressure, temperature and molecular_diameter (from which it is "

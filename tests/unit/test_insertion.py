@@ -22,6 +22,7 @@ from thermodem.config.insertion import (
     DiscreteRadius,
     FileInsertion,
     LatticeInsertion,
+    ListInsertion,
     LognormalRadius,
     MonoRadius,
     PourInsertion,
@@ -31,6 +32,7 @@ from thermodem.config.insertion import (
     UniformRadius,
     parse_insertion_section,
 )
+from thermodem.errors import ConfigError
 from thermodem.geometry.insertion import (
     InsertedParticles,
     Pourer,
@@ -419,8 +421,10 @@ def test_random_cylinder_tilted_axis():
 
 
 def test_random_insertion_too_many_particles_raises():
-    entry = random_box(distribution={"kind": "mono", "radius": 0.1}, count=1000, max_attempts=50)
-    with pytest.raises(ValueError, match=r"placed only \d+ of 1000 particles.*larger region"):
+    # 110 spheres of r = 0.1 fill 0.46 of the unit box: allowed, but random sequential
+    # addition jams below that (0.38 for equal spheres, less against walls)
+    entry = random_box(distribution={"kind": "mono", "radius": 0.1}, count=110, max_attempts=50)
+    with pytest.raises(ValueError, match=r"placed only \d+ of 110 particles.*larger region"):
         insert(entry, np.random.default_rng(14), None, None)
     too_big = random_box(distribution={"kind": "mono", "radius": 0.6}, count=1)
     with pytest.raises(ValueError, match="does not fit"):
@@ -637,7 +641,7 @@ def test_file_csv_any_column_order_comments_and_defaults(tmp_path):
         ("x y z radius\n0 nan 0 1e-3\n", r"line 2, column 'y'.*not finite"),
         ("x y radius\n0 0 1e-3\n", r"line 1: the header lacks required column\(s\) z"),
         ("x y z radius colour\n0 0 0 1 2\n", r"line 1: unknown column 'colour'.*allowed"),
-        ("0 0 0 1e-3\n", r"line 1: unknown column '0'.*header"),
+        ("0 0 0 1e-3\n", r"line 1: no header.*starts with the number '0'"),
         ("x y z radius vx vy\n0 0 0 1e-3 0 0\n", r"line 1: give all of vx, vy, vz"),
         ("x y z radius temperature\n0 0 0 1e-3 300\n0 0 0 1e-3 0\n", r"line 3.*temperature"),
         ("\n\n", r"is empty"),
@@ -659,6 +663,209 @@ def test_missing_file_and_walls_ok_rejection(tmp_path):
     entry = FileInsertion(material="a", path=path)
     with pytest.raises(ValueError, match="1 particle.*line 3"):
         insert(entry, None, None, None, walls_ok=lambda x, r: x[:, 2] - r >= -0.5)
+
+
+BED_HEADER = "# x y z r ; box 0.09 0.09 0.054959948092\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "radius", "temperature"),
+    [
+        # LIGGGHTS/Yade-style: a comment after the names on the header line
+        (BED_HEADER + "1e-3 2e-3 3e-3 0.001\n4e-3 5e-3 6e-3 0.002\n", [0.001, 0.002], None),
+        ("# written by another code\n# X Y Z R\n1e-3 2e-3 3e-3 0.001\n4e-3 5e-3 6e-3 0.002\n",
+         [0.001, 0.002], None),
+        ("x[m] y[m] z[m] rad (m)\n1e-3 2e-3 3e-3 0.001 # first\n4e-3 5e-3 6e-3 0.002\n",
+         [0.001, 0.002], None),
+        ("x,y,z,diameter,T\n1e-3,2e-3,3e-3,0.002,300\n4e-3,5e-3,6e-3,0.004,310\n",
+         [0.001, 0.002], [300.0, 310.0]),
+        ("x y z d temp\n1e-3 2e-3 3e-3 0.002 300\n4e-3 5e-3 6e-3 0.004 310\n",
+         [0.001, 0.002], [300.0, 310.0]),
+    ],
+    ids=["bed-header-comment", "comment-before-header", "units-and-inline-comment",
+         "diameter-csv", "d-temp"],
+)  # fmt: skip
+def test_file_aliases_and_header_comments(tmp_path, text, radius, temperature):
+    """Headers other codes write: r/rad, diameter/d (radius = d/2), T/temp, units in brackets,
+    text after ';' or '#', comment lines before the header; fast and checked parsers agree."""
+    from thermodem.io.particle_file import _parse_checked, _parse_fast
+
+    path = tmp_path / "bed.txt"
+    path.write_text(text)
+    fast, checked = _parse_fast(path, "g"), _parse_checked(path, "g")
+    assert fast is not None
+    for parsed in (fast, checked):
+        np.testing.assert_array_equal(
+            parsed.particles.position, [[1e-3, 2e-3, 3e-3], [4e-3, 5e-3, 6e-3]]
+        )
+        np.testing.assert_array_equal(parsed.particles.radius, radius)
+        if temperature is None:
+            assert parsed.particles.temperature is None
+        else:
+            np.testing.assert_array_equal(parsed.particles.temperature, temperature)
+    np.testing.assert_array_equal(fast.line_numbers, checked.line_numbers)
+
+
+def test_the_shared_bed_file_loads():
+    """The first lines of ../shared/beds/bed50k.txt (a LIGGGHTS bed), as users load it."""
+    from pathlib import Path
+
+    bed = Path("/work/shared/beds/bed50k.txt")
+    if not bed.exists():
+        pytest.skip("the shared bed is not on this machine")
+    p = load_particle_file(bed)
+    assert len(p) == 50000 and np.all(p.radius == 0.001)
+    assert np.all(p.position >= 0.0) and np.all(p.position[:, :2] <= 0.09)
+
+
+@pytest.mark.parametrize(
+    ("content", "pattern"),
+    [
+        ("x y z r radius\n0 0 0 1 1\n", r"line 1: column\(s\) \['radius'\] appear twice"),
+        ("x y z r d\n0 0 0 1 1\n", r"line 1: give the radius or the diameter, not both"),
+        ("# x y z r\n", r"has a header \(line 1\) but no particle rows"),
+        ("# generated\n1 2 3 4\n", r"line 1: unknown column 'generated'"),
+        ("x y z r\n0 0 0 \xe9\n", r"line 2, column 'r': '\xe9' is not a number"),
+    ],
+)
+def test_more_bad_files(tmp_path, content, pattern):
+    path = tmp_path / "bad.txt"
+    path.write_text(content, encoding="utf-8")
+    with pytest.raises(ValueError, match=pattern):
+        load_particle_file(path)
+
+
+def test_not_utf8_and_directory(tmp_path):
+    path = tmp_path / "latin1.txt"
+    path.write_bytes("x y z r\n0 0 0 1\n# caf\u00e9\n".encode("latin-1"))
+    with pytest.raises(ValueError, match=r"latin1.txt', line 3: not UTF-8 text \(byte 0xe9"):
+        load_particle_file(path)
+    with pytest.raises(ValueError, match="is a directory"):
+        load_particle_file(tmp_path)
+
+
+DOMAIN = (np.zeros(3), np.full(3, 0.01))
+
+
+def list_entry(**kw) -> ListInsertion:
+    base = dict(material="glass", positions=[(0.005, 0.005, 0.002)], radius=0.001)
+    base.update(kw)
+    return ListInsertion(**base)
+
+
+def test_list_of_one_two_and_ten_particles():
+    one = insert(list_entry(velocity=(0, 0, -1), temperature=350), None, None, None)
+    np.testing.assert_array_equal(one.position, [[0.005, 0.005, 0.002]])
+    np.testing.assert_array_equal(one.velocity, [[0, 0, -1]])
+    np.testing.assert_array_equal(one.temperature, [350.0])
+    two = insert(
+        list_entry(
+            positions=[(0.004, 0.005, 0.005), (0.006, 0.005, 0.005)],
+            radius=None,
+            radii=[0.001, 0.0009],
+            velocities=[(1, 0, 0), (-1, 0, 0)],
+            temperatures=[300, 400],
+        ),
+        None, None, None, domain=DOMAIN,
+    )  # fmt: skip
+    np.testing.assert_array_equal(two.radius, [0.001, 0.0009])
+    np.testing.assert_array_equal(two.velocity, [[1, 0, 0], [-1, 0, 0]])
+    np.testing.assert_array_equal(two.temperature, [300.0, 400.0])
+    line = [(0.0005 + 0.001 * k, 0.005, 0.005) for k in range(10)]  # touching neighbours
+    ten = insert(list_entry(positions=line, radius=0.0005), None, None, None, domain=DOMAIN)
+    assert len(ten) == 10 and ten.temperature is None
+    np.testing.assert_array_equal(ten.velocity, np.zeros((10, 3)))
+
+
+@pytest.mark.parametrize(
+    ("kw", "pattern"),
+    [
+        (dict(radius=None), r"radius: give exactly one of 'radius'"),
+        (dict(radii=[0.001]), r"radius: give exactly one"),
+        (dict(radius=None, radii=[0.001, 0.001]), r"radii: 2 value\(s\) for 1 position"),
+        (dict(velocities=[(0, 0, 0)] * 2), r"velocities: 2 value\(s\) for 1 position"),
+        (dict(velocities=[(0, 0, 0)], velocity=(1, 0, 0)), r"velocities: give 'velocity'"),
+        (dict(temperatures=[300], temperature=300), r"temperatures: give 'temperature'"),
+        (dict(temperatures=[0]), r"greater than 0"),
+        (dict(positions=[(0, 0, float("inf"))]), r"finite"),
+        (dict(positions=[]), r"at least 1"),
+    ],
+)
+def test_list_validation(kw, pattern):
+    with pytest.raises(ValidationError, match=pattern):
+        list_entry(**kw)
+
+
+def test_given_particles_inside_the_domain_and_not_coincident(tmp_path):
+    outside = list_entry(positions=[(0.005, 0.005, 0.002), (0.005, 0.005, 0.0101)])
+    with pytest.raises(
+        ConfigError,
+        match=r"^insertion.3.positions.1: particle centre .* "
+        r"outside the domain",
+    ):
+        insert(outside, None, None, None, key="insertion.3", domain=DOMAIN)
+    dup = list_entry(positions=[(0.002, 0.002, 0.002), (0.006, 0.006, 0.006)] * 2)
+    with pytest.raises(
+        ConfigError, match=r"positions.2: .* same position as insertion.positions.0"
+    ):
+        insert(dup, None, None, None)
+    # an overlap of 0.3 r is refused at the default limit 0.2 and accepted at 0.35
+    deep = list_entry(positions=[(0.004, 0.005, 0.005), (0.0057, 0.005, 0.005)])
+    with pytest.raises(ConfigError, match=r"positions.1: .* overlaps .*by 0.3 of the smaller"):
+        insert(deep, None, None, None)
+    assert len(insert(deep, None, None, None, max_overlap_ratio=0.35)) == 2
+    # overlap_check: false takes deep overlaps, even a small sphere inside a large one ...
+    inside = list_entry(
+        positions=[(0.004, 0.005, 0.005), (0.0042, 0.005, 0.005)],
+        radius=None,
+        radii=[0.002, 0.0005],
+        overlap_check=False,
+    )
+    assert len(insert(inside, None, None, None)) == 2
+    # ... but never coincident centres
+    same = list_entry(positions=[(0.004, 0.005, 0.005)] * 2, overlap_check=False)
+    with pytest.raises(ConfigError, match=r"same position .*even with overlap_check: false"):
+        insert(same, None, None, None)
+    with pytest.raises(ConfigError, match=r"same position"):
+        insert(list_entry(positions=[(0.004, 0.005, 0.005)], overlap_check=False), None,
+               np.array([[0.004, 0.005, 0.005]]), np.array([0.003]))  # fmt: skip
+    # against the particles of an earlier entry
+    with pytest.raises(ConfigError, match=r"earlier insertion entry at \[0.004, 0.005, 0.005\]"):
+        insert(list_entry(positions=[(0.0041, 0.005, 0.005)]), None,
+               np.array([[0.004, 0.005, 0.005]]), np.array([0.001]))  # fmt: skip
+    # a duplicate row of a file names both lines
+    path = tmp_path / "bed.txt"
+    path.write_text("# x y z r\n0.002 0.002 0.002 0.001\n0.005 0.005 0.002 0.001\n"
+                    "0.002 0.002 0.002 0.001\n")  # fmt: skip
+    with pytest.raises(
+        ConfigError,
+        match=r"insertion.0.path: .*bed.txt', line 4: .* same "
+        r"position as the particle of .*bed.txt', line 2",
+    ):
+        insert(FileInsertion(material="g", path=path), None, None, None, key="insertion.0")
+
+
+def test_overlap_search_equals_brute_force():
+    """The k-d tree search finds the first too-deep pair that an O(n²) loop finds."""
+    from thermodem.geometry.insertion import _deepest_overlap
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        n = 60
+        pos = rng.uniform(0, 0.02, (n, 3))
+        rad = rng.uniform(0.0005, 0.0015, n)
+        limit = 0.3
+        brute = None
+        for i in range(n):
+            for j in range(i):
+                d = np.linalg.norm(pos[i] - pos[j])
+                if (rad[i] + rad[j] - d) / min(rad[i], rad[j]) > limit:
+                    brute = (i, j)
+                    break
+            if brute:
+                break
+        found = _deepest_overlap(pos, rad, limit, None, None)
+        assert (found[:2] if found else None) == brute
 
 
 # --------------------------------------------------------------------------------------------
@@ -782,3 +989,28 @@ def test_pour_does_nothing_before_start():
 def test_box_region_validation():
     with pytest.raises(ValidationError, match="on the x axis lower=2.0 and upper=1.0"):
         BoxRegion(lower=(2, 0, 0), upper=(1, 1, 1))
+
+
+def test_a_pour_batch_tries_at_most_what_half_the_region_holds():
+    """rate × interval = 1e6 particles for a box that holds 119 at half its volume: the batch
+    tries 119 (the work is bounded), the rest are skipped and counted."""
+    import time
+
+    entry = pour_entry(
+        region={"kind": "box", "lower": (0, 0, 0), "upper": (0.01, 0.01, 0.01)},
+        distribution={"kind": "mono", "radius": 0.001},
+        rate=1e9,
+        start_time=0.0,
+        end_time=None,
+        interval=0.001,
+    )
+    pourer = Pourer(entry, np.random.default_rng(46))
+    assert pourer.batch_cap == int(0.5 * 1e-6 / (4.0 / 3.0 * math.pi * 1e-9))
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        new = pourer.emit(0.001, None, None)
+    assert time.perf_counter() - start < 10.0
+    assert 0 < len(new) <= pourer.batch_cap
+    assert pourer.inserted + pourer.skipped == 1_000_000
+    assert count_overlaps(new.position, new.radius) == 0

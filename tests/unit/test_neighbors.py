@@ -84,7 +84,10 @@ def build(
         "contact": contact or {"normal": "hertz", "tangential": "mindlin", "rolling": "none"},
         "neighbors": neighbors or {"skin": SKIN, "extra_distance": EXTRA},
         "walls": list(walls),
-        "insertion": [{"kind": "file", "material": "grain", "path": str(path)}],
+        # random positions overlap freely: only coincident ones would be refused
+        "insertion": [
+            {"kind": "file", "material": "grain", "path": str(path), "overlap_check": False}
+        ],
     }
     return Simulation(case_from_dict(case))
 

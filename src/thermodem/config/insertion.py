@@ -12,9 +12,11 @@ The section is a list of entries, each selected by its ``kind``:
     interval, at a given rate [particles/s], between a start and an end time.
 ``file``
     Positions and radii (optionally velocities and temperatures) read from a text/CSV file.
+``list``
+    Positions and radii (optionally velocities and temperatures) given in the case itself.
 
-Every entry names a ``material`` (a key of the case's ``materials`` section) and, except ``file``,
-a radius ``distribution`` (selected by its own ``kind``: ``mono``, ``uniform``,
+Every entry names a ``material`` (a key of the case's ``materials`` section) and, except ``file``
+and ``list``, a radius ``distribution`` (selected by its own ``kind``: ``mono``, ``uniform``,
 ``truncated_normal``, ``lognormal`` or ``discrete``). Entries may also set an initial
 ``velocity`` [m/s] and ``temperature`` [K]; when ``temperature`` is omitted the engine applies
 its default initial temperature.
@@ -475,7 +477,9 @@ class PourInsertion(_EntryBase):
     ``t`` a total of ``floor(rate (t - start_time))`` particles has been requested. Each batch is
     placed by random sequential addition without overlapping particles already in the region or
     each other; particles that cannot be placed in ``max_attempts`` tries are skipped with a
-    warning (they are not carried over to the next batch).
+    warning (they are not carried over to the next batch). A batch tries at most as many
+    particles as would fill half the region (more cannot be placed at random); the rest of it
+    is skipped at once, so the work of a batch is bounded whatever the rate.
     """
 
     kind: Literal["pour"] = "pour"
@@ -505,16 +509,94 @@ class FileInsertion(_EntryBase):
     The first non-blank line is a header naming the columns (a leading ``#`` is allowed):
     ``x y z radius`` are required; ``vx vy vz`` (all three) and ``temperature`` are optional
     and override the entry's ``velocity``/``temperature``. Later lines starting with ``#`` are
-    comments. A relative ``path`` is resolved by the caller (normally against the case file's
-    directory). Positions are taken as given: overlaps are not checked.
+    comments; aliases (``r`` for ``radius``, ...) and header comments are described in
+    :func:`thermodem.io.particle_file.load_particle_file`. A relative ``path`` is resolved by
+    the caller (normally against the case file's directory). Positions are checked when the
+    particles are inserted: every centre inside the domain, no two particles coincident or
+    overlapping by more than ``simulation.max_overlap_ratio`` of the smaller radius.
     """
 
     kind: Literal["file"] = "file"
     path: Path = Field(description="path of the particle file")
+    overlap_check: bool = Field(
+        default=True,
+        description="false: given particles may overlap deeply (the run still stops at its "
+        "first step when an overlap exceeds simulation.max_overlap_ratio); coincident "
+        "particles and centres outside the domain are refused regardless",
+    )
+
+
+PositiveTemperature = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+"""A strictly positive, finite temperature [K]."""
+
+
+class ListInsertion(_EntryBase):
+    """Particles given one by one in the case (the 1-, 2- and 10-particle cases).
+
+    ``positions`` are the centres [m]; give ``radius`` (one for all) or ``radii`` (one per
+    position). ``velocities`` [m/s] and ``temperatures`` [K] optionally give one value per
+    position; without them the entry's ``velocity``/``temperature`` apply to all. Like a
+    particle file, the positions are checked when the particles are inserted: every centre
+    inside the domain, no two particles coincident or overlapping by more than
+    ``simulation.max_overlap_ratio`` of the smaller radius (nor with particles of earlier
+    entries).
+    """
+
+    kind: Literal["list"] = "list"
+    positions: list[Vec3] = Field(min_length=1, description="particle centres [m]")
+    radius: PositiveLength | None = Field(default=None, description="radius of every particle")
+    radii: list[PositiveLength] | None = Field(default=None, description="one radius each [m]")
+    velocities: list[Vec3] | None = Field(default=None, description="one velocity each [m/s]")
+    temperatures: list[PositiveTemperature] | None = Field(
+        default=None, description="one temperature each [K]"
+    )
+    overlap_check: bool = Field(
+        default=True,
+        description="false: given particles may overlap deeply (the run still stops at its "
+        "first step when an overlap exceeds simulation.max_overlap_ratio); coincident "
+        "particles and centres outside the domain are refused regardless",
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> ListInsertion:
+        n = len(self.positions)
+        if (self.radius is None) == (self.radii is None):
+            raise ValueError(
+                "radius: give exactly one of 'radius' (one for every particle) or 'radii' "
+                f"(one per position), got radius={self.radius!r} and radii={self.radii!r}"
+            )
+        for key in ("radii", "velocities", "temperatures"):
+            values = getattr(self, key)
+            if values is not None and len(values) != n:
+                raise ValueError(
+                    f"{key}: {len(values)} value(s) for {n} position(s); give one per position"
+                )
+        if self.velocities is not None and "velocity" in self.model_fields_set:
+            raise ValueError(
+                "velocities: give 'velocity' (one for all) or 'velocities' (one per position), "
+                "not both"
+            )
+        if self.temperatures is not None and self.temperature is not None:
+            raise ValueError(
+                "temperatures: give 'temperature' (one for all) or 'temperatures' (one per "
+                "position), not both"
+            )
+        return self
+
+    def radius_array(self) -> np.ndarray:
+        """(n,) radii [m]."""
+        if self.radii is not None:
+            return np.asarray(self.radii, dtype=np.float64)
+        return np.full(len(self.positions), float(self.radius or 0.0))
 
 
 InsertionEntry = Annotated[
-    LatticeInsertion | RandomBoxInsertion | RandomCylinderInsertion | PourInsertion | FileInsertion,
+    LatticeInsertion
+    | RandomBoxInsertion
+    | RandomCylinderInsertion
+    | PourInsertion
+    | FileInsertion
+    | ListInsertion,
     Field(discriminator="kind"),
 ]
 """One entry of the ``insertion`` section, selected by ``kind``."""
@@ -538,6 +620,7 @@ __all__ = [
     "InsertionEntry",
     "InsertionSection",
     "LatticeInsertion",
+    "ListInsertion",
     "LognormalRadius",
     "MonoRadius",
     "PourInsertion",

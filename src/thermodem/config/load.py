@@ -36,6 +36,57 @@ def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: b
 
 _UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 
+#: Largest case file read [bytes]: a case is a few kilobytes; particles beyond a few
+#: thousand belong in a particle file (``insertion: kind: file``), which has no such limit.
+MAX_CASE_BYTES = 5_000_000
+#: Most YAML nodes a case may expand to once aliases are followed (``*name`` repeats the
+#: node it names; nested aliases grow exponentially: the "billion laughs" file).
+MAX_CASE_NODES = 1_000_000
+
+
+def _expanded_nodes(root: yaml.Node, limit: int) -> int:
+    """Number of nodes of the document with every alias expanded (linear time: each distinct
+    node is visited once); raises ConfigError-worthy ValueError above ``limit`` or for a
+    recursive alias."""
+    sizes: dict[int, int] = {}
+    active: set[int] = set()
+
+    def size(node: yaml.Node) -> int:
+        key = id(node)
+        if key in sizes:
+            return sizes[key]
+        if key in active:
+            raise ValueError("an alias refers to a node that contains it (a recursive alias)")
+        active.add(key)
+        total = 1
+        if isinstance(node, yaml.SequenceNode):
+            total += sum(size(child) for child in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            total += sum(size(k) + size(v) for k, v in node.value)
+        active.discard(key)
+        if total > limit:
+            raise ValueError(
+                f"it expands to more than {limit} values once its aliases (*name) are "
+                "followed (nested aliases grow exponentially)"
+            )
+        sizes[key] = total
+        return total
+
+    return size(root)
+
+
+def _parse_yaml(text: str) -> Any:
+    """The YAML document, refusing one that expands beyond :data:`MAX_CASE_NODES`."""
+    loader = _UniqueKeyLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _expanded_nodes(node, MAX_CASE_NODES)
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
 
 def case_from_dict(data: Any, source: str = "<case>") -> Case:
     """Validate a mapping into a Case, raising ConfigError with key paths."""
@@ -59,6 +110,16 @@ def load_case(path: str | Path) -> Case:
     if path.is_dir():
         raise ConfigError(f"case file {str(path)!r} is a directory, expected a YAML file")
     try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise ConfigError(f"case file {str(path)!r} cannot be read: {exc.strerror}") from None
+    if size > MAX_CASE_BYTES:
+        raise ConfigError(
+            f"case file {str(path)!r} is {size / 1e6:.3g} MB; a case file may have at most "
+            f"{MAX_CASE_BYTES / 1e6:g} MB (refused before reading it): put many particles in a "
+            "particle file (insertion: kind: file)"
+        )
+    try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"case file {str(path)!r} is not UTF-8 text ({exc.reason})") from None
@@ -67,13 +128,17 @@ def load_case(path: str | Path) -> Case:
     if not text.strip():
         raise ConfigError(f"case file {str(path)!r} is empty")
     try:
-        data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader subclass)
+        data = _parse_yaml(text)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown place"
         raise ConfigError(f"{path}: YAML syntax error at {where}: {exc.problem}") from None
     except yaml.YAMLError as exc:
         raise ConfigError(f"{path}: YAML error: {exc}") from None
+    except ValueError as exc:
+        raise ConfigError(f"case file {str(path)!r} refused: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"case file {str(path)!r} refused: it is nested too deeply") from None
     if data is None:
         raise ConfigError(f"case file {str(path)!r} is empty (only comments or blank lines)")
     case = case_from_dict(data, str(path))

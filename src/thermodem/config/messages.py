@@ -143,10 +143,11 @@ def walk(loc: tuple[Any, ...], data: Any) -> tuple[list[str], _Where | None]:
         members = _members(tp)
         tags = _tagged(members)
         if len(tags) > 1:
+            is_dict = isinstance(value, dict)
             if (
                 isinstance(elem, str)
                 and elem in tags
-                and not (isinstance(value, dict) and elem in value)
+                and (not (is_dict and elem in value) or (is_dict and value.get("kind") == elem))
             ):
                 where = _Where(tags[elem], value)  # a union tag: not part of the case file
                 continue
@@ -287,13 +288,61 @@ def format_error(err: dict[str, Any], data: Any) -> str:
     own = re.match(r"^([A-Za-z_][\w]*(?:\.[\w]+)*): ", msg)
     if own and "." in own.group(1) and (not dotted or own.group(1).startswith(dotted)):
         return msg
+    # ... or the key of the section they check ('radii: 3 values for 4 positions')
+    keys = _allowed_keys(where) or []
+    if own and dotted and own.group(1).split(".")[0] in keys:
+        return f"{dotted}.{msg}"
     shown = (
         "" if isinstance(value, dict | list) or repr(value) in msg else f" (got {_shown(value)})"
     )
     return f"{dotted}: {msg}{shown}" if dotted else f"{msg}{shown}"
 
 
+_MEMBER_TAG = re.compile(r"^(float|int|str|bool|none|[\w.]+\[.*\])$")
+_TYPE_ERRORS = re.compile(r"_(type|parsing)$")
+
+
+def _member_tag_at(loc: tuple[Any, ...], data: Any) -> int:
+    """Index in ``loc`` of the tag pydantic adds for a member of a union of plain types
+    (``float``, ``list[tuple[float, float]]``, ``str``), -1 if none: a string element that is
+    not a key of the data at that point."""
+    value = data
+    for k, elem in enumerate(loc):
+        if isinstance(elem, str) and _MEMBER_TAG.match(elem):
+            if not (isinstance(value, dict) and elem in value):
+                return k
+        if isinstance(value, dict):
+            value = value.get(elem)
+        elif isinstance(value, list | tuple) and isinstance(elem, int) and elem < len(value):
+            value = value[elem]
+        else:
+            value = None
+    return -1
+
+
+def _collapse_unions(errors: list[dict[str, Any]], data: Any) -> list[dict[str, Any]]:
+    """One error per value given to a union of plain types (``temperature: 300``, a table or
+    an expression): the member that accepted the value's type and refused its content
+    (``temperature: .inf`` -> 'should be a finite number'), without the member tags; when
+    every member refused the type, all of them (the value fits none)."""
+    groups: dict[tuple[Any, ...], list[tuple[int, dict[str, Any]]]] = {}
+    out: list[dict[str, Any]] = []
+    for err in errors:
+        loc = tuple(err["loc"])
+        k = _member_tag_at(loc, data)
+        if k < 0:
+            out.append(err)
+            continue
+        groups.setdefault(loc[:k], []).append((k, err))
+    for members in groups.values():
+        content = [(k, e) for k, e in members if not _TYPE_ERRORS.search(e["type"])]
+        for k, err in content or members:
+            loc = tuple(err["loc"])
+            out.append({**err, "loc": loc[:k] + loc[k + 1 :]} if content else err)
+    return out
+
+
 def format_validation_error(exc: ValidationError, data: Any = None) -> str:
     """All errors of ``exc``, one line each (``data``: the input, for exact key paths)."""
-    lines = [format_error(err, data) for err in exc.errors()]
+    lines = [format_error(err, data) for err in _collapse_unions(exc.errors(), data)]
     return "\n".join(dict.fromkeys(lines))

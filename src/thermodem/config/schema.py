@@ -7,6 +7,7 @@ registry (with a "did you mean") and the remaining keys against that model's own
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from pydantic import BaseModel, Field, field_validator, model_validator
@@ -169,6 +170,21 @@ class Output(StrictModel):
     )
 
 
+def _cylinder_bbox(region: Any) -> tuple[list[float], list[float]]:
+    """Axis-aligned bounding box of a (validated, unit-axis) cylinder region."""
+    base = [float(c) for c in region.base_centre]
+    axis = [float(c) for c in region.axis]
+    top = [b + region.length * a for b, a in zip(base, axis, strict=True)]
+    half = [region.radius * math.sqrt(max(0.0, 1.0 - a * a)) for a in axis]
+    lower = [min(b, t) - h for b, t, h in zip(base, top, half, strict=True)]
+    upper = [max(b, t) + h for b, t, h in zip(base, top, half, strict=True)]
+    return lower, upper
+
+
+def _fmt(values: list[float]) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
+
+
 class Case(StrictModel):
     """A whole case file."""
 
@@ -201,6 +217,7 @@ class Case(StrictModel):
                 raise ValueError(
                     f"insertion.{k}.material: unknown material {e.material!r}; allowed: {allowed}"
                 )
+            self._check_region_in_domain(k, e)
         for k, o in enumerate(self.interactions):
             for m in o.materials:
                 if m not in known:
@@ -218,6 +235,7 @@ class Case(StrictModel):
                             f"allowed: {allowed}"
                         )
             self._check_conductance_reuse(th)
+            self._probe_temperature_expressions(th)
             rule = th.initial_temperature
             if rule is not None and rule.kind == "per_material":
                 for m in rule.values:
@@ -227,6 +245,72 @@ class Case(StrictModel):
                             f"allowed: {allowed}"
                         )
         return self
+
+    def _check_region_in_domain(self, k: int, entry: Any) -> None:
+        """The box or cylinder an entry fills must lie inside the domain (particles outside it
+        would stop the run at its first step)."""
+        kind = entry.kind
+        if kind in ("lattice", "random_box"):
+            key, lower, upper = f"insertion.{k}", entry.lower, entry.upper
+            what = f"the {kind} box [{list(lower)}, {list(upper)}]"
+        elif kind == "random_cylinder" or (kind == "pour" and entry.region.kind == "cylinder"):
+            region = entry.region
+            key = f"insertion.{k}" + (".region" if kind == "pour" else "")
+            lower, upper = _cylinder_bbox(region)
+            what = (
+                f"the cylinder (base_centre {list(region.base_centre)}, axis "
+                f"{list(region.axis)}, radius {region.radius}, length {region.length}), whose "
+                f"bounding box is [{_fmt(lower)}, {_fmt(upper)}],"
+            )
+        elif kind == "pour":
+            key, lower, upper = f"insertion.{k}.region", entry.region.lower, entry.region.upper
+            what = f"the pour region [{list(lower)}, {list(upper)}]"
+        else:
+            return
+        dom = self.domain
+        for a, axis in enumerate("xyz"):
+            tol = 1e-9 * (dom.upper[a] - dom.lower[a])
+            if lower[a] < dom.lower[a] - tol or upper[a] > dom.upper[a] + tol:
+                raise ValueError(
+                    f"{key}: {what} reaches outside the domain [{list(dom.lower)}, "
+                    f"{list(dom.upper)}] on the {axis} axis ({lower[a]:g} .. {upper[a]:g} "
+                    f"against {dom.lower[a]:g} .. {dom.upper[a]:g}); particles must start "
+                    "inside the domain: move the region or enlarge domain"
+                )
+
+    def _probe_temperature_expressions(self, th: ThermalSettings) -> None:
+        """Temperature expressions evaluated before the run: the initial temperature on a
+        21 × 21 × 21 grid spanning the domain, each wall temperature at 2001 times from 0 to
+        end_time; every value must be finite and > 0 K."""
+        import numpy as np
+
+        from thermodem.engine.expressions import probe_expression
+
+        rule = th.initial_temperature
+        if rule is not None and rule.kind == "expression":
+            axes = [
+                np.linspace(lo, hi, 21)
+                for lo, hi in zip(self.domain.lower, self.domain.upper, strict=True)
+            ]
+            x, y, z = np.meshgrid(*axes, indexing="ij")
+            try:
+                probe_expression(rule.expression, ("x", "y", "z"), (x, y, z), 0.0)
+            except ValueError as exc:
+                raise ValueError(
+                    f"thermal.initial_temperature.expression: {exc} (an initial temperature "
+                    "[K] of every point of the domain)"
+                ) from None
+        times = np.linspace(0.0, self.simulation.end_time, 2001)
+        for k, wall in enumerate(self.walls):
+            value = wall.thermal.temperature
+            if wall.thermal.kind == "fixed" and isinstance(value, str):
+                try:
+                    probe_expression(value, ("t",), (times,), 0.0)
+                except ValueError as exc:
+                    raise ValueError(
+                        f"walls.{k}.thermal.temperature: {exc} (a wall temperature [K] from "
+                        "t = 0 to simulation.end_time)"
+                    ) from None
 
     def _check_conductance_reuse(self, th: ThermalSettings) -> None:
         """The reuse holds a conductance for a given normal force: the model must depend on

@@ -165,7 +165,9 @@ class ExternalSource(StrictModel):
     axis: Vec3 = (0.0, 0.0, 1.0)
     sigma: float | None = Field(default=None, gt=0, description="[m], gaussian profile")
     start_time: float = Field(default=0.0, ge=0)
-    end_time: float = Field(default=float("inf"), gt=0)
+    end_time: float = Field(
+        default=float("inf"), gt=0, allow_inf_nan=True, description="[s]; .inf: never ends"
+    )
 
     @model_validator(mode="after")
     def _check(self) -> ExternalSource:

@@ -196,8 +196,96 @@ def _load_pairs(buf: Any, arrays: dict[str, np.ndarray], count: int, capacity: i
     buf.group_start = np.array(arrays["group_start"], np.int64)
 
 
+#: Scalars a state must hold besides :data:`SCALARS`.
+STATE_SCALARS: tuple[str, ...] = (
+    "ledger_cumulative",
+    "rng",
+    "pourers",
+    "material_names",
+    "history_width",
+    "pair_capacity",
+    "wall_pair_capacity",
+    "pair_count",
+    "wall_pair_count",
+)
+
+
+def check_state(state: Any) -> None:
+    """Raise ConfigError unless ``state`` is a complete, self-consistent restart state: every
+    group and scalar present, every particle array of the same length, pair arrays with at
+    least ``count`` rows and indices of existing particles, slab groups in order. A damaged
+    or hand-edited checkpoint is refused here, before anything is built or written."""
+    if not isinstance(state, dict):
+        raise ConfigError(f"the state is a {type(state).__name__}, not a mapping of groups")
+    missing = [g for g in ("scalars", "particles", "pairs", "walls", "arrays") if g not in state]
+    if missing:
+        raise ConfigError(f"the group(s) {', '.join(missing)} are missing")
+    s = state["scalars"]
+    if not isinstance(s, dict):
+        raise ConfigError("the scalars are not a mapping")
+    absent = [k for k in (*SCALARS, *STATE_SCALARS) if k not in s]
+    if absent:
+        raise ConfigError(f"the scalar(s) {', '.join(absent)} are missing")
+    names = {f.name for f in fields(Particles)}
+    particles = state["particles"]
+    if set(particles) != names:
+        raise ConfigError(
+            f"the particle arrays are {sorted(particles)}, this version has {sorted(names)}"
+        )
+    n = int(np.shape(particles["global_id"])[0]) if np.ndim(particles["global_id"]) else -1
+    for name in sorted(names):
+        shape = np.shape(particles[name])
+        if len(shape) < 1 or shape[0] != n:
+            raise ConfigError(
+                f"particle array {name!r} has shape {shape}, but there are {n} particles "
+                "(global_id); the arrays are truncated or damaged"
+            )
+        if name in ("position", "velocity", "angular_velocity", "force", "torque") and (
+            len(shape) != 2 or shape[1] != 3
+        ):
+            raise ConfigError(f"particle array {name!r} has shape {shape}, expected ({n}, 3)")
+    wall_rows = np.shape(state["arrays"].get("wall_rows", np.zeros((0, 0))))
+    for group, count_key, j_limit in (
+        ("pairs", "pair_count", n),
+        ("walls", "wall_pair_count", wall_rows[0] if wall_rows else 0),
+    ):
+        arrays = state[group]
+        count = int(s[count_key])
+        lacking = [k for k in (*PAIR_ARRAYS, "group_start") if k not in arrays]
+        if lacking:
+            raise ConfigError(f"{group}: the array(s) {', '.join(lacking)} are missing")
+        for name in PAIR_ARRAYS:
+            rows = np.shape(arrays[name])
+            if not rows or rows[0] < count:
+                raise ConfigError(
+                    f"{group} array {name!r} has {rows[0] if rows else 0} rows but the state "
+                    f"counts {count} pairs; the arrays are truncated or damaged"
+                )
+        i = np.asarray(arrays["i"])[:count]
+        j = np.asarray(arrays["j"])[:count]
+        if count and (i.min() < 0 or i.max() >= n or j.min() < 0 or j.max() >= max(j_limit, 1)):
+            raise ConfigError(
+                f"{group}: pair indices outside 0..{n - 1} (particles) or the walls; the "
+                "arrays are damaged"
+            )
+        start = np.asarray(arrays["group_start"])
+        if start.ndim != 1 or start.size < 1 or np.any(np.diff(start) < 0) or start[-1] > count:
+            raise ConfigError(f"{group}: the slab groups (group_start) are out of order")
+    for name in ARRAYS:
+        if name not in state["arrays"]:
+            raise ConfigError(f"arrays: {name!r} is missing")
+    ref = np.shape(state["arrays"]["reference"])
+    if n and ref[0] not in (0, n):
+        raise ConfigError(f"arrays: 'reference' has {ref[0]} rows for {n} particles")
+    if "thermal" in state and not (
+        isinstance(state["thermal"], dict) and {"scalars", "arrays"} <= set(state["thermal"])
+    ):
+        raise ConfigError("thermal: the scalars or the arrays are missing")
+
+
 def restore(sim: Simulation, state: dict[str, Any]) -> None:
     """Load ``state`` (from :func:`capture`) into ``sim``, built from the same case."""
+    check_state(state)
     s = state["scalars"]
     if list(s["material_names"]) != list(sim.material_names):
         raise _mismatch("the list of materials", list(s["material_names"]), sim.material_names)

@@ -13,11 +13,21 @@ Output directory layout::
                                           the end and on an interrupt (newest
                                           output.checkpoint_keep kept, the final one always)
     OUT/failed.h5                         the state when a SimulationError was raised
+    OUT/run.lock                          pid, host and start of the process writing OUT (while
+                                          it runs; a second run, --overwrite or restart of OUT
+                                          is refused while that process is alive)
 
 Three entry points: :func:`run_case` (a fresh run), :func:`restart_run` (continue the run in
 an output directory from its newest checkpoint, appending to its outputs) and
 :func:`run_from_checkpoint` (a new output directory starting from any checkpoint, with the
 stored or a changed case). All three go through one loop, :func:`_drive`.
+
+Before anything in an output directory is written or deleted, everything that can be checked
+is: the output path (its parent must be a directory), the lock of a live process writing it,
+the checkpoint to continue from (complete, consistent arrays, written for this directory:
+the ``run_id`` of ``status.json`` and the stored case, end time aside), the end time, the
+resources. A truncated last row of ``timeseries.csv`` (a run killed while writing it) is
+dropped at a restart with a message.
 
 Failures: a :class:`SimulationError` from the engine writes ``failed.h5`` (the state at the
 failure, for inspection) and is raised again with the last good checkpoint named in the
@@ -29,6 +39,7 @@ from __future__ import annotations
 
 import csv
 import datetime as _dt
+import json
 import math
 import os
 import signal
@@ -36,6 +47,7 @@ import socket
 import sys
 import threading
 import time as wallclock
+import uuid
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -58,6 +70,7 @@ from thermodem.engine.validation import (
 )
 from thermodem.errors import ConfigError, RunInterrupted, SimulationError
 from thermodem.io.checkpoint import (
+    Checkpoint,
     checkpoint_name,
     list_checkpoints,
     read_checkpoint,
@@ -142,6 +155,7 @@ class _Run:
     every: int
     case_yaml: str = ""
     last_checkpoint: Path | None = None
+    run_id: str = ""
 
 
 def _schedule(case: Case, sim: Simulation, interval: float | None, default_fraction: float) -> int:
@@ -196,7 +210,11 @@ def _make_run(
 def _checkpoint(sim: Simulation, run: _Run, kind: str) -> Path:
     directory = run.output / CHECKPOINT_DIR
     path = write_checkpoint(
-        sim, directory / checkpoint_name(sim.step_count), kind=kind, case_yaml=run.case_yaml
+        sim,
+        directory / checkpoint_name(sim.step_count),
+        kind=kind,
+        case_yaml=run.case_yaml,
+        run_id=run.run_id,
     )
     run.last_checkpoint = path
     if run.checkpoint_keep is not None:
@@ -285,7 +303,14 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
 def _failed(sim: Simulation, run: _Run, exc: SimulationError) -> SimulationError:
     failed = run.output / FAILED_FILE
     try:
-        write_checkpoint(sim, failed, kind="failed", message=str(exc), case_yaml=run.case_yaml)
+        write_checkpoint(
+            sim,
+            failed,
+            kind="failed",
+            message=str(exc),
+            case_yaml=run.case_yaml,
+            run_id=run.run_id,
+        )
         failed_text = f"state at the failure (for inspection): {failed}"
     except Exception as write_error:  # noqa: BLE001 (report the original error regardless)
         failed_text = f"the state at the failure could not be written: {write_error}"
@@ -342,6 +367,7 @@ def _open(
             case=case_name,
             started=_dt.datetime.now().isoformat(timespec="seconds"),
             host=socket.gethostname(),
+            run_id=uuid.uuid4().hex,
         )
     return log, status
 
@@ -403,27 +429,39 @@ def run_case(
     """
     output = Path(output)
     check_completeness(case)
+    _check_output_path(output)
+    if output.is_dir():
+        _refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
     prepare_output_dir(output, overwrite)
-    for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
-        (output / stale).unlink(missing_ok=True)
-    for old in list_checkpoints(output / CHECKPOINT_DIR):
-        old.unlink()
-    (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
-    runlog, status = _open(output, log, append=False, case_name=case_name)
-    _compile_note(runlog, case)
+    lock = _RunLock(output)
+    lock.acquire()
     try:
-        sim = Simulation(case, threads=threads)
-        for warning in check_simulation_time_step(sim):
-            runlog.warn(warning)
-        _header(runlog, sim, threads, output)
-        run = _make_run(sim, output, runlog, status, False, progress, log_interval, callback, every)
-        return _drive(sim, run, fresh=True)
-    except ConfigError as exc:
-        runlog.file_only(f"error: {exc}")
-        status.update(status="failed", message=str(exc))
-        raise
+        for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
+            (output / stale).unlink(missing_ok=True)
+        for old in list_checkpoints(output / CHECKPOINT_DIR):
+            old.unlink()
+        (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
+        runlog, status = _open(output, log, append=False, case_name=case_name)
+        _compile_note(runlog, case)
+        run_id = status.data["run_id"]
+        try:
+            sim = Simulation(case, threads=threads)
+            for warning in check_simulation_time_step(sim):
+                runlog.warn(warning)
+            _header(runlog, sim, threads, output)
+            run = _make_run(
+                sim, output, runlog, status, False, progress, log_interval, callback, every
+            )
+            run.run_id = run_id
+            return _drive(sim, run, fresh=True)
+        except ConfigError as exc:
+            runlog.file_only(f"error: {exc}")
+            status.update(status="failed", message=str(exc))
+            raise
+        finally:
+            runlog.close()
     finally:
-        runlog.close()
+        lock.release()
 
 
 def restart_run(
@@ -439,42 +477,75 @@ def restart_run(
 ) -> Simulation:
     """Continue the run in ``output`` from its newest checkpoint to end_time (``end_time``
     replaces the stored one). Frames and time-series rows after the checkpoint are dropped and
-    written again, so the finished directory is the same as an uninterrupted run's."""
+    written again, so the finished directory is the same as an uninterrupted run's.
+
+    Everything is checked before the directory is touched: no live process writing it, the
+    end time (finite, > 0, not before the checkpoint), the checkpoint (complete, written for
+    this directory), the resources."""
     output = Path(output)
     if not output.is_dir():
         raise ConfigError(f"{str(output)!r} is not an output directory")
+    if end_time is not None and not (math.isfinite(end_time) and end_time > 0.0):
+        raise ConfigError(
+            f"--end-time: {end_time!r} is not allowed; give a finite end time > 0 [s]"
+        )
     checkpoints = list_checkpoints(output / CHECKPOINT_DIR)
     if not checkpoints:
         raise ConfigError(f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from")
+    _refuse_if_busy(output, "restart")
     previous = Status.read(output)
-    pid = previous.get("pid")
-    if previous.get("status") == "running" and pid and pid != os.getpid() and _alive(pid):
-        if previous.get("host") in (None, socket.gethostname()):
-            raise ConfigError(f"{output} is still being written by a running process (pid {pid})")
-    ckpt = read_checkpoint(checkpoints[-1])
+    ckpt = _read_newest(checkpoints)
+    _check_belongs(ckpt, output, previous)
     case = ckpt.case()
     if end_time is not None:
+        if end_time < ckpt.time:
+            raise ConfigError(
+                f"--end-time: {end_time:g} s is before the time of the newest checkpoint, "
+                f"{ckpt.time:.6g} s ({ckpt.path}); give a later end time"
+            )
         case.simulation.end_time = float(end_time)
-    sim = Simulation.from_checkpoint(ckpt, threads=threads, case=case)
-    if end_time is not None:
-        (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
-    runlog, status = _open(output, log, append=True, case_name=previous.get("case"))
+    sim = _restored(ckpt, threads, case)
+    check_resources(estimate_resources(sim, threads))  # refuses before anything is written
+    series_repair = _timeseries_repair(output / TIMESERIES_FILE)
+    for pvd in ("particles.pvd", "walls.pvd"):
+        if (output / pvd).exists():
+            try:
+                PVDWriter.read(output / pvd)
+            except (ValueError, OSError, SyntaxError) as exc:  # ParseError: a SyntaxError
+                raise ConfigError(
+                    f"{output / pvd} cannot be read ({exc}); restart refused, nothing was "
+                    "changed: repair or delete it"
+                ) from None
+    # nothing above wrote to the directory
+    lock = _RunLock(output)
+    lock.acquire()
     try:
-        runlog.info(
-            f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) to end time "
-            f"{case.simulation.end_time:g} s"
-        )
-        (output / FAILED_FILE).unlink(missing_ok=True)
-        _header(runlog, sim, threads, output)
-        run = _make_run(sim, output, runlog, status, True, progress, log_interval, callback, every)
-        run.last_checkpoint = ckpt.path
-        if sim.step_count >= run.total:
-            runlog.info(f"already at the end time (step {sim.step_count}); nothing to do")
-            return sim
-        result = _drive(sim, run, fresh=False)
-        return result
+        if end_time is not None:
+            (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
+        runlog, status = _open(output, log, append=True, case_name=previous.get("case"))
+        run_id = status.data.setdefault("run_id", ckpt.run_id or uuid.uuid4().hex)
+        try:
+            runlog.info(
+                f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) to end "
+                f"time {case.simulation.end_time:g} s"
+            )
+            if series_repair is not None:
+                runlog.warn(series_repair())
+            (output / FAILED_FILE).unlink(missing_ok=True)
+            _header(runlog, sim, threads, output)
+            run = _make_run(
+                sim, output, runlog, status, True, progress, log_interval, callback, every
+            )
+            run.run_id = run_id
+            run.last_checkpoint = ckpt.path
+            if sim.step_count >= run.total:
+                runlog.info(f"already at the end time (step {sim.step_count}); nothing to do")
+                return sim
+            return _drive(sim, run, fresh=False)
+        finally:
+            runlog.close()
     finally:
-        runlog.close()
+        lock.release()
 
 
 def run_from_checkpoint(
@@ -496,21 +567,291 @@ def run_from_checkpoint(
     output = Path(output)
     ckpt = read_checkpoint(checkpoint)
     case = case or ckpt.case()
-    sim = Simulation.from_checkpoint(ckpt, threads=threads, case=case)
+    sim = _restored(ckpt, threads, case)
+    _check_output_path(output)
+    if output.is_dir():
+        _refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
     prepare_output_dir(output, overwrite)
-    for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
-        (output / stale).unlink(missing_ok=True)
-    (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
-    runlog, status = _open(output, log, append=False, case_name=case_name)
+    lock = _RunLock(output)
+    lock.acquire()
     try:
-        runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
-        for warning in check_simulation_time_step(sim):
-            runlog.warn(warning)
-        _header(runlog, sim, threads, output)
-        run = _make_run(sim, output, runlog, status, False, progress, log_interval, callback, every)
-        return _drive(sim, run, fresh=True)
+        for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
+            (output / stale).unlink(missing_ok=True)
+        (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
+        runlog, status = _open(output, log, append=False, case_name=case_name)
+        try:
+            runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
+            for warning in check_simulation_time_step(sim):
+                runlog.warn(warning)
+            _header(runlog, sim, threads, output)
+            run = _make_run(
+                sim, output, runlog, status, False, progress, log_interval, callback, every
+            )
+            run.run_id = status.data["run_id"]
+            return _drive(sim, run, fresh=True)
+        finally:
+            runlog.close()
     finally:
-        runlog.close()
+        lock.release()
+
+
+# ------------------------------------------------------------------ checks before touching
+LOCK_FILE = "run.lock"
+
+
+def _check_output_path(output: Path) -> None:
+    """The output directory can be created: no file on its path, and the first existing
+    directory on it is writable."""
+    for parent in (output, *output.parents):
+        if not parent.exists():
+            continue
+        if not parent.is_dir():
+            if parent == output:
+                raise ConfigError(f"--output {str(output)!r} exists and is not a directory")
+            raise ConfigError(
+                f"--output {str(output)!r}: {str(parent)!r} is a file, not a directory, so "
+                "the output directory cannot be created there; choose another --output"
+            )
+        if not os.access(parent, os.W_OK | os.X_OK):
+            raise ConfigError(
+                f"--output {str(output)!r}: the directory {str(parent)!r} is not writable"
+            )
+        return
+
+
+def _process_start(pid: int) -> str | None:
+    """Start time of process ``pid`` (Linux: field 22 of /proc/PID/stat), None if unknown;
+    tells a live lock holder from an unrelated process that reuses its pid."""
+    try:
+        text = Path(f"/proc/{int(pid)}/stat").read_text()
+        return text.rsplit(")", 1)[1].split()[19]
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def _lock_holder(output: Path) -> dict[str, Any] | None:
+    """The live process that holds ``output``'s lock, or None (no lock, or a stale one)."""
+    try:
+        data = json.loads((output / LOCK_FILE).read_text())
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        return None  # unreadable: a lock half written by a killed process
+    if not isinstance(data, dict) or not isinstance(data.get("pid"), int):
+        return None
+    pid, host = data["pid"], data.get("host")
+    if host not in (None, socket.gethostname()):
+        return data  # another machine (a shared file system): cannot tell, assume alive
+    if not _alive(pid):
+        return None
+    start, now = data.get("start"), _process_start(pid)
+    if start and now and start != now:
+        return None  # the pid belongs to another process now
+    return data
+
+
+def _refuse_if_busy(output: Path, what: str) -> None:
+    """ConfigError when a live process writes ``output`` (its lock, or an older run's
+    ``status.json`` that says running with a live pid)."""
+    holder = _lock_holder(output)
+    if holder is not None:
+        pid = holder["pid"]
+        raise ConfigError(
+            f"{output} is being written by a running thermodem process (pid {pid} on "
+            f"{holder.get('host')}, since {holder.get('started')}); {what} refused: wait for "
+            f"it to finish, stop it (Ctrl-C, or kill {pid}: it writes a checkpoint), or choose "
+            f"another --output (if that process is not thermodem, delete {output / LOCK_FILE})"
+        )
+    previous = Status.read(output)
+    pid = previous.get("pid")
+    if previous.get("status") == "running" and pid and pid != os.getpid() and _alive(pid):
+        if previous.get("host") in (None, socket.gethostname()):
+            raise ConfigError(
+                f"{output} is still being written by a running process (pid {pid}, according "
+                f"to its status.json); {what} refused (if pid {pid} is not a thermodem run, "
+                f"delete {output / STATUS_FILE})"
+            )
+
+
+class _RunLock:
+    """``OUT/run.lock``: created exclusively (O_EXCL) with this process's pid, host and start
+    time; a stale lock (its process gone) is replaced; removed when the run ends."""
+
+    def __init__(self, output: Path) -> None:
+        self.output = output
+        self.path = output / LOCK_FILE
+        self.held = False
+
+    def acquire(self) -> None:
+        me = {
+            "pid": os.getpid(),
+            "host": socket.gethostname(),
+            "start": _process_start(os.getpid()),
+            "started": _dt.datetime.now().isoformat(timespec="seconds"),
+        }
+        for _ in range(3):
+            try:
+                fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                _refuse_if_busy(self.output, "the run")
+                self.path.unlink(missing_ok=True)  # stale
+                continue
+            with os.fdopen(fd, "w") as f:
+                f.write(json.dumps(me) + "\n")
+            self.held = True
+            return
+        raise ConfigError(f"could not take the lock {self.path} (another run took it?)")
+
+    def release(self) -> None:
+        if self.held:
+            self.path.unlink(missing_ok=True)
+            self.held = False
+
+
+def _read_newest(checkpoints: list[Path]) -> Checkpoint:
+    """The newest checkpoint, read and checked; a damaged one names the older ones."""
+    try:
+        return read_checkpoint(checkpoints[-1])
+    except ConfigError as exc:
+        older = [str(p) for p in checkpoints[:-1]]
+        hint = (
+            f"; an older checkpoint can be continued into a new directory: thermodem run "
+            f"--restart {older[-1]} --output NEWDIR"
+            if older
+            else ""
+        )
+        raise ConfigError(f"{exc}; nothing was changed in the run directory{hint}") from None
+
+
+def _restored(ckpt: Checkpoint, threads: int | None, case: Case) -> Simulation:
+    """A simulation continuing from ``ckpt`` (ConfigError for a state that does not load)."""
+    try:
+        return Simulation.from_checkpoint(ckpt, threads=threads, case=case)
+    except ConfigError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError) as exc:
+        raise ConfigError(
+            f"checkpoint {ckpt.path} cannot be restored ({type(exc).__name__}: {exc}); the file "
+            "is damaged or was written by another version"
+        ) from None
+
+
+def _case_without_end_time(text: str) -> Any:
+    import yaml
+
+    data = yaml.safe_load(text)
+    if isinstance(data, dict) and isinstance(data.get("simulation"), dict):
+        data["simulation"].pop("end_time", None)
+    return data
+
+
+def _first_difference(a: Any, b: Any, path: str = "") -> str | None:
+    """Key path of the first difference between two plain-data trees ('' for the root)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in list(a) + [k for k in b if k not in a]:
+            if key not in a or key not in b:
+                return f"{path}{key}"
+            found = _first_difference(a[key], b[key], f"{path}{key}.")
+            if found is not None:
+                return found
+        return None
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return path.rstrip(".") or "(the whole case)"
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            found = _first_difference(x, y, f"{path}{k}.")
+            if found is not None:
+                return found
+        return None
+    return None if a == b else (path.rstrip(".") or "(the whole case)")
+
+
+def _check_belongs(ckpt: Checkpoint, output: Path, status: dict[str, Any]) -> None:
+    """Refuse a checkpoint that was not written for ``output``: another run_id than the
+    directory's ``status.json``, or a stored case that differs from ``case.resolved.yaml``
+    (the end time aside, which a restart may change)."""
+    import yaml
+
+    own = status.get("run_id")
+    if own and ckpt.run_id and own != ckpt.run_id:
+        raise ConfigError(
+            f"checkpoint {ckpt.path} was written by another run (run_id {ckpt.run_id}, this "
+            f"directory's is {own}: copied in from elsewhere?); restart refused, nothing was "
+            f"changed. To continue it in a new directory: thermodem run --restart {ckpt.path} "
+            "--output NEWDIR"
+        )
+    resolved = output / "case.resolved.yaml"
+    if not resolved.exists():
+        return
+    try:
+        mine = _case_without_end_time(resolved.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{resolved} cannot be read ({exc}); restart refused") from None
+    try:
+        stored = _case_without_end_time(ckpt.case_yaml)
+    except yaml.YAMLError as exc:
+        raise ConfigError(
+            f"checkpoint {ckpt.path}: the stored case is not valid YAML ({exc})"
+        ) from None
+    where = _first_difference(mine, stored)
+    if where is not None:
+        raise ConfigError(
+            f"checkpoint {ckpt.path} holds another case than {resolved} (they differ at "
+            f"{where}): it belongs to another run; restart refused, nothing was changed. To "
+            f"continue it with its own case in a new directory: thermodem run --restart "
+            f"{ckpt.path} --output NEWDIR"
+        )
+
+
+def _timeseries_repair(path: Path) -> Callable[[], str] | None:
+    """A repair of ``timeseries.csv`` to do at a restart, or None: its last row is dropped
+    when it is incomplete (no line end, fewer cells than the header, or a time or step that is
+    not a number: a run killed while writing it). A damaged row before the last is an error
+    (the file was edited or broken otherwise)."""
+    if not path.exists():
+        return None
+    raw = path.read_bytes()
+    text = raw.decode("utf-8", errors="replace")
+    lines = text.split("\n")
+    complete = text.endswith("\n")
+    body = lines[:-1] if complete else lines
+    if len(body) < 2:
+        return None
+    header = next(csv.reader([body[0]]), [])
+
+    def problem(row: str) -> str | None:
+        cells = next(csv.reader([row]), [])
+        if len(cells) != len(header):
+            return f"{len(cells)} of {len(header)} values"
+        try:
+            float(cells[0])
+            int(cells[1])
+        except (ValueError, IndexError):
+            return "its time or step is not a number"
+        return None
+
+    for k, row in enumerate(body[1:-1], start=2):
+        why = problem(row)
+        if why is not None:
+            raise ConfigError(
+                f"{path}, line {k}: damaged row ({why}); restart refused, nothing was changed: "
+                "repair or move the file away (the restart then writes the rows after the "
+                "checkpoint only)"
+            )
+    last = len(body)
+    why = "no line end" if not complete else problem(body[-1])
+    if why is None:
+        return None
+
+    def repair() -> str:
+        _atomic_write_text(path, "\n".join(body[:-1]) + "\n")
+        return (
+            f"{path}: its last row (line {last}) was incomplete ({why}; the run was stopped "
+            "while writing it); dropped it, the restart writes the rows after the checkpoint "
+            "again"
+        )
+
+    return repair
 
 
 def _alive(pid: int) -> bool:

@@ -35,7 +35,7 @@ from thermodem.config.schema import Case
 from thermodem.engine import diagnostics as D
 from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
-from thermodem.engine.validation import check_completeness
+from thermodem.engine.validation import check_completeness, check_insertion_memory
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
 from thermodem.geometry.insertion import InsertedParticles, Pourer, insert
@@ -135,12 +135,22 @@ class Simulation:
         self.particles = Particles.empty(self.mechanisms)
         self.next_global_id = 0
         self.pourers: list[Pourer] = []
-        for entry in case.insertion:
+        if insert_particles:
+            check_insertion_memory(case)  # before anything is allocated (engine/validation.py)
+        for k, entry in enumerate(case.insertion):
             if entry.kind == "pour":
                 self.pourers.append(Pourer(entry, self.rng))
             elif insert_particles:
                 self.add_particles(
-                    insert(entry, self.rng, self.particles.position, self.particles.radius)
+                    insert(
+                        entry,
+                        self.rng,
+                        self.particles.position,
+                        self.particles.radius,
+                        key=f"insertion.{k}",
+                        domain=(self.lower, self.upper),
+                        max_overlap_ratio=sim.max_overlap_ratio,
+                    )
                 )
         # neighbour list
         nb = case.neighbors

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from pydantic import BaseModel
 
 from thermodem.errors import ConfigError
@@ -30,6 +31,9 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 MECHANICAL_FAMILIES = ("normal", "tangential", "rolling")
+#: Material properties an ``interactions`` entry may give for the pair instead (equivalent
+#: values): a material need not give them when every pair it forms has them.
+PAIR_PROPERTIES = ("surface_roughness", "surface_slope")
 
 #: The run time estimate: a fixed cost per step (Python orchestration and kernel launches,
 #: independent of the particle count) plus a cost per particle-step, each for mechanics and
@@ -98,6 +102,18 @@ def meeting_materials(case: Case) -> tuple[set[str], set[str], set[str]]:
 def check_completeness(case: Case) -> None:
     """Raise ConfigError naming ``materials.NAME.PROPERTY`` for each missing property."""
     particles, walls, hot = meeting_materials(case)
+    overrides = {frozenset(o.materials): o for o in case.interactions}
+
+    def given_per_pair(name: str, prop: str, partners: set[str]) -> bool:
+        """Every pair of ``name`` with its partners has an interactions entry giving
+        ``prop`` (pair properties: the equivalent surface roughness and slope)."""
+        if prop not in PAIR_PROPERTIES:
+            return False
+        return all(
+            getattr(overrides.get(frozenset((name, other))), prop, None) is not None
+            for other in partners
+        )
+
     problems: list[str] = []
     for path, choice in model_choices(case):
         spec = choice.spec
@@ -107,8 +123,11 @@ def check_completeness(case: Case) -> None:
             meets = sorted(particles | (hot if particles else set()))
         for name in meets:
             material = case.materials[name]
+            partners = (set(meets) if name in particles else set(particles)) or {name}
             for prop in spec.requires:
-                if getattr(material, prop, None) is None:
+                if getattr(material, prop, None) is None and not given_per_pair(
+                    name, prop, partners
+                ):
                     role = "particles" if name in particles else "walls"
                     problems.append(
                         f"materials.{name}.{prop}: missing; required by {path} = "
@@ -233,11 +252,8 @@ def estimate_resources(sim: Simulation, threads: int | None = None) -> ResourceE
         final += count
         particle_seconds += seconds
     particle_steps = particle_seconds / dt_run
-    width = sim.pairs.history_width
-    pair_bytes = 1.25 * (8 + 8 * width + 16 + 8 + 1 + 9)
-    if sim.thermal is not None:
-        pair_bytes += 16  # conductance and heat rate (heat-only passes)
-    memory = BASELINE_BYTES + final * (BYTES_PER_PARTICLE + PAIRS_PER_PARTICLE * pair_bytes)
+    per_particle = bytes_per_particle(sim.pairs.history_width, sim.thermal is not None)
+    memory = BASELINE_BYTES + final * per_particle
     fixed, variable = run_time(sim, steps, particle_steps, threads)
     total, avail = physical_memory()
     return ResourceEstimate(
@@ -284,6 +300,68 @@ def run_time(
     n = sim.particles.count + sum(poured_particles(p.entry, sim.time, end)[0] for p in sim.pourers)
     writing = rows * ROW_SECONDS + files * (FILE_SECONDS + n * FILE_SECONDS_PER_PARTICLE)
     return steps * per_step + writing, particle_steps * per_particle
+
+
+def bytes_per_particle(history_width: int = 6, thermal: bool = False) -> float:
+    """Estimated memory per particle [B]: its arrays plus its share of the pair lists."""
+    pair_bytes = 1.25 * (8 + 8 * history_width + 16 + 8 + 1 + 9)
+    if thermal:
+        pair_bytes += 16  # conductance and heat rate (heat-only passes)
+    return BYTES_PER_PARTICLE + PAIRS_PER_PARTICLE * pair_bytes
+
+
+def insertion_counts(case: Case) -> list[tuple[str, float, str]]:
+    """(key path, about how many particles, how the number comes about) of every insertion
+    entry, computed from the case alone (nothing is allocated; particle files: their data
+    lines are not counted, 0)."""
+    from thermodem.geometry.distributions import mean_sphere_volume
+    from thermodem.geometry.insertion import lattice_axis_counts
+
+    out: list[tuple[str, float, str]] = []
+    end = case.simulation.end_time
+    for k, entry in enumerate(case.insertion):
+        key = f"insertion.{k}"
+        if entry.kind == "lattice":
+            nx, ny, nz = lattice_axis_counts(entry)
+            out.append((key, float(nx) * ny * nz, f"a lattice of {nx} × {ny} × {nz} sites"))
+        elif entry.kind in ("random_box", "random_cylinder"):
+            if entry.count is not None:
+                out.append((key, float(entry.count), f"count {entry.count}"))
+            else:
+                volume = entry.volume_fraction * float(
+                    np.prod(np.subtract(entry.upper, entry.lower))
+                )
+                n = volume / mean_sphere_volume(entry.distribution)
+                out.append((key, n, f"volume_fraction {entry.volume_fraction}"))
+        elif entry.kind == "pour":
+            n, _ = poured_particles(entry, 0.0, end)
+            out.append((key, n, f"rate {entry.rate:g}/s until t = {end:g} s"))
+        elif entry.kind == "list":
+            out.append((key, float(len(entry.positions)), "positions"))
+        else:
+            out.append((key, 0.0, "a particle file"))
+    return out
+
+
+def check_insertion_memory(case: Case) -> None:
+    """Refuse, before anything is allocated, a case whose insertion entries would need more
+    memory than the machine has (a lattice of 1e9 sites, a count of 1e9): ConfigError naming
+    the largest entry."""
+    counts = insertion_counts(case)
+    if not counts:
+        return
+    total_count = sum(n for _, n, _ in counts)
+    width = 10 if case.contact.rolling.spec.history_width > 0 else 6
+    memory = BASELINE_BYTES + total_count * bytes_per_particle(width, case.thermal is not None)
+    total, _ = physical_memory()
+    if math.isfinite(total) and memory > total:
+        key, n, how = max(counts, key=lambda c: c[1])
+        raise ConfigError(
+            f"{key}: {how} gives about {n:.3g} particles; the estimated memory "
+            f"{memory / 1e9:.3g} GB for about {total_count:.3g} particles exceeds the physical "
+            f"memory {total / 1e9:.3g} GB of this machine (refused before allocating); use "
+            "fewer particles (a larger spacing, a smaller count or region)"
+        )
 
 
 def check_resources(estimate: ResourceEstimate) -> list[str]:

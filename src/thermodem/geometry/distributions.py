@@ -86,3 +86,17 @@ def _radii_for_volume(dist: Any, volume: float, rng: np.random.Generator) -> np.
     cumulative = np.cumsum(4.0 / 3.0 * np.pi * radii**3)
     n = int(np.searchsorted(cumulative, volume)) + 1
     return radii[: min(n, radii.size)]
+
+
+def mean_sphere_volume(dist: Any, samples: int = 8192) -> float:
+    """Mean sphere volume 4/3 π E[r³] [m³] of a radius distribution: exact for ``mono`` and
+    ``discrete``, else estimated from ``samples`` radii drawn with a fixed seed of their own
+    (the run's generator is not touched, so the particles of the run do not change). Used to
+    judge whether a requested count can fit a region before drawing it."""
+    if isinstance(dist, MonoRadius):
+        return 4.0 / 3.0 * math.pi * dist.radius**3
+    if isinstance(dist, DiscreteRadius):
+        radii = np.asarray(dist.radii, dtype=np.float64)
+        return float(4.0 / 3.0 * math.pi * np.sum(dist.number_fractions() * radii**3))
+    r = sample_radii(dist, samples, np.random.default_rng(20240601))
+    return float(4.0 / 3.0 * math.pi * np.mean(r**3))

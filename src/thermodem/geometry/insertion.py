@@ -12,6 +12,7 @@ Public API: :class:`InsertedParticles`, :func:`sample_radii`, :func:`insert`,
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -22,11 +23,13 @@ import numpy as np
 from thermodem.config.insertion import (
     FileInsertion,
     LatticeInsertion,
+    ListInsertion,
     PourInsertion,
     RandomBoxInsertion,
     RandomCylinderInsertion,
 )
-from thermodem.geometry.distributions import _radii_for_volume, sample_radii
+from thermodem.errors import ConfigError
+from thermodem.geometry.distributions import _radii_for_volume, mean_sphere_volume, sample_radii
 from thermodem.geometry.random_fill import (
     _AXES,
     _Box,
@@ -42,6 +45,21 @@ from thermodem.io.particle_file import (  # noqa: F401 (re-exported)
     load_particle_file,
     save_particle_file,
 )
+
+#: Random sequential addition of equal spheres jams at a solid fraction of about 0.38
+#: (Torquato, Uche & Stillinger 2006, Phys. Rev. E 74, 061308; less near walls, somewhat more
+#: for polydisperse radii): a ``random_*`` entry whose particles would fill more than this
+#: fraction of its region is refused before any attempt (it could only fail, slowly).
+RSA_MAX_FRACTION = 0.5
+
+#: Default of ``simulation.max_overlap_ratio``: the deepest overlap accepted between given
+#: particles (file, list) when the caller does not pass the case's value.
+DEFAULT_MAX_OVERLAP_RATIO = 0.2
+
+#: Two given particles whose centres are closer than this fraction of the larger radius are
+#: coincident: refused even with ``overlap_check: false``, since such a pair never interacts
+#: (it has no contact normal).
+COINCIDENT_DISTANCE = 1e-9
 
 WallsOk = Callable[[np.ndarray, np.ndarray], np.ndarray]
 """Predicate ``walls_ok(positions (n, 3), radii (n,)) -> bool (n,)``: True where a sphere is
@@ -100,6 +118,23 @@ def _assemble(
 # --------------------------------------------------------------------------------------------
 # Static insertion kinds
 # --------------------------------------------------------------------------------------------
+
+
+def lattice_axis_counts(entry: LatticeInsertion) -> tuple[int, int, int]:
+    """Number of lattice sites along x, y and z (without allocating them)."""
+    r_max = entry.distribution.max_radius_bound
+    if r_max is None:
+        raise ValueError("lattice insertion needs a bounded radius distribution (set max_radius)")
+    if entry.count is not None:
+        return (int(entry.count[0]), int(entry.count[1]), int(entry.count[2]))
+    margin = r_max + entry.jitter
+    out = []
+    for a in range(3):
+        span = entry.upper[a] - entry.lower[a] - 2.0 * margin
+        spacing = entry.axis_spacing(a)
+        assert spacing is not None
+        out.append(int(math.floor(max(span, 0.0) / spacing + 1e-9)) + 1)
+    return (out[0], out[1], out[2])
 
 
 def lattice_sites(entry: LatticeInsertion) -> np.ndarray:
@@ -169,7 +204,20 @@ def _insert_random(
         region: _Box | _Cylinder = _Box(entry.lower, entry.upper)
     else:
         region = _Cylinder(entry.base_centre, entry.axis, entry.radius, entry.length)
+    bound = entry.distribution.max_radius_bound
+    if bound is not None:
+        region.check_fits(float(bound), f"{entry.kind} insertion")
     if entry.count is not None:
+        fraction = entry.count * mean_sphere_volume(entry.distribution) / region.volume()
+        if fraction > RSA_MAX_FRACTION:
+            raise ValueError(
+                f"count: {entry.count} particles (mean sphere volume "
+                f"{mean_sphere_volume(entry.distribution):.3g} m³) would fill {fraction:.3g} of "
+                f"the region's volume {region.volume():.3g} m³; random sequential addition "
+                f"jams near 0.38 for equal spheres, so more than {RSA_MAX_FRACTION} is refused: "
+                "lower count, enlarge the region, or use a lattice (and let the particles "
+                "settle)"
+            )
         radii = sample_radii(entry.distribution, entry.count, rng)
     else:
         assert isinstance(entry, RandomBoxInsertion) and entry.volume_fraction is not None
@@ -189,34 +237,65 @@ def _insert_random(
 
 
 def insert(
-    entry: LatticeInsertion | RandomBoxInsertion | RandomCylinderInsertion | FileInsertion,
+    entry: LatticeInsertion
+    | RandomBoxInsertion
+    | RandomCylinderInsertion
+    | FileInsertion
+    | ListInsertion,
     rng: np.random.Generator,
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
     walls_ok: WallsOk | None = None,
+    *,
+    key: str = "insertion",
+    domain: tuple[np.ndarray, np.ndarray] | None = None,
+    max_overlap_ratio: float = DEFAULT_MAX_OVERLAP_RATIO,
 ) -> InsertedParticles:
-    """Insert the particles of one static entry (``lattice``, ``random_*`` or ``file``).
+    """Insert the particles of one static entry (``lattice``, ``random_*``, ``file``, ``list``).
 
     ``existing_positions`` (n, 3) and ``existing_radii`` (n,) are the particles already present
     (None or empty arrays for none). ``walls_ok`` optionally screens spheres against the walls.
 
     * ``lattice``: sites overlapping an existing particle or rejected by ``walls_ok`` are skipped.
     * ``random_box``/``random_cylinder``: random sequential addition; no particle overlaps an
-      existing one or another new one, every particle lies fully inside the region. Raises
-      ValueError if not every particle can be placed.
-    * ``file``: positions are used as given (no overlap check); raises ValueError if
-      ``walls_ok`` rejects any particle.
+      existing one or another new one, every particle lies fully inside the region. A count
+      that would fill more than :data:`RSA_MAX_FRACTION` of the region is refused at once;
+      otherwise an error if not every particle can be placed.
+    * ``file``/``list``: positions are used as given, after checks: every centre inside
+      ``domain`` (``(lower, upper)``, if given), no two particles (given, or given and
+      existing) coincident or overlapping by more than ``max_overlap_ratio`` of the smaller
+      radius, and ``walls_ok`` accepting every particle.
+
+    Errors are :class:`~thermodem.errors.ConfigError` (a ValueError) whose message starts with
+    ``key`` (the entry's key path, e.g. ``insertion.0``).
 
     ``pour`` entries are time dependent: use :class:`Pourer`.
     """
-    if isinstance(entry, LatticeInsertion):
-        return _insert_lattice(entry, rng, existing_positions, existing_radii, walls_ok)
-    if isinstance(entry, RandomBoxInsertion | RandomCylinderInsertion):
-        return _insert_random(entry, rng, existing_positions, existing_radii, walls_ok)
-    if isinstance(entry, FileInsertion):
-        return _insert_file(entry, walls_ok)
     if isinstance(entry, PourInsertion):
         raise TypeError("'pour' insertion entries are time dependent: use Pourer(entry, rng)")
+    try:
+        if isinstance(entry, LatticeInsertion):
+            return _insert_lattice(entry, rng, existing_positions, existing_radii, walls_ok)
+        if isinstance(entry, RandomBoxInsertion | RandomCylinderInsertion):
+            return _insert_random(entry, rng, existing_positions, existing_radii, walls_ok)
+        if isinstance(entry, FileInsertion | ListInsertion):
+            given = _insert_file(entry, walls_ok) if isinstance(entry, FileInsertion) else None
+            if isinstance(entry, ListInsertion):
+                given = _insert_list(entry)
+            assert given is not None
+            _check_given(
+                entry, given, key, domain, max_overlap_ratio, existing_positions, existing_radii
+            )
+            return given.particles
+    except ConfigError:
+        raise
+    except ValueError as exc:
+        text = str(exc)
+        if isinstance(entry, FileInsertion):
+            sep = ".path: "
+        else:
+            sep = "." if re.match(r"^[a-z_]+: ", text) else ": "
+        raise ConfigError(f"{key}{sep}{text}") from None
     raise TypeError(f"unknown insertion entry {type(entry).__name__}")
 
 
@@ -245,6 +324,13 @@ class Pourer:
         """Particles requested but not placed (the region was too full)."""
         self.last_time = float(entry.start_time)
         """Time up to which particles have been requested [s]."""
+        self.batch_cap = max(
+            1,
+            int(RSA_MAX_FRACTION * self._region.volume() / mean_sphere_volume(entry.distribution)),
+        )
+        """Most particles one batch tries to place: more than :data:`RSA_MAX_FRACTION` of the
+        region could not be placed anyway (the rest of the batch is skipped at once, which
+        bounds the work of a batch whatever the rate)."""
 
     @property
     def finished(self) -> bool:
@@ -291,6 +377,8 @@ class Pourer:
         self.last_time = max(self.last_time, t)
         if n <= 0:
             return InsertedParticles.empty(entry.material, entry.temperature is not None)
+        requested = n
+        n = min(n, self.batch_cap)
         radii = sample_radii(entry.distribution, n, self.rng)
         self._region.check_fits(float(radii.max()), "pour insertion")
         positions, placed = _random_fill(
@@ -304,6 +392,7 @@ class Pourer:
         )
         n_placed = int(placed.sum())
         self.inserted += n_placed
+        n = requested
         if n_placed < n:
             self.skipped += n - n_placed
             warnings.warn(
@@ -342,7 +431,16 @@ class Pourer:
 # --------------------------------------------------------------------------------------------
 
 
-def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None) -> InsertedParticles:
+@dataclass
+class _Given:
+    """Particles at given positions and where each one was given (for messages)."""
+
+    particles: InsertedParticles
+    where: Callable[[int], str]
+    """index -> 'insertion.0.positions.3' or "insertion.0.path: particle file 'f', line 7"."""
+
+
+def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None) -> _Given:
     parsed = _parse_particle_file(entry.path, entry.material)
     p = parsed.particles
     n = len(p)
@@ -358,4 +456,165 @@ def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None) -> InsertedPart
                 f"particle file {str(entry.path)!r}: {bad.size} particle(s) cut through or lie "
                 f"outside a wall, the first on line {parsed.line_numbers[bad[0]]}"
             )
-    return p
+
+    def where(i: int) -> str:
+        return f"particle file {str(entry.path)!r}, line {parsed.line_numbers[i]}"
+
+    return _Given(p, where)
+
+
+def _insert_list(entry: ListInsertion) -> _Given:
+    n = len(entry.positions)
+    if entry.velocities is not None:
+        velocity = np.asarray(entry.velocities, dtype=np.float64).reshape(n, 3)
+    else:
+        velocity = np.tile(np.asarray(entry.velocity, dtype=np.float64), (n, 1))
+    temperature = None
+    if entry.temperatures is not None:
+        temperature = np.asarray(entry.temperatures, dtype=np.float64)
+    elif entry.temperature is not None:
+        temperature = np.full(n, float(entry.temperature))
+    p = InsertedParticles(
+        position=np.asarray(entry.positions, dtype=np.float64).reshape(n, 3),
+        radius=entry.radius_array(),
+        velocity=velocity,
+        temperature=temperature,
+        material=entry.material,
+    )
+    return _Given(p, lambda i: f"positions.{i}")
+
+
+def _vec(x: np.ndarray) -> str:
+    return "[" + ", ".join(f"{float(c):.6g}" for c in x) + "]"
+
+
+def _check_given(
+    entry: FileInsertion | ListInsertion,
+    given: _Given,
+    key: str,
+    domain: tuple[np.ndarray, np.ndarray] | None,
+    limit: float,
+    existing_positions: np.ndarray | None,
+    existing_radii: np.ndarray | None,
+) -> None:
+    """Refuse given particles outside the domain, coincident or overlapping too deeply."""
+    p = given.particles
+    sep = "." if isinstance(entry, ListInsertion) else ".path: "
+
+    def at(i: int) -> str:
+        return f"{key}{sep}{given.where(i)}"
+
+    if domain is not None and len(p):
+        lower = np.asarray(domain[0], dtype=np.float64)
+        upper = np.asarray(domain[1], dtype=np.float64)
+        outside = np.any((p.position < lower) | (p.position > upper), axis=1)
+        bad = np.flatnonzero(outside)
+        if bad.size:
+            i = int(bad[0])
+            raise ConfigError(
+                f"{at(i)}: particle centre {_vec(p.position[i])} is outside the domain "
+                f"[{_vec(lower)}, {_vec(upper)}] ({bad.size} of {len(p)} particles are); move "
+                "the particles or enlarge domain"
+            )
+    found = _deepest_overlap(
+        p.position,
+        p.radius,
+        limit,
+        existing_positions,
+        existing_radii,
+        coincident_only=not entry.overlap_check,
+    )
+    if found is None:
+        return
+    i, j, ratio, other_entry = found
+    if other_entry:
+        assert existing_positions is not None and existing_radii is not None
+        other_pos = np.asarray(existing_positions, dtype=np.float64).reshape(-1, 3)[j]
+        other_rad = float(np.asarray(existing_radii).reshape(-1)[j])
+        other = f"a particle of an earlier insertion entry at {_vec(other_pos)}"
+    else:
+        other_pos, other_rad = p.position[j], float(p.radius[j])
+        other = f"the particle of {given.where(j)}" if sep != "." else f"{key}.{given.where(j)}"
+    distance = float(np.linalg.norm(p.position[i] - other_pos))
+    if distance <= COINCIDENT_DISTANCE * max(float(p.radius[i]), other_rad):
+        what = f"is at the same position as {other} (a duplicate row?)"
+    else:
+        what = (
+            f"overlaps {other} by {ratio:.3g} of the smaller radius (centres {distance:.6g} m "
+            "apart)"
+        )
+    rule = (
+        f"given particles may overlap by at most simulation.max_overlap_ratio = {limit:g} of the "
+        "smaller radius (two coincident particles never interact)"
+        if entry.overlap_check
+        else "coincident particles are refused even with overlap_check: false (they never interact)"
+    )
+    raise ConfigError(
+        f"{at(i)}: the particle at {_vec(p.position[i])} {what}; {rule}; remove or move one of them"
+    )
+
+
+def _deepest_overlap(
+    pos: np.ndarray,
+    rad: np.ndarray,
+    limit: float,
+    existing_positions: np.ndarray | None,
+    existing_radii: np.ndarray | None,
+    coincident_only: bool = False,
+) -> tuple[int, int, float, bool] | None:
+    """The first pair (in the order given) whose overlap exceeds ``limit`` × the smaller
+    radius (``coincident_only``: whose centres are within :data:`COINCIDENT_DISTANCE` × the
+    larger radius): (i, j, overlap ratio, j is an existing particle), or None.
+
+    Pairs come from a k-d tree (scipy.spatial.cKDTree) within ``r_i + r_max``: O(n log n).
+    """
+    from scipy.spatial import cKDTree
+
+    n = rad.shape[0]
+    if n == 0:
+        return None
+
+    def bad_pairs(pa, ra, pb, rb):  # noqa: ANN001, ANN202
+        if coincident_only:
+            d = np.sqrt(np.einsum("ij,ij->i", pa - pb, pa - pb))
+            return d <= COINCIDENT_DISTANCE * np.maximum(ra, rb)
+        return _overlap_ratio(pa, ra, pb, rb) > limit
+
+    tree = cKDTree(pos)
+    candidates: list[tuple[int, int, float, bool]] = []
+    reach = float(rad.max())
+    if n > 1:
+        cut = COINCIDENT_DISTANCE * reach if coincident_only else 2.0 * reach
+        pairs = tree.query_pairs(cut, output_type="ndarray")
+        if pairs.size:
+            a, b = pairs[:, 0], pairs[:, 1]
+            bad = np.flatnonzero(bad_pairs(pos[a], rad[a], pos[b], rad[b]))
+            if bad.size:
+                late = np.maximum(a[bad], b[bad])
+                k = bad[np.lexsort((np.minimum(a[bad], b[bad]), late))[0]]
+                i, j = max(int(a[k]), int(b[k])), min(int(a[k]), int(b[k]))
+                ratio = float(_overlap_ratio(pos[[i]], rad[[i]], pos[[j]], rad[[j]])[0])
+                candidates.append((i, j, ratio, False))
+    if existing_positions is not None and existing_radii is not None and len(existing_radii):
+        ex_pos = np.asarray(existing_positions, dtype=np.float64).reshape(-1, 3)
+        ex_rad = np.asarray(existing_radii, dtype=np.float64).reshape(-1)
+        reach = max(reach, float(ex_rad.max()))
+        cut = COINCIDENT_DISTANCE * reach if coincident_only else float(rad.max() + ex_rad.max())
+        m = tree.sparse_distance_matrix(cKDTree(ex_pos), cut, output_type="ndarray")
+        if m.size:
+            a, b = m["i"].astype(np.int64), m["j"].astype(np.int64)
+            bad = np.flatnonzero(bad_pairs(pos[a], rad[a], ex_pos[b], ex_rad[b]))
+            if bad.size:
+                k = bad[np.argmin(a[bad])]
+                i, j = int(a[k]), int(b[k])
+                ratio = float(_overlap_ratio(pos[[i]], rad[[i]], ex_pos[[j]], ex_rad[[j]])[0])
+                candidates.append((i, j, ratio, True))
+    if not candidates:
+        return None
+    return min(candidates, key=lambda c: c[0])
+
+
+def _overlap_ratio(pa: np.ndarray, ra: np.ndarray, pb: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    """(r_a + r_b - |x_a - x_b|) / min(r_a, r_b) for each pair (coincident: >= 2)."""
+    d = np.sqrt(np.einsum("ij,ij->i", pa - pb, pa - pb))
+    return (ra + rb - d) / np.minimum(ra, rb)

@@ -4,7 +4,8 @@ File layout (``h5py``)::
 
     /                  attributes: format = "thermodem-checkpoint", format_version,
                        thermodem_version, kind ("checkpoint" | "interrupted" | "final" |
-                       "failed"), step, time, created (ISO time), message
+                       "failed"), step, time, created (ISO time), message, run_id (the
+                       run directory it was written for, "" outside a run directory)
     /case_yaml         the resolved case (every default filled in), a UTF-8 string
     /scalars_json      JSON of the scalar state (time, step, ids, ledger, random generator
                        state, pour state, ...)
@@ -20,6 +21,11 @@ killed while writing leaves the previous file intact.
 
 A ``failed`` checkpoint holds the state at the moment a :class:`SimulationError` was raised
 (in the middle of a step) for inspection; it cannot be restarted from.
+
+Reading checks the file completely before anything uses it (:func:`read_checkpoint`): a
+missing attribute, group or dataset, scalars that are not JSON, a stored case that is not
+YAML or not a valid case, arrays of inconsistent lengths
+(:func:`thermodem.engine.restart.check_state`) each give one ConfigError naming the file.
 """
 
 from __future__ import annotations
@@ -73,11 +79,14 @@ def write_checkpoint(
     message: str = "",
     fsync: bool = False,
     case_yaml: str | None = None,
+    run_id: str = "",
 ) -> Path:
     """Write the complete state of ``sim`` to ``path`` atomically; returns the path.
 
     ``case_yaml``: the resolved case text if the caller has it already (it is the same for
     every checkpoint of a run and costs more to produce than the arrays of a small case).
+    ``run_id``: the identity of the run directory (``status.json``), so that a restart can
+    refuse a checkpoint copied in from another run.
     """
     import h5py
 
@@ -99,6 +108,7 @@ def write_checkpoint(
         f.attrs["time"] = float(sim.time)
         f.attrs["created"] = _dt.datetime.now().isoformat(timespec="seconds")
         f.attrs["message"] = message
+        f.attrs["run_id"] = run_id
         text = h5py.string_dtype("utf-8")
         if case_yaml is None:
             case_yaml = resolved_case_yaml(sim.case)
@@ -135,6 +145,7 @@ class Checkpoint:
     time: float
     created: str
     message: str
+    run_id: str = ""
 
     def case(self) -> Case:
         """The case stored in the checkpoint, validated."""
@@ -142,7 +153,14 @@ class Checkpoint:
 
         from thermodem.config.load import case_from_dict
 
-        return case_from_dict(yaml.safe_load(self.case_yaml), f"{self.path} (stored case)")
+        try:
+            data = yaml.safe_load(self.case_yaml)
+        except yaml.YAMLError as exc:
+            raise ConfigError(
+                f"checkpoint {self.path}: the stored case is not valid YAML "
+                f"({_yaml_problem(exc)}); the file is damaged"
+            ) from None
+        return case_from_dict(data, f"{self.path} (stored case)")
 
 
 def _read_group(group: Any) -> dict[str, np.ndarray]:
@@ -153,8 +171,32 @@ def _text(value: Any) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
+def _yaml_problem(exc: Exception) -> str:
+    """One line for a YAML error: the problem and where."""
+    import yaml
+
+    if isinstance(exc, yaml.MarkedYAMLError) and exc.problem_mark is not None:
+        mark = exc.problem_mark
+        return f"{exc.problem} at line {mark.line + 1}, column {mark.column + 1}"
+    return " ".join(str(exc).split())
+
+
+def _check_case_yaml(text: str, damaged: str) -> None:
+    import yaml
+
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(
+            f"{damaged}: the stored case is not valid YAML ({_yaml_problem(exc)})"
+        ) from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{damaged}: the stored case is not a mapping of sections")
+
+
 def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
-    """Read a checkpoint file (ConfigError with one line if it is missing or not one)."""
+    """Read a checkpoint file and check it completely (ConfigError with one line if it is
+    missing, not a checkpoint, or damaged: a missing group, bad JSON, short arrays)."""
     import h5py
 
     path = Path(path)
@@ -164,36 +206,69 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
         f = h5py.File(path, "r")
     except OSError as exc:
         raise ConfigError(f"checkpoint {str(path)!r} is not a readable HDF5 file: {exc}") from None
+    damaged = f"checkpoint {path} is damaged or incomplete"
     with f:
         if _text(f.attrs.get("format", "")) != FORMAT:
             raise ConfigError(f"{path} is not a thermodem checkpoint")
-        version = int(f.attrs["format_version"])
+        absent = [
+            k for k in ("format_version", "kind", "step", "time", "created") if k not in f.attrs
+        ]
+        if absent:
+            raise ConfigError(f"{damaged}: attribute(s) {', '.join(absent)} missing")
+        try:
+            version = int(f.attrs["format_version"])
+            attrs = {k: f.attrs[k] for k in ("kind", "step", "time", "created")}
+            attrs["message"] = f.attrs.get("message", "")
+            attrs["run_id"] = f.attrs.get("run_id", "")
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ConfigError(f"{damaged}: attribute {exc} is missing or wrong") from None
         if version != FORMAT_VERSION:
             raise ConfigError(
                 f"{path}: checkpoint format version {version}, this thermodem reads "
                 f"{FORMAT_VERSION}"
             )
-        state: dict[str, Any] = {
-            "scalars": json.loads(_text(f["scalars_json"][()])),
-        }
-        for group in ("particles", "pairs", "walls", "arrays"):
-            state[group] = _read_group(f[group])
+        required = ("case_yaml", "scalars_json", "particles", "pairs", "walls", "arrays")
+        lacking = [name for name in required if name not in f]
         if "thermal" in f:
-            g = f["thermal"]
-            state["thermal"] = {
-                "scalars": json.loads(_text(g["scalars_json"][()])),
-                "arrays": _read_group(g["arrays"]),
-            }
-        return Checkpoint(
-            path=path,
-            case_yaml=_text(f["case_yaml"][()]),
-            state=state,
-            kind=_text(f.attrs["kind"]),
-            step=int(f.attrs["step"]),
-            time=float(f.attrs["time"]),
-            created=_text(f.attrs["created"]),
-            message=_text(f.attrs.get("message", "")),
-        )
+            lacking += [f"thermal/{n}" for n in ("scalars_json", "arrays") if n not in f["thermal"]]
+        if lacking:
+            raise ConfigError(f"{damaged}: it has no {', '.join(lacking)}")
+        try:
+            state: dict[str, Any] = {"scalars": json.loads(_text(f["scalars_json"][()]))}
+            for group in ("particles", "pairs", "walls", "arrays"):
+                state[group] = _read_group(f[group])
+            if "thermal" in f:
+                g = f["thermal"]
+                state["thermal"] = {
+                    "scalars": json.loads(_text(g["scalars_json"][()])),
+                    "arrays": _read_group(g["arrays"]),
+                }
+            case_yaml = _text(f["case_yaml"][()])
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"{damaged}: its scalars are not valid JSON ({exc})") from None
+        except (KeyError, OSError, TypeError, ValueError) as exc:
+            raise ConfigError(f"{damaged}: {exc}") from None
+        kind = _text(attrs["kind"])
+        if kind not in KINDS:
+            raise ConfigError(f"{damaged}: kind {kind!r} is not one of {', '.join(KINDS)}")
+    from thermodem.engine.restart import check_state
+
+    _check_case_yaml(case_yaml, damaged)
+    try:
+        check_state(state)
+    except ConfigError as exc:
+        raise ConfigError(f"{damaged}: {exc}") from None
+    return Checkpoint(
+        path=path,
+        case_yaml=case_yaml,
+        state=state,
+        kind=kind,
+        step=int(attrs["step"]),
+        time=float(attrs["time"]),
+        created=_text(attrs["created"]),
+        message=_text(attrs["message"]),
+        run_id=_text(attrs["run_id"]),
+    )
 
 
 def load_simulation(

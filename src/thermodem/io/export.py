@@ -66,9 +66,8 @@ class ParticleTable:
 
 def from_frame(directory: Path, frame: int) -> ParticleTable:
     """The particles of frame ``frame`` of ``directory/particles.pvd``."""
-    import meshio
 
-    from thermodem.io.vtk import PVDWriter, read_name_table
+    from thermodem.io.vtk import PVDWriter, read_name_table, read_vtu
 
     pvd = directory / "particles.pvd"
     if not pvd.is_file():
@@ -84,7 +83,7 @@ def from_frame(directory: Path, frame: int) -> ParticleTable:
     time, _, file = entries[frame]
     path = directory / file
     try:
-        mesh = meshio.read(path)
+        mesh = read_vtu(path)
     except Exception as exc:  # noqa: BLE001 (any reader failure is one message)
         raise ConfigError(f"frame {frame} ({path}) cannot be read: {exc}") from None
     data = mesh.point_data

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+import warnings
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,6 +16,25 @@ if TYPE_CHECKING:
 
 FILE_REQUIRED_COLUMNS = ("x", "y", "z", "radius")
 FILE_OPTIONAL_COLUMNS = ("vx", "vy", "vz", "temperature")
+
+#: Header names accepted for each column (case-insensitive). ``diameter``/``d`` replace
+#: ``radius`` (the radius is half of it).
+COLUMN_ALIASES: dict[str, tuple[str, ...]] = {
+    "x": ("x",),
+    "y": ("y",),
+    "z": ("z",),
+    "radius": ("radius", "r", "rad"),
+    "diameter": ("diameter", "d", "diam"),
+    "vx": ("vx",),
+    "vy": ("vy",),
+    "vz": ("vz",),
+    "temperature": ("temperature", "t", "temp"),
+}
+_CANONICAL = {alias: name for name, aliases in COLUMN_ALIASES.items() for alias in aliases}
+_ALLOWED_TEXT = (
+    "x, y, z, radius (or r, rad; or diameter, d), and optionally vx, vy, vz and temperature "
+    "(or t, temp)"
+)
 
 
 @dataclass
@@ -32,28 +53,90 @@ class _ParsedFile:
         return self.lines
 
 
+def _header_names(line: str) -> list[str]:
+    """Column names of a header line: a leading ``#`` allowed, text after ``;`` or a second
+    ``#`` is a comment (``# x y z r ; box 0.09 0.09 0.055``), units in brackets dropped
+    (``x[m]``, ``radius (m)``), commas or blanks between names; lower case."""
+    text = line.strip().lstrip("#")
+    text = re.split(r"[;#]", text, maxsplit=1)[0]
+    text = re.sub(r"\[[^\]]*\]|\([^)]*\)", " ", text)
+    return text.replace(",", " ").lower().split()
+
+
+def _is_header(line: str) -> bool:
+    names = _header_names(line)
+    return bool(names) and all(n in _CANONICAL for n in names)
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
 def _content_lines(lines: Iterable[str]) -> Iterator[tuple[int, str, bool]]:
-    """(line number, stripped text, is the header) of the header and of every data line: the
-    header is the first non-blank line (a leading # allowed); blank lines and later # lines
-    are skipped."""
+    """(line number, text, is the header) of the header and of every data line.
+
+    The header is the first of the leading ``#`` lines that names only known columns
+    (comment lines may come before it), else the first line that does not start with ``#``.
+    After the header, blank lines, ``#`` lines and text after a ``#`` on a data line are
+    skipped. When no line qualifies, the first non-blank line is reported as the header (so
+    that the checked parser names it in its message).
+    """
     header_seen = False
+    first_comment: tuple[int, str] | None = None
     for lineno, raw in enumerate(lines, start=1):
         line = raw.strip()
-        if not line or (header_seen and line.startswith("#")):
+        if not line:
             continue
-        yield lineno, line, not header_seen
+        if header_seen:
+            if line.startswith("#"):
+                continue
+            line = line.split("#", 1)[0].strip()
+            if line:
+                yield lineno, line, False
+            continue
+        if line.startswith("#"):
+            if _is_header(line):
+                header_seen = True
+                yield lineno, line, True
+            elif first_comment is None:
+                first_comment = (lineno, line)
+            continue
         header_seen = True
-
-
-def _header_names(line: str) -> list[str]:
-    return line.lstrip("#").replace(",", " ").lower().split()
+        text = line.split("#", 1)[0].strip()
+        tokens = text.replace(",", " ").split()
+        if first_comment is not None and tokens and _is_number(tokens[0]):
+            # comment lines, then data: the header is missing (or misspelt in a comment)
+            yield first_comment[0], first_comment[1], True
+            yield lineno, text, False
+        else:
+            yield lineno, line, True
+    if not header_seen and first_comment is not None:
+        yield first_comment[0], first_comment[1], True
 
 
 def _data_line_numbers(path: Path) -> np.ndarray:
     """Line numbers of the data lines."""
-    with path.open() as f:
+    with path.open(encoding="utf-8") as f:
         numbers = [n for n, _, is_header in _content_lines(f) if not is_header]
     return np.asarray(numbers, dtype=np.int64)
+
+
+def _columns(header: list[str]) -> dict[str, int] | None:
+    """Canonical column name -> index, None unless the header is complete and unambiguous."""
+    names = [_CANONICAL.get(n) for n in header]
+    if any(n is None for n in names) or len(set(names)) != len(names):
+        return None
+    col = {str(n): j for j, n in enumerate(names)}
+    if ("radius" in col) == ("diameter" in col) or any(a not in col for a in "xyz"):
+        return None
+    vel = [a in col for a in ("vx", "vy", "vz")]
+    if any(vel) and not all(vel):
+        return None
+    return col
 
 
 def _parse_particle_file(path: str | Path, material: str = "") -> _ParsedFile:
@@ -71,7 +154,7 @@ def _parse_fast(path: Path, material: str) -> _ParsedFile | None:
         header: list[str] | None = None
         header_line = 0
         comma = False
-        with path.open() as f:
+        with path.open(encoding="utf-8") as f:
             for lineno, line, is_header in _content_lines(f):
                 if is_header:
                     header = _header_names(line)
@@ -79,33 +162,28 @@ def _parse_fast(path: Path, material: str) -> _ParsedFile | None:
                 else:  # the first data line tells the delimiter
                     comma = "," in line
                     break
-        if not header or len(set(header)) != len(header):
+        col = _columns(header) if header else None
+        if col is None:
             return None
-        allowed = FILE_REQUIRED_COLUMNS + FILE_OPTIONAL_COLUMNS
-        if any(name not in allowed for name in header) or any(
-            name not in header for name in FILE_REQUIRED_COLUMNS
-        ):
-            return None
-        vel = [name in header for name in ("vx", "vy", "vz")]
-        if any(vel) and not all(vel):
-            return None
-        data = np.loadtxt(
-            path,
-            dtype=np.float64,
-            comments="#",
-            delimiter="," if comma else None,
-            skiprows=header_line,
-            ndmin=2,
-        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "input contained no data": the checked parser says
+            data = np.loadtxt(
+                path,
+                dtype=np.float64,
+                comments="#",
+                delimiter="," if comma else None,
+                skiprows=header_line,
+                ndmin=2,
+                encoding="utf-8",
+            )
     except (ValueError, OSError, UnicodeDecodeError):
         return None
-    if data.shape[1] != len(header) or data.shape[0] == 0 or not np.isfinite(data).all():
+    if data.shape[1] != len(col) or data.shape[0] == 0 or not np.isfinite(data).all():
         return None
-    col = {name: j for j, name in enumerate(header)}
-    for name in ("radius", "temperature"):
+    for name in ("radius", "diameter", "temperature"):
         if name in col and not (data[:, col[name]] > 0.0).all():
             return None
-    return _assemble(data, col, all(vel), material, None, path)
+    return _assemble(data, col, "vx" in col, material, None, path)
 
 
 def _assemble(
@@ -120,9 +198,13 @@ def _assemble(
     velocity = data[:, [col["vx"], col["vy"], col["vz"]]] if has_velocity else np.zeros((n, 3))
     from thermodem.geometry.insertion import InsertedParticles
 
+    if "radius" in col:
+        radius = np.ascontiguousarray(data[:, col["radius"]])
+    else:
+        radius = 0.5 * data[:, col["diameter"]]
     particles = InsertedParticles(
         position=np.ascontiguousarray(data[:, [col["x"], col["y"], col["z"]]]),
-        radius=np.ascontiguousarray(data[:, col["radius"]]),
+        radius=radius,
         velocity=np.ascontiguousarray(velocity),
         temperature=np.ascontiguousarray(data[:, col["temperature"]])
         if "temperature" in col
@@ -132,13 +214,29 @@ def _assemble(
     return _ParsedFile(particles, lines, has_velocity, "temperature" in col, path)
 
 
+def _read_text(path: Path) -> str:
+    where = f"particle file {str(path)!r}"
+    if not path.exists():
+        raise ValueError(f"{where} does not exist")
+    if path.is_dir():
+        raise ValueError(f"{where} is a directory, expected a text file")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"cannot read {where}: {exc.strerror}") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ValueError(
+            f"{where}, line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset "
+            f"{exc.start}); particle files are plain text (save it as UTF-8 or ASCII)"
+        ) from None
+
+
 def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
     """Token-by-token parse that names the file, line and column of the first problem."""
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ValueError(f"cannot read particle file {str(path)!r}: {exc}") from exc
-    allowed = FILE_REQUIRED_COLUMNS + FILE_OPTIONAL_COLUMNS
+    text = _read_text(path)
     header: list[str] | None = None
     header_line = 0
     rows: list[list[str]] = []
@@ -154,29 +252,48 @@ def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
     if not header:
         raise ValueError(
             f"{where} is empty: the first line must be a header naming the columns "
-            f"({' '.join(FILE_REQUIRED_COLUMNS)} required; {' '.join(FILE_OPTIONAL_COLUMNS)} "
-            "optional)"
+            f"({_ALLOWED_TEXT})"
         )
     for name in header:
-        if name not in allowed:
+        if name not in _CANONICAL:
+            if _is_number(name):
+                raise ValueError(
+                    f"{where}, line {header_line}: no header; the first line must name the "
+                    f"columns ({_ALLOWED_TEXT}), e.g. 'x y z radius', but it starts with the "
+                    f"number {name!r}"
+                )
             raise ValueError(
                 f"{where}, line {header_line}: unknown column {name!r} in the header; allowed "
-                f"columns are {', '.join(allowed)} (the first line must be the header)"
+                f"columns are {_ALLOWED_TEXT} (the first line must be the header; text after "
+                "';' or '#' is a comment)"
             )
-    duplicated = sorted({name for name in header if header.count(name) > 1})
+    canonical = [_CANONICAL[n] for n in header]
+    duplicated = sorted({n for n in canonical if canonical.count(n) > 1})
     if duplicated:
-        raise ValueError(f"{where}, line {header_line}: column(s) {duplicated} appear twice")
-    missing = [name for name in FILE_REQUIRED_COLUMNS if name not in header]
+        raise ValueError(
+            f"{where}, line {header_line}: column(s) {duplicated} appear twice (names and "
+            "their aliases count as the same column)"
+        )
+    if "radius" in canonical and "diameter" in canonical:
+        raise ValueError(f"{where}, line {header_line}: give the radius or the diameter, not both")
+    missing = [a for a in "xyz" if a not in canonical]
+    if "radius" not in canonical and "diameter" not in canonical:
+        missing.append("radius")
     if missing:
         raise ValueError(
             f"{where}, line {header_line}: the header lacks required column(s) "
-            f"{', '.join(missing)}; it must name x, y, z and radius"
+            f"{', '.join(missing)}; it must name x, y, z and radius (or r, or diameter)"
         )
-    vel_cols = [name for name in ("vx", "vy", "vz") if name in header]
+    vel_cols = [name for name in ("vx", "vy", "vz") if name in canonical]
     if vel_cols and len(vel_cols) != 3:
         raise ValueError(
             f"{where}, line {header_line}: give all of vx, vy, vz or none, got only "
             f"{', '.join(vel_cols)}"
+        )
+    if not rows:
+        raise ValueError(
+            f"{where} has a header (line {header_line}) but no particle rows: give one line "
+            f"of {' '.join(header)} per particle"
         )
     ncol = len(header)
     lines = np.asarray(line_numbers, dtype=np.int64)
@@ -185,36 +302,34 @@ def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
     if bad.size:
         i = int(bad[0])
         raise ValueError(
-            f"{where}, line {lines[i]}: expected {ncol} values ({' '.join(header)}), "
-            f"found {widths[i]}"
+            f"{where}, line {lines[i]}: expected {ncol} values ({' '.join(header)}, as the "
+            f"header on line {header_line} names), found {widths[i]}"
         )
     try:
         data = np.array(rows, dtype=np.float64).reshape(len(rows), ncol)
     except ValueError:
         for i, row in enumerate(rows):
             for j, token in enumerate(row):
-                try:
-                    float(token)
-                except ValueError:
+                if not _is_number(token):
                     raise ValueError(
                         f"{where}, line {lines[i]}, column {header[j]!r}: {token!r} is not a number"
                     ) from None
         raise
-    col = {name: j for j, name in enumerate(header)}
+    col = {name: j for j, name in enumerate(canonical)}
     nonfinite = np.argwhere(~np.isfinite(data))
     if nonfinite.size:
         i, j = (int(v) for v in nonfinite[0])
         raise ValueError(
             f"{where}, line {lines[i]}, column {header[j]!r}: value {data[i, j]!r} is not finite"
         )
-    for name in ("radius", "temperature"):
+    for name in ("radius", "diameter", "temperature"):
         if name in col:
             bad = np.flatnonzero(data[:, col[name]] <= 0.0)
             if bad.size:
                 i = int(bad[0])
                 raise ValueError(
-                    f"{where}, line {lines[i]}, column {name!r}: value {data[i, col[name]]!r} "
-                    "must be > 0"
+                    f"{where}, line {lines[i]}, column {header[col[name]]!r}: value "
+                    f"{data[i, col[name]]!r} must be > 0"
                 )
     return _assemble(data, col, bool(vel_cols), material, lines, path)
 
@@ -222,11 +337,15 @@ def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
 def load_particle_file(path: str | Path, material: str = "") -> InsertedParticles:
     """Read particles from a whitespace- or comma-separated text file.
 
-    The first non-blank line is the header naming the columns (a leading ``#`` is allowed):
-    ``x y z radius`` are required, ``vx vy vz`` (all three) and ``temperature`` are optional;
-    columns may come in any order. Blank lines and later lines starting with ``#`` are ignored.
-    Missing velocity columns give zero velocities; a missing temperature column gives
-    ``temperature=None``. Errors name the file, the line number and the column.
+    The header names the columns (a leading ``#`` is allowed; comment lines may come before
+    it; text after ``;`` or a second ``#`` on it is a comment, so a LIGGGHTS/Yade-style
+    ``# x y z r ; box ...`` works): ``x y z radius`` are required (``r``/``rad`` for radius,
+    or ``diameter``/``d`` instead), ``vx vy vz`` (all three) and ``temperature`` (``t``,
+    ``temp``) are optional (:data:`COLUMN_ALIASES`); names are case-insensitive and columns
+    may come in any order. Blank lines, later lines starting with ``#`` and text after ``#``
+    on a data line are ignored. Missing velocity columns give zero velocities; a missing
+    temperature column gives ``temperature=None``. Errors name the file, the line number and
+    the column (a missing file, a header without rows, text that is not UTF-8 included).
     """
     return _parse_particle_file(path, material).particles
 

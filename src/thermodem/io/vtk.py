@@ -13,6 +13,11 @@ colouring by a particle field) act on both blocks at once. With two collections 
 two independent pipeline sources. :class:`PVDWriter` nevertheless supports the ``part``
 attribute, so both kinds of frame can share one PVD (particles part 0, walls part 1) if wanted.
 
+A frame of an empty bed (before a pour starts, or after every particle left) is a valid VTU
+with no points: VTK reads it (checked with VTK 9.7.2 in ``tests/run/test_faults.py``), meshio
+5.3 does not (its reader fails on any file without cells, meshio issue #1412): read frames
+back with :func:`read_vtu`, which handles both.
+
 The VTU files are written with meshio as uncompressed base64 "binary" XML (``header_type``
 UInt64, so a single array may exceed 4 GiB); they read back with meshio and with VTK's
 ``vtkXMLUnstructuredGridReader`` (checked with VTK 9.7: vertex cells, all arrays and dtypes
@@ -86,6 +91,7 @@ __all__ = [
     "write_particles_vtu",
     "write_wall_frame",
     "write_walls_vtu",
+    "read_vtu",
 ]
 
 #: ``part`` index of particle frames when particles and walls share one PVD.
@@ -471,6 +477,93 @@ def write_wall_frame(path: str | os.PathLike[str], sim: Simulation, extent: floa
         extent,
         names=list(sim.wall_labels),
         tables={"material_id": list(sim.material_names)},
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Reading back
+# --------------------------------------------------------------------------------------------
+
+_VTK_DTYPES = {
+    "Int8": np.int8,
+    "UInt8": np.uint8,
+    "Int16": np.int16,
+    "UInt16": np.uint16,
+    "Int32": np.int32,
+    "UInt32": np.uint32,
+    "Int64": np.int64,
+    "UInt64": np.uint64,
+    "Float32": np.float32,
+    "Float64": np.float64,
+}
+
+
+def _field_data(root: ET.Element) -> dict[str, np.ndarray]:
+    """The FieldData arrays of an uncompressed VTU (ascii or base64 binary), as meshio
+    returns them; {} for a compressed file (not written by default)."""
+    import base64
+
+    if root.get("compressor"):
+        return {}
+    header = np.dtype(_VTK_DTYPES[root.get("header_type", "UInt32")]).newbyteorder("<")
+    out: dict[str, np.ndarray] = {}
+    for da in root.iterfind("UnstructuredGrid/FieldData/DataArray"):
+        dtype = np.dtype(_VTK_DTYPES.get(da.get("type", "Float64"), np.float64))
+        text = (da.text or "").strip()
+        if da.get("format") == "ascii":
+            values = np.array(text.split(), dtype=dtype)
+        else:
+            raw = base64.b64decode(text)
+            nbytes = int(np.frombuffer(raw[: header.itemsize], header)[0])
+            values = np.frombuffer(raw[header.itemsize : header.itemsize + nbytes], dtype).copy()
+        k = int(da.get("NumberOfComponents", "1"))
+        out[da.get("Name", "")] = values.reshape(-1, k) if k > 1 else values
+    return out
+
+
+def read_vtu(path: str | os.PathLike[str]) -> meshio.Mesh:
+    """Read a VTU written here, including an empty frame (no particles yet, or none left).
+
+    An empty frame is a valid VTK file (``NumberOfPoints="0"``; VTK's
+    ``vtkXMLUnstructuredGridReader`` reads it with its arrays), but meshio 5.3's VTU reader
+    fails on any file without cells (IndexError, meshio issue #1412). For such a file this
+    returns a mesh with no points, one empty cell block (``triangle`` for a walls file, which
+    has cell data, else ``vertex``), every point and cell array, empty, with its dtype and
+    number of components, and the field data (name tables); other files go to
+    :func:`meshio.read`.
+    """
+    p = Path(path)
+    root = ET.parse(p).getroot()
+    piece = root.find("UnstructuredGrid/Piece")
+    if piece is None or int(piece.get("NumberOfCells", "1")) != 0:
+        return meshio.read(p)
+
+    def empty(section: str) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        for da in piece.iterfind(f"{section}/DataArray"):
+            k = int(da.get("NumberOfComponents", "1"))
+            dtype = _VTK_DTYPES.get(da.get("type", "Float64"), np.float64)
+            out[da.get("Name", "")] = np.zeros((0, k) if k > 1 else (0,), dtype=dtype)
+        return out
+
+    cell_data = {name: [value] for name, value in empty("CellData").items()}
+    field_data = _field_data(root)
+    points = np.zeros((int(piece.get("NumberOfPoints", "0")), 3))
+    if points.shape[0]:  # points but no cells: not something written here
+        return meshio.read(p)
+    # one empty block of the kind written here: triangles for walls (they carry cell data),
+    # vertices for particles
+    block = (
+        ("triangle", np.zeros((0, 3), np.int64))
+        if cell_data
+        else ("vertex", np.zeros((0, 1), np.int64))
+    )
+    return meshio.Mesh(
+        points,
+        [block],
+        point_data=empty("PointData"),
+        cell_data=cell_data or None,
+        field_data=field_data,
     )
 
 

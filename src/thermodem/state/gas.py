@@ -40,7 +40,12 @@ class GasProperties(StrictModel):
     thermal_conductivity: float = Field(default=0.0263, gt=0, description="k_g [W/(m K)]")
     specific_heat: float = Field(default=1007.0, gt=0, description="c_p,g [J/(kg K)]")
     dynamic_viscosity: float = Field(default=1.846e-5, gt=0, description="μ_g [Pa s]")
-    heat_capacity_ratio: float = Field(default=1.4, gt=1, description="γ_g = c_p/c_v [-]")
+    heat_capacity_ratio: float = Field(
+        default=1.4,
+        ge=1,
+        description="γ_g = c_p/c_v [-]; 1 is allowed (the limit of many internal degrees of "
+        "freedom; Lethe's resistance tests use it): the factor 2γ/(1 + γ) of M is then 1",
+    )
     mean_free_path: float | None = Field(
         default=None, gt=0, description="Λ [m]; null: from pressure, temperature, diameter"
     )

@@ -80,12 +80,26 @@ class Material(StrictModel):
 
 
 class InteractionOverride(StrictModel):
-    """Pair-specific mechanical coefficients that replace the mixing rule for one pair."""
+    """Pair-specific coefficients that replace the mixing rule for one pair of materials.
+
+    Mechanical: ``restitution``, ``sliding_friction``, ``rolling_friction`` (replace the mean
+    of the two materials). Surface of the pair for the resistance network (Beaulieu 2020):
+    ``surface_roughness`` σ and ``surface_slope`` τ are the pair's *equivalent* values, which
+    otherwise are σ = √(σ_i² + σ_j²) and τ = √(τ_i² + τ_j²) of the materials (Bahrami et al.
+    2006); a source that gives equivalent values (Lethe's tests: σ = 25 nm, τ = 0.078) puts them
+    here, and the materials then need not give their own.
+    """
 
     materials: tuple[str, str]
     restitution: float | None = Field(default=None, ge=0.0, le=1.0)
     sliding_friction: float | None = Field(default=None, ge=0.0)
     rolling_friction: float | None = Field(default=None, ge=0.0)
+    surface_roughness: float | None = Field(
+        default=None, gt=0, description="equivalent RMS roughness σ of the pair [m]"
+    )
+    surface_slope: float | None = Field(
+        default=None, gt=0, description="equivalent RMS asperity slope τ of the pair [-]"
+    )
 
 
 def effective_youngs_modulus(mi: Material, mj: Material, real: bool = False) -> float:
@@ -113,6 +127,9 @@ class PairContext:
 
     ``gas`` is the case's interstitial gas (``thermal.gas``), the same for every pair; models
     that need a gas read it here. Default: air at 300 K, 1 atm, as the case-file default.
+
+    ``surface_roughness`` and ``surface_slope``: the pair's equivalent σ and τ when an
+    ``interactions`` entry gives them, else None (a model combines the materials' values).
     """
 
     mat_i: Material
@@ -122,6 +139,8 @@ class PairContext:
     rolling_friction: float
     is_wall: bool = False
     gas: GasProperties = field(default_factory=GasProperties)
+    surface_roughness: float | None = None
+    surface_slope: float | None = None
 
     @property
     def effective_youngs_modulus(self) -> float:
@@ -155,4 +174,6 @@ def resolve_pair(
         rolling_friction=pick("rolling_friction"),
         is_wall=is_wall,
         gas=gas if gas is not None else GasProperties(),
+        surface_roughness=None if override is None else override.surface_roughness,
+        surface_slope=None if override is None else override.surface_slope,
     )

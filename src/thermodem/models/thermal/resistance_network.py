@@ -230,8 +230,9 @@ def pack_resistance_network(params: ResistanceNetworkParams, pair: PairContext) 
 
     k_i, k_j = both("thermal_conductivity")
     h_i, h_j = both("microhardness")
-    s_i, s_j = both("surface_roughness")
-    t_i, t_j = both("surface_slope")
+    # equivalent σ, τ of the pair: an interactions entry's, else from the two materials
+    sigma = pair.surface_roughness or math.hypot(*both("surface_roughness"))
+    tau = pair.surface_slope or math.hypot(*both("surface_slope"))
     a_i, a_j = both("thermal_accommodation")
     e_sim = pair.effective_youngs_modulus
     real = mi.youngs_modulus_real is not None or mj.youngs_modulus_real is not None
@@ -245,8 +246,8 @@ def pack_resistance_network(params: ResistanceNetworkParams, pair: PairContext) 
             e_sim,
             c,
             2.0 * h_i * h_j / (h_i + h_j),
-            math.hypot(s_i, s_j),
-            math.hypot(t_i, t_j),
+            sigma,
+            tau,
             pair.gas.thermal_conductivity,
             gas_parameter(a_i, a_j, pair.gas),
             params.packing_constant,
