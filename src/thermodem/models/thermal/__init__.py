@@ -1,11 +1,9 @@
-"""Thermal models (imported to register them)."""
+"""Thermal models, one module per family or model group; importing the package imports every
+module in it, whose ``register()`` calls fill the registry (a new model module needs no line
+here)."""
 
-from thermodem.models.thermal import (  # noqa: F401
-    contact_radius,
-    direct_conduction,
-    indirect_conduction,
-    radiation,
-    resistance_network,
-    surrounding_layer,
-    vargas_mccarthy,
-)
+import importlib
+import pkgutil
+
+for _module in pkgutil.iter_modules(__path__):
+    importlib.import_module(f"{__name__}.{_module.name}")
