@@ -2,6 +2,7 @@
 
 from thermodem.models.thermal import (  # noqa: F401
     contact_radius,
+    convection,
     direct_conduction,
     indirect_conduction,
     radiation,
