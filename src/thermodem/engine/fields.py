@@ -165,7 +165,7 @@ class FieldProvider:
             if self.radiation is not None and self.radiation.table.ndim == 2
             else np.zeros(1)
         )
-        self.lattice = fk.unit_ball_lattice()
+        self.lattice = fk.unit_ball_points()
         self.solid = np.zeros(0)
         self.scratch = np.zeros((1, 4))
         # cell porosity (the grid is set up at the first evaluation: its default size)
@@ -202,7 +202,7 @@ class FieldProvider:
             if components == 1 and not (values > 0).all():
                 k = np.argwhere(values <= 0)[0]
                 raise ConfigError(
-                    f"{key}.file: temperature {values[tuple(k)]!r} K at grid index "
+                    f"{key}.file: temperature {float(values[tuple(k)])!r} K at grid index "
                     f"{tuple(int(v) for v in k[:3])} of {source.file}; temperatures must be > 0"
                 )
             return ("grid", axes, values, source.file)
@@ -347,7 +347,7 @@ class FieldProvider:
                 k = int(np.argmax(bad))
                 raise SimulationError(
                     f"thermal.fluid.temperature: the expression {source[2][0]!r} gives "
-                    f"{values[k]!r} K at particle {int(p.global_id[k])} (x, y, z = "
+                    f"{float(values[k])!r} K at particle {int(p.global_id[k])} (x, y, z = "
                     f"{tuple(float(v) for v in pos[k])}) at step {self.sim.step_count} "
                     f"(t = {time:.6g} s); temperatures must be finite and > 0",
                     self.sim.step_count,

@@ -93,7 +93,8 @@ def _checked(path: Path, axes, values: np.ndarray, components: int) -> Grid:  # 
     bad = ~np.isfinite(values)
     if bad.any():
         k = np.argwhere(bad)[0]
-        raise ValueError(f"{path}: value {values[tuple(k)]!r} at grid index {tuple(k[:3])}")
+        where = tuple(int(v) for v in k[:3])
+        raise ValueError(f"{path}: value {float(values[tuple(k)])!r} at grid index {where}")
     return axes, np.ascontiguousarray(values)
 
 
@@ -533,8 +534,9 @@ def _read_vtk_legacy(path: Path, names: tuple[str, ...], components: int, locati
             break
     else:
         raise ValueError(
-            f"no data array {'/'.join(names)!r}; point data: {sorted(arrays['point'])}, cell "
-            f"data: {sorted(arrays['cell'])}"
+            f"no {location if location != 'auto' else 'point or cell'} data array "
+            f"{'/'.join(names)!r}; point data: {sorted(arrays['point'])}, cell data: "
+            f"{sorted(arrays['cell'])}"
         )
     if values.shape[1] != components:
         raise ValueError(
