@@ -18,8 +18,11 @@ DATA = Path(__file__).resolve().parents[1] / "data" / "grids"
 sys.path.insert(0, str(DATA))
 from expected import AXES, temperature, velocity  # noqa: E402
 
-VTK_FILES = sorted(p.name for p in DATA.iterdir() if p.suffix in (".vti", ".vtr", ".vts", ".vtk")
-                   and p.stem != "curvilinear")  # fmt: skip
+VTK_FILES = sorted(
+    p.name
+    for p in DATA.iterdir()
+    if p.suffix in (".vti", ".vtr", ".vts", ".vtk") and p.stem != "curvilinear"
+)
 
 
 @pytest.mark.parametrize("name", VTK_FILES)
@@ -38,8 +41,9 @@ def test_vtk_files_written_by_vtk(name: str) -> None:
     centres = [0.5 * (a[1:] + a[:-1]) for a in AXES]
     for a, b in zip(axes, centres, strict=True):
         assert np.allclose(a, b, rtol=0, atol=1e-15)
-    assert np.allclose(tc[..., 0], temperature(*np.meshgrid(*centres, indexing="ij")),
-                       rtol=1e-14, atol=0)  # fmt: skip
+    assert np.allclose(
+        tc[..., 0], temperature(*np.meshgrid(*centres, indexing="ij")), rtol=1e-14, atol=0
+    )
     with pytest.raises(ValueError, match=r"no cell data array 'T'.*cell data: \['Tc'\]"):
         read_grid_field(DATA / name, "T", 1, "cell")
 
@@ -58,8 +62,17 @@ def test_npz_and_its_errors(tmp_path: Path) -> None:
     x, y, z = _lattice()
     u = np.stack(velocity(x, y, z), axis=-1)
     path = tmp_path / "flow.npz"
-    np.savez(path, x=AXES[0], y=AXES[1], z=AXES[2], T=temperature(x, y, z), U=u,
-             ux=u[..., 0], uy=u[..., 1], uz=u[..., 2])  # fmt: skip
+    np.savez(
+        path,
+        x=AXES[0],
+        y=AXES[1],
+        z=AXES[2],
+        T=temperature(x, y, z),
+        U=u,
+        ux=u[..., 0],
+        uy=u[..., 1],
+        uz=u[..., 2],
+    )
     _, t = read_grid_field(path, "T", 1)
     assert np.array_equal(t[..., 0], temperature(x, y, z))
     _, v = read_grid_field(path, "U", 3)
@@ -113,7 +126,10 @@ def test_missing_files_and_formats(tmp_path: Path) -> None:
         read_grid_field(bad, "T", 1)
     lz4 = tmp_path / "lz4.vti"
     text = (DATA / "image_ascii.vti").read_text()
-    lz4.write_text(text.replace('header_type="UInt64"',
-                                'header_type="UInt64" compressor="vtkLZ4DataCompressor"'))  # fmt: skip
+    lz4.write_text(
+        text.replace(
+            'header_type="UInt64"', 'header_type="UInt64" compressor="vtkLZ4DataCompressor"'
+        )
+    )
     with pytest.raises(ValueError, match="vtkLZ4DataCompressor' is not supported"):
         read_grid_field(lz4, "T", 1)

@@ -191,8 +191,11 @@ COOLING = [
 ]
 
 
-@pytest.mark.parametrize(("model", "speed", "eps", "formula", "c_gas"), COOLING,
-                         ids=[f"{m['model']}-{m.get('regime', '')}" for m, *_ in COOLING])  # fmt: skip
+@pytest.mark.parametrize(
+    ("model", "speed", "eps", "formula", "c_gas"),
+    COOLING,
+    ids=[f"{m['model']}-{m.get('regime', '')}" for m, *_ in COOLING],
+)
 def test_lumped_convective_cooling_matches_the_closed_form(
     tmp_path: Path, model: dict, speed: float, eps: float | None, formula, c_gas: float
 ) -> None:  # noqa: ANN001
@@ -226,8 +229,7 @@ def test_lumped_convective_cooling_matches_the_closed_form(
 
 
 def test_relative_velocity_and_a_moving_particle(tmp_path: Path) -> None:
-    case = _case(tmp_path, "ranz_marshall1952", {"temperature": 300.0, "velocity": [1, 2, 3]},
-                 1e-3)  # fmt: skip
+    case = _case(tmp_path, "ranz_marshall1952", {"temperature": 300.0, "velocity": [1, 2, 3]}, 1e-3)
     sim = Simulation(case_from_dict(case))
     th = sim.thermal
     assert th.fields[0, fk.F_RELATIVE_SPEED] == pytest.approx(math.sqrt(14.0), rel=1e-14)
@@ -257,8 +259,9 @@ def test_leaving_the_validity_range_warns_once_with_the_particle(tmp_path: Path)
 def test_gunn_rayleigh_range_is_checked_for_a_gas(tmp_path: Path) -> None:
     # a 2 cm sphere 1000 K above a stagnant gas: Ra = g β ΔT d³ / (ν α) ≈ 1e5 < 1e9; with a
     # 0.3 m sphere (hypothetical) it leaves the range
-    case = _case(tmp_path, "gunn1978", {"temperature": 300.0, "velocity": [0, 0, 0.1]}, 1e-3,
-                 0.5, t0=1300.0)  # fmt: skip
+    case = _case(
+        tmp_path, "gunn1978", {"temperature": 300.0, "velocity": [0, 0, 0.1]}, 1e-3, 0.5, t0=1300.0
+    )
     sim = Simulation(case_from_dict(case))
     ra = sim.thermal.field_provider.numbers(sim.thermal.fields)["Ra"][0]
     d = 2 * R
@@ -269,11 +272,20 @@ def test_gunn_rayleigh_range_is_checked_for_a_gas(tmp_path: Path) -> None:
 
 def test_whitaker_viscosity_ratio_from_a_liquid_table(tmp_path: Path) -> None:
     mu = [[280.0, 1.4e-3], [380.0, 0.3e-3]]
-    liquid = {"kind": "liquid", "thermal_conductivity": [[280.0, 0.58], [380.0, 0.68]],
-              "density": 1000.0, "specific_heat": 4180.0, "dynamic_viscosity": mu}  # fmt: skip
-    case = _case(tmp_path, "whitaker1972",
-                 {"temperature": 300.0, "velocity": [0, 0, 0.05], "properties": liquid}, 1e-4,
-                 t0=330.0)  # fmt: skip
+    liquid = {
+        "kind": "liquid",
+        "thermal_conductivity": [[280.0, 0.58], [380.0, 0.68]],
+        "density": 1000.0,
+        "specific_heat": 4180.0,
+        "dynamic_viscosity": mu,
+    }
+    case = _case(
+        tmp_path,
+        "whitaker1972",
+        {"temperature": 300.0, "velocity": [0, 0, 0.05], "properties": liquid},
+        1e-4,
+        t0=330.0,
+    )
     sim = Simulation(case_from_dict(case))
     f = sim.thermal.fields[0]
     mu_f = 1.4e-3 + (300 - 280) / 100 * (0.3e-3 - 1.4e-3)
@@ -292,13 +304,19 @@ def test_whitaker_viscosity_ratio_from_a_liquid_table(tmp_path: Path) -> None:
 
 def test_missing_sections_are_named(tmp_path: Path) -> None:
     case = _case(tmp_path, "gunn1978", {"temperature": 300.0}, 1e-3)
-    with pytest.raises(ConfigError, match=r"thermal.porosity: missing; required by "
-                       r"thermal.convection = 'gunn1978'"):  # fmt: skip
+    with pytest.raises(
+        ConfigError,
+        match=r"thermal.porosity: missing; required by "
+        r"thermal.convection = 'gunn1978'",
+    ):
         Simulation(case_from_dict(case))
     case = _case(tmp_path, "ranz_marshall1952", {"temperature": 300.0}, 1e-3)
     del case["thermal"]["fluid"]
-    with pytest.raises(ConfigError, match=r"thermal.fluid: missing; required by "
-                       r"thermal.convection = 'ranz_marshall1952'"):  # fmt: skip
+    with pytest.raises(
+        ConfigError,
+        match=r"thermal.fluid: missing; required by "
+        r"thermal.convection = 'ranz_marshall1952'",
+    ):
         Simulation(case_from_dict(case))
     case = _case(tmp_path, "gunn1978", {"temperature": 300.0}, 1e-3, {"kind": "voronoi"})
     with pytest.raises(ConfigError, match=r"thermal.porosity.kind = 'voronoi': needs the Voronoi"):

@@ -29,8 +29,13 @@ sys.path.insert(0, str(DATA))
 from expected import AXES, temperature, velocity  # noqa: E402
 
 R = 2e-4
-MATERIAL = {"density": 3000.0, "youngs_modulus": 1e8, "poisson_ratio": 0.3,
-            "thermal_conductivity": 2.0, "specific_heat": 900.0}  # fmt: skip
+MATERIAL = {
+    "density": 3000.0,
+    "youngs_modulus": 1e8,
+    "poisson_ratio": 0.3,
+    "thermal_conductivity": 2.0,
+    "specific_heat": 900.0,
+}
 
 
 def _write(path: Path, pos: np.ndarray, radius: float = R, temp: float = 350.0) -> str:
@@ -68,21 +73,26 @@ def _inside_grid(n: int, seed: int = 3) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", ["image_appended_raw_zlib.vti", "legacy_rectilinear_binary.vtk"])
-def test_grid_fluid_is_interpolated_trilinearly_at_the_particles(tmp_path: Path,
-                                                                 name: str) -> None:  # fmt: skip
+def test_grid_fluid_is_interpolated_trilinearly_at_the_particles(tmp_path: Path, name: str) -> None:
     pos = _inside_grid(30)
-    fluid = {"temperature": {"file": str(DATA / name), "field": "T"},
-             "velocity": {"file": str(DATA / name), "field": "U"}}  # fmt: skip
+    fluid = {
+        "temperature": {"file": str(DATA / name), "field": "T"},
+        "velocity": {"file": str(DATA / name), "field": "U"},
+    }
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
-        sim = Simulation(case_from_dict(_case(_write(tmp_path / "p.txt", pos),
-                                              {"convection": "stagnant", "fluid": fluid})))  # fmt: skip
+        sim = Simulation(
+            case_from_dict(
+                _case(_write(tmp_path / "p.txt", pos), {"convection": "stagnant", "fluid": fluid})
+            )
+        )
     f = sim.thermal.fields
     tf = _gid(sim, f[:, fk.F_FLUID_TEMPERATURE])
     assert np.allclose(tf, temperature(*pos.T), rtol=1e-13, atol=0)
     # the stagnant model does not read the velocity: check it with a flowing correlation
-    case = _case(_write(tmp_path / "p.txt", pos), {"convection": "ranz_marshall1952",
-                                                   "fluid": fluid})  # fmt: skip
+    case = _case(
+        _write(tmp_path / "p.txt", pos), {"convection": "ranz_marshall1952", "fluid": fluid}
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # Re < 1 here
         sim = Simulation(case_from_dict(case))
@@ -107,10 +117,13 @@ def test_outside_the_grid_the_boundary_value_holds_with_one_warning(tmp_path: Pa
 
 def test_fluid_temperature_table_and_expressions(tmp_path: Path) -> None:
     pos = np.array([[0.001, 0.002, 0.003], [0.004, 0.0, -0.001]])
-    fluid = {"temperature": [[0.0, 300.0], [0.05, 400.0]],
-             "velocity": ["1 + 100 * x", "0.5 * t", "-z * 10"]}  # fmt: skip
-    case = _case(_write(tmp_path / "p.txt", pos), {"convection": "ranz_marshall1952",
-                                                   "fluid": fluid})  # fmt: skip
+    fluid = {
+        "temperature": [[0.0, 300.0], [0.05, 400.0]],
+        "velocity": ["1 + 100 * x", "0.5 * t", "-z * 10"],
+    }
+    case = _case(
+        _write(tmp_path / "p.txt", pos), {"convection": "ranz_marshall1952", "fluid": fluid}
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         sim = Simulation(case_from_dict(case))
@@ -165,21 +178,31 @@ def test_cell_porosity_by_hand(tmp_path: Path) -> None:
     """Domain 8R × 8R × 8R, cells 4R: three particles in the first cell, one in the last; a
     plane wall at x = 2R makes the first-column cells half fluid."""
     s = R
-    pos = np.array([[2.5 * s, 1.2 * s, 1.2 * s], [2.5 * s, 2.9 * s, 1.2 * s],
-                    [3.0 * s, 2.0 * s, 3.0 * s], [6.0 * s, 6.0 * s, 6.0 * s]])  # fmt: skip
-    radiation = {"model": "surroundings", "environment_temperature": 300.0,
-                 "exposure": "fraction"}  # fmt: skip
+    pos = np.array(
+        [
+            [2.5 * s, 1.2 * s, 1.2 * s],
+            [2.5 * s, 2.9 * s, 1.2 * s],
+            [3.0 * s, 2.0 * s, 3.0 * s],
+            [6.0 * s, 6.0 * s, 6.0 * s],
+        ]
+    )
+    radiation = {"model": "surroundings", "environment_temperature": 300.0, "exposure": "fraction"}
     thermal = {"radiation": radiation, "porosity": {"kind": "cell", "cell_size": 4 * s}}
-    case = _case(_write(tmp_path / "p.txt", pos, radius=0.5 * s), thermal,
-                 lower=(0, 0, 0), upper=(8 * s, 8 * s, 8 * s))  # fmt: skip
+    case = _case(
+        _write(tmp_path / "p.txt", pos, radius=0.5 * s),
+        thermal,
+        lower=(0, 0, 0),
+        upper=(8 * s, 8 * s, 8 * s),
+    )
     case["materials"]["grain"]["emissivity"] = 0.9
     sim = Simulation(case_from_dict(case))
     eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
     v = 4 / 3 * math.pi * (0.5 * s) ** 3
     assert eps[:3] == pytest.approx([1 - 3 * v / (4 * s) ** 3] * 3, rel=1e-14)
     assert eps[3] == pytest.approx(1 - v / (4 * s) ** 3, rel=1e-14)
-    case["walls"] = [{"kind": "plane", "point": [2 * s, 0, 0], "normal": [1, 0, 0],
-                      "material": "grain"}]  # fmt: skip
+    case["walls"] = [
+        {"kind": "plane", "point": [2 * s, 0, 0], "normal": [1, 0, 0], "material": "grain"}
+    ]
     sim = Simulation(case_from_dict(case))
     eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
     assert eps[:3] == pytest.approx([1 - 3 * v / (0.5 * (4 * s) ** 3)] * 3, rel=1e-14)
@@ -214,8 +237,10 @@ def _lens(a: float, b: float, d: float) -> float:
         return math.pi * max(min(r1, r2), 0.0)
 
     x_cut = (d * d + a * a - b * b) / (2 * d)
-    return (integrate.quad(area, d - b, x_cut, epsrel=1e-12)[0]
-            + integrate.quad(area, x_cut, a, epsrel=1e-12)[0])  # fmt: skip
+    return (
+        integrate.quad(area, d - b, x_cut, epsrel=1e-12)[0]
+        + integrate.quad(area, x_cut, a, epsrel=1e-12)[0]
+    )
 
 
 def test_shell_porosity_against_quadratures(tmp_path: Path) -> None:
@@ -223,10 +248,17 @@ def test_shell_porosity_against_quadratures(tmp_path: Path) -> None:
     rs = ratio * R
     # a lone particle far from everything, and a pair 3.5 R apart (shells overlap them)
     pos = np.array([[0.0, 0.0, 0.0], [0.01, 0.01, 0.01], [0.01 + 3.5 * R, 0.01, 0.01]])
-    case = _case(_write(tmp_path / "p.txt", pos),
-                 {"radiation": {"model": "surroundings", "environment_temperature": 300.0,
-                                "exposure": "fraction"},
-                  "porosity": {"kind": "shell", "radius_ratio": ratio}})  # fmt: skip
+    case = _case(
+        _write(tmp_path / "p.txt", pos),
+        {
+            "radiation": {
+                "model": "surroundings",
+                "environment_temperature": 300.0,
+                "exposure": "fraction",
+            },
+            "porosity": {"kind": "shell", "radius_ratio": ratio},
+        },
+    )
     case["materials"]["grain"]["emissivity"] = 0.9
     sim = Simulation(case_from_dict(case))
     eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
@@ -237,24 +269,21 @@ def test_shell_porosity_against_quadratures(tmp_path: Path) -> None:
     assert eps[1] == pytest.approx(1 - (vp + lens) / vs, rel=1e-10)
     # walls: one plane 1.5 R below particle 0 (exact cap), then a second at 1.2 R in x (the
     # overlap of the two caps from the lattice)
-    walls = [{"kind": "plane", "point": [0, 0, -1.5 * R], "normal": [0, 0, 1],
-              "material": "grain"}]  # fmt: skip
+    walls = [{"kind": "plane", "point": [0, 0, -1.5 * R], "normal": [0, 0, 1], "material": "grain"}]
     case["walls"] = walls
     sim = Simulation(case_from_dict(case))
     eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
     v_avail = _sphere_volume_beyond_planes(rs, [rs, 1.5 * R])
     assert eps[0] == pytest.approx(1 - vp / v_avail, rel=1e-10)
     # a second wall 1.2 R away in x: the overlap of the two caps (a quadrature in the kernel)
-    second = {"kind": "plane", "point": [-1.2 * R, 0, 0], "normal": [1, 0, 0],
-              "material": "grain"}  # fmt: skip
+    second = {"kind": "plane", "point": [-1.2 * R, 0, 0], "normal": [1, 0, 0], "material": "grain"}
     case["walls"] = walls + [second]
     sim = Simulation(case_from_dict(case))
     eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
     v_avail = _sphere_volume_beyond_planes(rs, [1.2 * R, 1.5 * R])
     assert 1 - eps[0] == pytest.approx(vp / v_avail, rel=1e-6)
     # a box corner, a third wall 1.0 R away in y: the triple overlap from quasi-random points
-    third = {"kind": "plane", "point": [0, -1.0 * R, 0], "normal": [0, 1, 0],
-             "material": "grain"}  # fmt: skip
+    third = {"kind": "plane", "point": [0, -1.0 * R, 0], "normal": [0, 1, 0], "material": "grain"}
     case["walls"] = walls + [second, third]
     sim = Simulation(case_from_dict(case))
     eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])

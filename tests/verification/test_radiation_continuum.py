@@ -38,15 +38,21 @@ MATERIAL = {
 
 def _write(path: Path, pos: np.ndarray, radius: np.ndarray, temp: np.ndarray) -> str:
     rows = ["x y z radius temperature"]
-    rows += [" ".join(repr(float(v)) for v in (*x, r, t))
-             for x, r, t in zip(pos, radius, temp, strict=True)]  # fmt: skip
+    rows += [
+        " ".join(repr(float(v)) for v in (*x, r, t))
+        for x, r, t in zip(pos, radius, temp, strict=True)
+    ]
     path.write_text("\n".join(rows) + "\n")
     return str(path)
 
 
 def _case(files: list[tuple[str, str]], radiation: dict, extra: dict | None = None) -> dict:
-    thermal = {"direct_conduction": "none", "radiation": radiation, "frozen_mechanics": True,
-               "time_step": 1e-3}  # fmt: skip
+    thermal = {
+        "direct_conduction": "none",
+        "radiation": radiation,
+        "frozen_mechanics": True,
+        "time_step": 1e-3,
+    }
     thermal.update(extra or {})
     return {
         "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0, 0, 0]},
@@ -113,8 +119,10 @@ def _random_bed(tmp_path: Path, n: int = 40, seed: int = 4):  # noqa: ANN202
     pos, rad = np.array(pos), np.array(rad)
     temp = rng.uniform(500.0, 1400.0, n)
     half = n // 2
-    files = [("a", _write(tmp_path / "a.txt", pos[:half], rad[:half], temp[:half])),
-             ("b", _write(tmp_path / "b.txt", pos[half:], rad[half:], temp[half:]))]  # fmt: skip
+    files = [
+        ("a", _write(tmp_path / "a.txt", pos[:half], rad[:half], temp[:half])),
+        ("b", _write(tmp_path / "b.txt", pos[half:], rad[half:], temp[half:])),
+    ]
     emissivity = np.where(np.arange(n) < half, EPS, 0.5)
     return files, pos, rad, temp, emissivity
 
@@ -126,8 +134,7 @@ def test_continuum_models_on_a_polydisperse_bed_against_brute_force(
     files, pos, rad, temp, emis = _random_bed(tmp_path)
     ratio = 2.5
     extra = {"fluid": {"temperature": 450.0}, "porosity": 0.55} if model == "zhou2009" else {}
-    sim = Simulation(case_from_dict(_case(files, {"model": model, "radius_ratio": ratio},
-                                          extra)))  # fmt: skip
+    sim = Simulation(case_from_dict(_case(files, {"model": model, "radius_ratio": ratio}, extra)))
     got = _by_gid(sim, sim.particles.heat_rate_by_mechanism[:, heat.M_RADIATION])
     n = len(pos)
     for i in range(n):
@@ -148,8 +155,9 @@ def test_continuum_models_on_a_polydisperse_bed_against_brute_force(
 
 
 def test_krause_without_neighbours_uses_the_optional_environment(tmp_path: Path) -> None:
-    path = _write(tmp_path / "one.txt", np.array([[0.0, 0.0, 0.0]]), np.array([R]),
-                  np.array([900.0]))  # fmt: skip
+    path = _write(
+        tmp_path / "one.txt", np.array([[0.0, 0.0, 0.0]]), np.array([R]), np.array([900.0])
+    )
     sim = Simulation(case_from_dict(_case([("a", path)], {"model": "krause2017"})))
     assert sim.particles.heat_rate_by_mechanism[0, heat.M_RADIATION] == 0.0
     assert sim.thermal.conductance_sum[0] == 0.0
@@ -163,21 +171,27 @@ def test_krause_without_neighbours_uses_the_optional_environment(tmp_path: Path)
 # --------------------------------------------------------------- exposure, walls
 @pytest.mark.parametrize(
     ("exposure", "factor"),
-    [({"exposure": "all"}, 1.0), ({"exposure": "fraction"}, 0.45),
-     ({"exposure": "threshold", "threshold": 0.4}, 1.0),
-     ({"exposure": "threshold", "threshold": 0.5}, 0.0)],  # fmt: skip
+    [
+        ({"exposure": "all"}, 1.0),
+        ({"exposure": "fraction"}, 0.45),
+        ({"exposure": "threshold", "threshold": 0.4}, 1.0),
+        ({"exposure": "threshold", "threshold": 0.5}, 0.0),
+    ],
     ids=["all", "fraction", "threshold-exposed", "threshold-hidden"],
 )
-def test_surroundings_exposure_by_local_porosity(tmp_path: Path, exposure: dict,
-                                                 factor: float) -> None:  # fmt: skip
-    path = _write(tmp_path / "one.txt", np.array([[0.0, 0.0, 0.0]]), np.array([R]),
-                  np.array([900.0]))  # fmt: skip
+def test_surroundings_exposure_by_local_porosity(
+    tmp_path: Path, exposure: dict, factor: float
+) -> None:
+    path = _write(
+        tmp_path / "one.txt", np.array([[0.0, 0.0, 0.0]]), np.array([R]), np.array([900.0])
+    )
     radiation = {"model": "surroundings", "environment_temperature": 300.0, **exposure}
     sim = Simulation(case_from_dict(_case([("a", path)], radiation, {"porosity": 0.45})))
     area = 4 * math.pi * R**2
     q = sim.particles.heat_rate_by_mechanism[0, heat.M_RADIATION]
-    assert q == pytest.approx(factor * EPS * area * SIGMA * (300.0**4 - 900.0**4), rel=1e-12,
-                              abs=0.0)  # fmt: skip
+    assert q == pytest.approx(
+        factor * EPS * area * SIGMA * (300.0**4 - 900.0**4), rel=1e-12, abs=0.0
+    )
     assert sim.thermal.conductance_sum[0] == pytest.approx(
         factor * 4 * EPS * area * SIGMA * 900.0**3, rel=1e-12, abs=0.0
     )
@@ -190,8 +204,12 @@ def test_exposure_by_shell_porosity_picks_the_free_surface(tmp_path: Path) -> No
     pos = grid.reshape(-1, 3) * 2.0 * R + R
     temp = np.full(len(pos), 900.0)
     path = _write(tmp_path / "bed.txt", pos, np.full(len(pos), R), temp)
-    radiation = {"model": "surroundings", "environment_temperature": 300.0,
-                 "exposure": "threshold", "threshold": 0.55}  # fmt: skip
+    radiation = {
+        "model": "surroundings",
+        "environment_temperature": 300.0,
+        "exposure": "threshold",
+        "threshold": 0.55,
+    }
     case = _case([("a", path)], radiation, {"porosity": {"kind": "shell"}})
     case["walls"] = [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "a"}]
     sim = Simulation(case_from_dict(case))
@@ -208,18 +226,29 @@ def test_particle_wall_radiation(tmp_path: Path) -> None:
     # particle 0: surface gap 0.5 R to the hot floor (in view), particle 1: 5 R above it
     pos = np.array([[0.0, 0.0, 1.5 * R], [0.01, 0.0, 6.0 * R]])
     path = _write(tmp_path / "two.txt", pos, np.full(2, R), np.array([600.0, 600.0]))
-    radiation = {"model": "surroundings", "environment_temperature": 300.0, "walls": True,
-                 "wall_view_factor": 0.5, "wall_range": 1.0}  # fmt: skip
+    radiation = {
+        "model": "surroundings",
+        "environment_temperature": 300.0,
+        "walls": True,
+        "wall_view_factor": 0.5,
+        "wall_range": 1.0,
+    }
     case = _case([("a", path)], radiation)
-    wall = {"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "a",
-            "thermal": {"kind": "fixed", "temperature": 1200.0}}  # fmt: skip
+    wall = {
+        "kind": "plane",
+        "point": [0, 0, 0],
+        "normal": [0, 0, 1],
+        "material": "a",
+        "thermal": {"kind": "fixed", "temperature": 1200.0},
+    }
     case["walls"] = [wall]
     sim = Simulation(case_from_dict(case))
     q = _by_gid(sim, sim.particles.heat_rate_by_mechanism[:, heat.M_RADIATION])
     g = _by_gid(sim, sim.thermal.conductance_sum)
     c = EPS * 4 * math.pi * R**2 * SIGMA
-    assert q[0] == pytest.approx(c * (0.5 * (1200.0**4 - 600.0**4) + 0.5 * (300.0**4 - 600.0**4)),
-                                 rel=1e-12)  # fmt: skip
+    assert q[0] == pytest.approx(
+        c * (0.5 * (1200.0**4 - 600.0**4) + 0.5 * (300.0**4 - 600.0**4)), rel=1e-12
+    )
     assert q[1] == pytest.approx(c * (300.0**4 - 600.0**4), rel=1e-12)
     assert g == pytest.approx([4 * c * 600.0**3] * 2, rel=1e-12)
     # the heat from the wall is ledgered with the radiation
@@ -234,16 +263,25 @@ def test_particle_wall_radiation(tmp_path: Path) -> None:
 
 
 def test_three_walls_in_a_corner_share_the_whole_surface(tmp_path: Path) -> None:
-    path = _write(tmp_path / "one.txt", np.array([[1.2 * R, 1.2 * R, 1.2 * R]]), np.array([R]),
-                  np.array([600.0]))  # fmt: skip
+    path = _write(
+        tmp_path / "one.txt",
+        np.array([[1.2 * R, 1.2 * R, 1.2 * R]]),
+        np.array([R]),
+        np.array([600.0]),
+    )
     radiation = {"model": "krause2017", "walls": True}
     case = _case([("a", path)], radiation)
     temps = (1000.0, 800.0, 500.0)
     case["walls"] = [
-        {"kind": "plane", "point": [0, 0, 0], "normal": n, "material": "a",
-         "thermal": {"kind": "fixed", "temperature": t}}
+        {
+            "kind": "plane",
+            "point": [0, 0, 0],
+            "normal": n,
+            "material": "a",
+            "thermal": {"kind": "fixed", "temperature": t},
+        }
         for n, t in zip(([1, 0, 0], [0, 1, 0], [0, 0, 1]), temps, strict=True)
-    ]  # fmt: skip
+    ]
     sim = Simulation(case_from_dict(case))
     c = EPS * 4 * math.pi * R**2 * SIGMA
     expected = c * sum((t**4 - 600.0**4) / 3 for t in temps)  # 3 × 1/2 scaled to 1
@@ -260,8 +298,10 @@ def test_explicit_limit_with_radiation_and_convection_at_1500_k(tmp_path: Path) 
     pos = np.array([[0.0, 0.0, 0.0], [2.5 * R, 0.0, 0.0], [-2.5 * R, 0.0, 0.0]])
     temp = np.array([1500.0, 700.0, 700.0])
     path = _write(tmp_path / "three.txt", pos, np.array([R, R, R]), temp)
-    extra = {"convection": "ranz_marshall1952",
-             "fluid": {"temperature": 300.0, "velocity": [0, 0, 3.0]}}  # fmt: skip
+    extra = {
+        "convection": "ranz_marshall1952",
+        "fluid": {"temperature": 300.0, "velocity": [0, 0, 3.0]},
+    }
     case = _case([("a", path)], {"model": "krause2017"}, extra)
     sim = Simulation(case_from_dict(case))
     gid = np.argsort(sim.particles.global_id)
@@ -290,8 +330,11 @@ def test_explicit_limit_with_radiation_and_convection_at_1500_k(tmp_path: Path) 
 
 def test_ledger_of_a_lattice_with_continuum_radiation(tmp_path: Path) -> None:
     path, _ = _lattice(tmp_path)
-    sim = Simulation(case_from_dict(_case([("a", path)], {"model": "krause2017",
-                                                          "environment_temperature": 300.0})))  # fmt: skip
+    sim = Simulation(
+        case_from_dict(
+            _case([("a", path)], {"model": "krause2017", "environment_temperature": 300.0})
+        )
+    )
     for _ in range(20):
         sim.step()
     th = sim.thermal
@@ -307,18 +350,32 @@ def _moving_case(tmp_path: Path, n_side: int) -> dict:
     temp = rng.uniform(600.0, 1200.0, len(pos))
     path = _write(tmp_path / "bed.txt", pos, np.full(len(pos), R), temp)
     side = n_side * 2.02 * R + 2 * R
-    case = _case([("a", path)], {"model": "krause2017", "walls": True},
-                 {"convection": "gunn1978", "porosity": {"kind": "shell"},
-                  "fluid": {"temperature": 300.0, "velocity": [0.0, 0.0, 1.0]},
-                  "range_skin": 0.02 * R, "substeps": 2})  # fmt: skip
+    case = _case(
+        [("a", path)],
+        {"model": "krause2017", "walls": True},
+        {
+            "convection": "gunn1978",
+            "porosity": {"kind": "shell"},
+            "fluid": {"temperature": 300.0, "velocity": [0.0, 0.0, 1.0]},
+            "range_skin": 0.02 * R,
+            "substeps": 2,
+        },
+    )
     case["thermal"].pop("frozen_mechanics")
     case["thermal"].pop("time_step")
     case["simulation"]["gravity"] = [0, 0, -9.81]
     case["domain"] = {"lower": [0, 0, 0], "upper": [side, side, 0.02]}
     case["neighbors"] = {"skin": 0.05 * R}
-    case["walls"] = [{"kind": "box", "lower": [0, 0, 0], "upper": [side, side, 0.02],
-                      "material": "a", "open_top": True,
-                      "thermal": {"kind": "fixed", "temperature": 1000.0}}]  # fmt: skip
+    case["walls"] = [
+        {
+            "kind": "box",
+            "lower": [0, 0, 0],
+            "upper": [side, side, 0.02],
+            "material": "a",
+            "open_top": True,
+            "thermal": {"kind": "fixed", "temperature": 1000.0},
+        }
+    ]
     return case
 
 
@@ -335,8 +392,9 @@ def test_restart_with_the_neighbourhood_set_is_bit_identical(tmp_path: Path) -> 
     second = Simulation.from_checkpoint(path)
     second.run(steps=199)
     for field in ("position", "velocity", "temperature", "heat_rate_by_mechanism"):
-        assert np.array_equal(getattr(reference.particles, field),
-                              getattr(second.particles, field)), field  # fmt: skip
+        assert np.array_equal(
+            getattr(reference.particles, field), getattr(second.particles, field)
+        ), field
     na = reference.thermal.field_provider.neighbourhood
     nb = second.thermal.field_provider.neighbourhood
     assert na.builds > 1 and (na.count, na.builds) == (nb.count, nb.builds)
