@@ -21,6 +21,7 @@ import pytest
 from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import SimulationError
+from thermodem.kernels import fields as fk
 from thermodem.models.thermal.radiation import STEFAN_BOLTZMANN as SIGMA
 from thermodem.state import heat
 
@@ -91,8 +92,11 @@ def test_krause_on_a_lattice_against_a_hand_evaluation(tmp_path: Path) -> None:
     corner = int(np.nonzero(off == 3)[0][0])
     te4 = (3 * 800.0**4 + 3 * 900.0**4) / 6
     assert q[corner] == pytest.approx(EPS * area * SIGMA * (te4 - 300.0**4), rel=1e-12)
-    count = _by_gid(sim, sim.thermal.fields[:, 10])  # F_NEIGHBOURS
-    assert count[centre] == 18 and count[corner] == 6
+    # Σ ε_j A_j / 2 over the sphere: 18 neighbours of the centre, 6 of a corner
+    area_sum = _by_gid(sim, sim.thermal.fields[:, fk.F_NEIGHBOUR_AREA])
+    half = EPS * 2 * math.pi * R**2
+    assert area_sum[centre] == pytest.approx(18 * half, rel=1e-14)
+    assert area_sum[corner] == pytest.approx(6 * half, rel=1e-14)
 
 
 def test_zhou_on_a_lattice_against_a_hand_evaluation(tmp_path: Path) -> None:
@@ -105,6 +109,8 @@ def test_zhou_on_a_lattice_against_a_hand_evaluation(tmp_path: Path) -> None:
     assert t_e == pytest.approx(620.0)
     area = 4 * math.pi * R**2
     assert q[centre] == pytest.approx(EPS * area * SIGMA * (620.0**4 - 1000.0**4), rel=1e-12)
+    count = _by_gid(sim, sim.thermal.fields[:, fk.F_NEIGHBOURS])
+    assert count[centre] == 18
 
 
 def _random_bed(tmp_path: Path, n: int = 40, seed: int = 4):  # noqa: ANN202

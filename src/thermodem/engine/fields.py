@@ -165,8 +165,14 @@ class FieldProvider:
             if self.radiation is not None and self.radiation.table.ndim == 2
             else np.zeros(1)
         )
+        self.radiation_mode = 0
+        if self.radiation is not None and self.radiation.choice.model == "krause2017":
+            self.radiation_mode = fk.NB_KRAUSE
+        elif self.radiation is not None and self.radiation.choice.model == "zhou2009":
+            self.radiation_mode = fk.NB_ZHOU
         self.lattice = fk.unit_ball_points()
-        self.solid = np.zeros(0)
+        self.sums = np.zeros((0, 4))
+        self.weights = np.zeros((0, 4))
         self.scratch = np.zeros((1, 4))
         # cell porosity (the grid is set up at the first evaluation: its default size)
         self.cell_size = 0.0
@@ -419,24 +425,27 @@ class FieldProvider:
         ns = self.neighbourhood
         if ns.due(sim):
             ns.build(sim, self._neighbourhood_gap(), 0.0)
+        n = p.count
+        if self.sums.shape[0] != n:
+            self.sums = np.zeros((n, 4))
+            self.weights = np.zeros((n, 4))
+        args = (p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower, sim.upper,
+                sim.periodic, self.weights)  # fmt: skip
         if self.radiation_ratio > 0.0:
-            fk.zero_columns(fields, fk.F_NEIGHBOURS, fk.F_NEIGHBOUR_AREA + 1)
+            fk.neighbour_weights(p.radius, p.temperature, p.type_id, self.emissivity,
+                                 self.weights)  # fmt: skip
+            fk.zero_rows(self.sums)
+            fk.neighbourhood_pass(*args, self.radiation_mode, self.radiation_ratio, 0.0,
+                                  self.sums)  # fmt: skip
+            fk.neighbour_columns(self.sums, fields)
         if self.shell_ratio > 0.0:
-            if self.solid.shape[0] != p.count:
-                self.solid = np.zeros(p.count)
-            else:
-                self.solid[:] = 0.0
-        fk.neighbourhood_pass(
-            p.position, p.radius, p.temperature, p.type_id, ns.i, ns.j, ns.group_start,
-            sim.lower, sim.upper, sim.periodic, self.emissivity, self.radiation_ratio,
-            self.shell_ratio, fields, self.solid,
-        )  # fmt: skip
-        if self.shell_ratio > 0.0:
+            fk.zero_rows(self.sums)
+            fk.neighbourhood_pass(*args, fk.NB_SHELL, 0.0, self.shell_ratio, self.sums)
             width = 4 * max(sim.wall_kind.shape[0], 1)
             if self.scratch.shape[0] < self._chunks() or self.scratch.shape[1] < width:
                 self.scratch = np.zeros((self._chunks(), width))
             fk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
-                              self.shell_ratio, self.lattice, self.solid, self.scratch,
+                              self.shell_ratio, self.lattice, self.sums, self.scratch,
                               fields)  # fmt: skip
 
     # ------------------------------------------------------------------ cell porosity

@@ -14,8 +14,9 @@ thread count):
 - :func:`grid_sample`: trilinear interpolation of a rectilinear grid field at the particles;
 - :func:`relative_speed`: |u_f - v_p|;
 - :func:`cell_fluid_volume`, :func:`cell_porosity`: porosity by a cell count;
-- :func:`neighbourhood_pass`: sums over the neighbours within a sphere of influence
-  (count, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2, the solid volume within a shell);
+- :func:`neighbour_weights`, :func:`neighbourhood_pass`, :func:`neighbour_columns`: sums over
+  the neighbours within a sphere of influence (count, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2;
+  or the solid volume within a shell);
 - :func:`shell_porosity`: 1 - solid volume / shell volume inside the walls;
 - :func:`wall_view`: view factors and Σ F T_w⁴ of the fixed-temperature walls in view.
 """
@@ -351,48 +352,91 @@ def lens_volume(a, b, d):
     return math.pi * s * s * (d * d + 2.0 * d * (a + b) - 3.0 * (a - b) * (a - b)) / (12.0 * d)
 
 
+#: What :func:`neighbourhood_pass` sums (bits of its ``mode``).
+NB_KRAUSE = 1  # Σ ε_j A_j T_j⁴ / 2 and Σ ε_j A_j / 2 (krause2017)
+NB_ZHOU = 2  # n_p and Σ T_j (zhou2009)
+NB_SHELL = 4  # the neighbours' volume in the shell (shell porosity)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def neighbour_weights(radius, temperature, type_id, emissivity, weights):
+    """Per particle: weights[i] = (ε_i A_i / 2, ε_i A_i T_i⁴ / 2, T_i, 0), read by the pairs."""
+    n = radius.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            t = temperature[i]
+            w = 2.0 * math.pi * radius[i] * radius[i] * emissivity[type_id[i]]
+            weights[i, 0] = w
+            weights[i, 1] = w * (t * t) * (t * t)
+            weights[i, 2] = t
+            weights[i, 3] = 0.0
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def neighbourhood_pass(
-    position, radius, temperature, type_id, pair_i, pair_j, group_start, lower, upper, periodic,
-    emissivity, radiation_ratio, shell_ratio, fields, solid,
+    position, radius, pair_i, pair_j, group_start, lower, upper, periodic, weights, mode,
+    radiation_ratio, shell_ratio, sums,
 ):  # fmt: skip
-    """Sums over the pairs of a range set, by slab groups (race-free, fixed order).
-
-    With ``radiation_ratio`` > 0: for every particle i, over the particles j whose centre is
-    within radiation_ratio × R_i: the count, Σ T_j, Σ ε_j A_j T_j⁴ / 2 and Σ ε_j A_j / 2
-    (``emissivity`` by material). With ``shell_ratio`` > 0: the volume of every neighbour
-    inside the sphere of radius shell_ratio × R_i into ``solid[i]``. The columns and ``solid``
-    are zeroed first by the caller.
-    """
+    """Sums over the pairs of a range set, by slab groups (race-free, fixed order), into
+    ``sums`` (n, 4), zeroed by the caller: for every particle i, over the particles j whose
+    centre is within radiation_ratio × R_i, [n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2]
+    (``mode`` bits NB_ZHOU, NB_KRAUSE; ``weights`` from :func:`neighbour_weights`); with
+    ``mode`` = NB_SHELL (a pass of its own), sums[i, 0] is instead the volume of the
+    neighbours inside the sphere of radius shell_ratio × R_i."""
     length = upper - lower
     ngroups = group_start.shape[0] - 1
+    krause = (mode & NB_KRAUSE) != 0
+    zhou = (mode & NB_ZHOU) != 0
+    shell = (mode & NB_SHELL) != 0
+    q2 = radiation_ratio * radiation_ratio
     for parity in range(2):
         for half in prange((ngroups + 1 - parity) // 2):
             g = 2 * half + parity
             for k in range(group_start[g], group_start[g + 1]):
                 i = pair_i[k]
                 j = pair_j[k]
-                d = pair_separation(position, i, j, length, periodic)[3]
+                dx, dy, dz, d = pair_separation(position, i, j, length, periodic)
+                d2 = dx * dx + dy * dy + dz * dz
                 ri = radius[i]
                 rj = radius[j]
-                if radiation_ratio > 0.0:
-                    if d < radiation_ratio * ri:
-                        tj = temperature[j]
-                        wj = 2.0 * math.pi * rj * rj * emissivity[type_id[j]]  # ε A / 2
-                        fields[i, F_NEIGHBOURS] += 1.0
-                        fields[i, F_NEIGHBOUR_TEMPERATURE] += tj
-                        fields[i, F_NEIGHBOUR_EMISSION] += wj * (tj * tj) * (tj * tj)
-                        fields[i, F_NEIGHBOUR_AREA] += wj
-                    if d < radiation_ratio * rj:
-                        ti = temperature[i]
-                        wi = 2.0 * math.pi * ri * ri * emissivity[type_id[i]]
-                        fields[j, F_NEIGHBOURS] += 1.0
-                        fields[j, F_NEIGHBOUR_TEMPERATURE] += ti
-                        fields[j, F_NEIGHBOUR_EMISSION] += wi * (ti * ti) * (ti * ti)
-                        fields[j, F_NEIGHBOUR_AREA] += wi
-                if shell_ratio > 0.0:
-                    solid[i] += lens_volume(shell_ratio * ri, rj, d)
-                    solid[j] += lens_volume(shell_ratio * rj, ri, d)
+                if shell:
+                    sums[i, 0] += lens_volume(shell_ratio * ri, rj, d)
+                    sums[j, 0] += lens_volume(shell_ratio * rj, ri, d)
+                    continue
+                if d2 < q2 * ri * ri:
+                    if zhou:
+                        sums[i, 0] += 1.0
+                        sums[i, 1] += weights[j, 2]
+                    if krause:
+                        sums[i, 2] += weights[j, 1]
+                        sums[i, 3] += weights[j, 0]
+                if d2 < q2 * rj * rj:
+                    if zhou:
+                        sums[j, 0] += 1.0
+                        sums[j, 1] += weights[i, 2]
+                    if krause:
+                        sums[j, 2] += weights[i, 1]
+                        sums[j, 3] += weights[i, 0]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def neighbour_columns(sums, fields):
+    """fields[:, F_NEIGHBOURS:F_NEIGHBOUR_AREA + 1] = sums (n, 4)."""
+    n = sums.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            for q in range(4):
+                fields[i, F_NEIGHBOURS + q] = sums[i, q]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def zero_rows(values):
+    """values[:, :] = 0 (parallel)."""
+    n = values.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            for q in range(values.shape[1]):
+                values[i, q] = 0.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -500,7 +544,7 @@ def cap_overlap(r, d1, n1x, n1y, n1z, d2, n2x, n2y, n2z):
 @njit(cache=True, parallel=True, error_model="numpy")
 def shell_porosity(
     position, radius, wall_kind, wall_rows, shell_ratio, lattice, solid, scratch, fields
-):
+):  # solid: (n, 4), the neighbours' volume in column 0
     """ε_i = 1 - (V_i + solid_i) / V_shell,i, clipped to [0, 1]: V_i the particle's own
     volume, solid_i the neighbours' volume inside the shell (:func:`neighbourhood_pass`),
     V_shell,i the volume of the sphere of radius shell_ratio × R_i on the particles' side of
@@ -555,7 +599,7 @@ def shell_porosity(
                         extra += (inside - 1) * (inside - 2) // 2
                 volume -= extra * full / npts
             own = 4.0 / 3.0 * math.pi * ri * ri * ri
-            eps = 1.0 - (own + solid[i]) / volume if volume > 0.0 else 0.0
+            eps = 1.0 - (own + solid[i, 0]) / volume if volume > 0.0 else 0.0
             fields[i, F_POROSITY] = min(max(eps, 0.0), 1.0)
 
 
