@@ -328,3 +328,9 @@ def test_missing_sections_are_named(tmp_path: Path) -> None:
     case["thermal"]["gas"] = {"mean_free_path": 1e-7}
     with pytest.raises(ConfigError, match=r"thermal.gas.density: missing"):
         Simulation(case_from_dict(case))
+
+
+def test_an_unused_fluid_or_porosity_section_is_reported(tmp_path: Path) -> None:
+    case = _case(tmp_path, "stagnant", {"temperature": 300.0}, 1e-3, porosity=0.4)
+    with pytest.warns(RuntimeWarning, match=r"thermal.porosity is given but no selected model"):
+        Simulation(case_from_dict(case))

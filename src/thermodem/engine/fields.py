@@ -129,6 +129,16 @@ class FieldProvider:
                 "local porosity), e.g. porosity: {kind: cell} or {kind: shell, radius_ratio: "
                 "3.0} or {kind: global, value: 0.4}"
             )
+        for key, given, used in (("fluid", self.fluid, users["fluid"]),
+                                 ("porosity", self.porosity, users["porosity"])):  # fmt: skip
+            if given is not None and not used:
+                warnings.warn(
+                    f"thermal.{key} is given but no selected model reads it (thermal.convection "
+                    f"= {settings.convection.model!r}, thermal.radiation = "
+                    f"{settings.radiation.model!r}): it has no effect",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
         if not self.needs_porosity:
             self.porosity = None
         self.shell_ratio = (
@@ -563,14 +573,4 @@ def gas_density(gas: Any) -> float:
     return float(gas.pressure * gas.molar_mass / (GAS_CONSTANT * gas.temperature))
 
 
-def describe(fields: np.ndarray) -> dict[str, float]:
-    """Mean of every non-zero field column (for scripts and tests)."""
-    out = {}
-    for k, name in enumerate(fk.FIELD_NAMES):
-        col = fields[:, k]
-        if col.size and np.any(col != 0.0):
-            out[name] = float(col.mean())
-    return out
-
-
-__all__ = ["FieldProvider", "POROSITY_PROVIDERS", "PorosityProvider", "gas_density", "describe"]
+__all__ = ["FieldProvider", "POROSITY_PROVIDERS", "PorosityProvider", "gas_density"]
