@@ -192,7 +192,8 @@ def test_surroundings_exposure_by_local_porosity(
         tmp_path / "one.txt", np.array([[0.0, 0.0, 0.0]]), np.array([R]), np.array([900.0])
     )
     radiation = {"model": "surroundings", "environment_temperature": 300.0, **exposure}
-    sim = Simulation(case_from_dict(_case([("a", path)], radiation, {"porosity": 0.45})))
+    extra = {"porosity": 0.45} if exposure["exposure"] != "all" else {}
+    sim = Simulation(case_from_dict(_case([("a", path)], radiation, extra)))
     area = 4 * math.pi * R**2
     q = sim.particles.heat_rate_by_mechanism[0, heat.M_RADIATION]
     assert q == pytest.approx(
