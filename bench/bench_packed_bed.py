@@ -11,6 +11,10 @@ With ``--heat MODEL`` the bed conducts heat (contact radius: geometric) with tha
 conduction model, solved every ``--substeps`` mechanical steps (default 1: every step, the
 spec's calculation cycle). ``--conductance-tolerance TOL`` sets
 ``thermal.conductance_force_tolerance`` (default 0: every contact evaluated at every step).
+``--convection MODEL`` adds convection to air at 300 K flowing upwards at 0.5 m/s (uniform)
+with the local porosity of ``--porosity`` (cell, shell or global; default cell), and
+``--radiation MODEL`` a radiation model (e.g. krause2017), both per-particle terms on top of the
+direct conduction (issue 13: gunn1978 + cell + krause2017 on top of batchelor_obrien_simple).
 
 Settling uses the same materials with a softer damping (e = 0.1) and dt = 1e-5 s to get to rest
 faster; the timed run uses exactly the parameters above.
@@ -71,6 +75,9 @@ def case_dict(
     heat: str | None = None,
     substeps: str = "1",
     tolerance: float = 0.0,
+    convection: str | None = None,
+    porosity: str = "cell",
+    radiation: str | None = None,
 ) -> dict:
     side, height, fill_height, _ = bed_geometry(n)
     material = {
@@ -106,6 +113,18 @@ def case_dict(
             "conductance_force_tolerance": tolerance,
             "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * z"},
         }
+        if convection:
+            case["thermal"]["convection"] = convection
+            case["thermal"]["fluid"] = {"temperature": 300.0, "velocity": [0.0, 0.0, 0.5]}
+        if convection or radiation:
+            porosity_case = {"global": {"kind": "global", "value": 0.4},
+                             "cell": {"kind": "cell"}, "shell": {"kind": "shell"}}  # fmt: skip
+            case["thermal"]["porosity"] = porosity_case[porosity]
+        if radiation:
+            material["emissivity"] = 0.9
+            case["thermal"]["radiation"] = {"model": radiation}
+            if radiation == "surroundings":
+                case["thermal"]["radiation"]["environment_temperature"] = 300.0
     if positions_file is None:
         case["insertion"] = [
             {
@@ -174,21 +193,40 @@ def rss_bytes() -> int:
 
 
 def timed(
-    n: int, steps: int, threads: int, heat: str | None, substeps: str = "1", tolerance: float = 0.0
-) -> dict:
+    n: int, steps: int, threads: int, heat: str | None, substeps: str = "1", tolerance: float = 0.0,
+    convection: str | None = None, porosity: str = "cell", radiation: str | None = None,
+) -> dict:  # fmt: skip
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
     bed = settle(n)
     # baseline: interpreter + libraries + compiled kernels on a tiny case
     tiny = Simulation(
-        case_from_dict(case_dict(50, None, 5e-6, 0.5, 1.0, heat, substeps, tolerance)),
+        case_from_dict(
+            case_dict(
+                50, None, 5e-6, 0.5, 1.0, heat, substeps, tolerance, convection, porosity, radiation
+            )
+        ),  # fmt: skip
         threads=threads,
     )
     tiny.run(steps=5)
     baseline = rss_bytes()
     sim = Simulation(
-        case_from_dict(case_dict(n, str(bed), 5e-6, 0.5, 1.0, heat, substeps, tolerance)),
+        case_from_dict(
+            case_dict(
+                n,
+                str(bed),
+                5e-6,
+                0.5,
+                1.0,
+                heat,
+                substeps,
+                tolerance,
+                convection,
+                porosity,
+                radiation,
+            )
+        ),  # fmt: skip
         threads=threads,
     )
     sim.run(steps=20)  # warm-up
@@ -207,6 +245,9 @@ def timed(
         "heat": heat,
         "substeps": substeps if heat else None,
         "conductance_force_tolerance": tolerance if heat else None,
+        "convection": convection,
+        "porosity": porosity if (convection or radiation) else None,
+        "radiation": radiation,
         "particle_steps_per_s": n * steps / elapsed,
         "seconds": elapsed,
         "rebuilds": sim.rebuild_count - r0,
@@ -231,13 +272,16 @@ def main() -> None:
         default=0.0,
         help="thermal.conductance_force_tolerance (0: every contact evaluated at every step)",
     )
+    ap.add_argument("--convection", default=None, help="convection model (with --heat)")
+    ap.add_argument("--porosity", default="cell", choices=["cell", "shell", "global"])
+    ap.add_argument("--radiation", default=None, help="radiation model (with --heat)")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         res = timed(
             args.n, args.steps, args.threads[0], args.heat, args.substeps,
-            args.conductance_tolerance,
+            args.conductance_tolerance, args.convection, args.porosity, args.radiation,
         )  # fmt: skip
         print(json.dumps(res))
         return
@@ -259,6 +303,11 @@ def main() -> None:
         if args.heat:
             cmd += ["--heat", args.heat, "--substeps", args.substeps]
             cmd += ["--conductance-tolerance", str(args.conductance_tolerance)]
+            if args.convection:
+                cmd += ["--convection", args.convection]
+            if args.radiation:
+                cmd += ["--radiation", args.radiation]
+            cmd += ["--porosity", args.porosity]
         out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
         res = json.loads(out.strip().splitlines()[-1])
         results.append(res)
@@ -267,7 +316,11 @@ def main() -> None:
                 f"N = {res['n']}, threads = {th}"
                 + (
                     f", heat {res['heat']} (substeps {res['substeps']}, conductance force "
-                    f"tolerance {res['conductance_force_tolerance']:g})"
+                    f"tolerance {res['conductance_force_tolerance']:g}"
+                    + (f", convection {res['convection']}" if res["convection"] else "")
+                    + (f", radiation {res['radiation']}" if res["radiation"] else "")
+                    + (f", porosity {res['porosity']}" if res["porosity"] else "")
+                    + ")"
                     if res["heat"]
                     else ""
                 )

@@ -14,7 +14,13 @@ untimed steps, then the timed steps; throughput = N × steps / loop seconds.
     python bench/bench_shared_bed.py [--threads 1 2] [--steps 1000] [--warmup 500]
         [--cases mechanics heat region material]
         [--indirect MODEL [--indirect-param KEY=VALUE ...]]
-        [--substeps N] [--json]
+        [--substeps N] [--convection MODEL] [--porosity cell|shell|global]
+        [--radiation MODEL] [--json]
+
+``--convection`` adds convection to air at 300 K flowing upwards at 0.5 m/s (uniform) with
+the local porosity of ``--porosity`` (default cell), ``--radiation`` a radiation model (e.g.
+krause2017; emissivity 0.9), both per-particle terms on top of the heat cases (issue 13:
+``--cases region --convection gunn1978 --radiation krause2017`` against ``--cases region``).
 
 Each (case, thread count) runs in a fresh process; prints particle-steps per second and the
 peak memory above the interpreter's baseline per particle.
@@ -62,7 +68,11 @@ def particle_files(tiny: bool = False) -> tuple[Path, Path, Path]:
     return paths
 
 
-def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = False) -> dict:
+Terms = tuple[str | None, str, str | None]  # (convection, porosity kind, radiation)
+
+
+def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = False,
+              terms: Terms = (None, "cell", None)) -> dict:  # fmt: skip
     all_path, hot_path, cold_path = particle_files(tiny)
     material = {
         "density": 2500.0,
@@ -114,6 +124,20 @@ def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = Fals
         thermal["fixed_temperature"] = [{"select": {"material": "hot"}, "temperature": 400.0}]
     if indirect is not None:
         thermal["indirect_conduction"] = indirect
+    convection, porosity, radiation = terms
+    if convection:
+        thermal["convection"] = convection
+        thermal["fluid"] = {"temperature": 300.0, "velocity": [0.0, 0.0, 0.5]}
+    if convection or radiation:
+        kinds = {"global": {"kind": "global", "value": 0.4}, "cell": {"kind": "cell"},
+                 "shell": {"kind": "shell"}}  # fmt: skip
+        thermal["porosity"] = kinds[porosity]
+    if radiation:
+        for m in case["materials"].values():
+            m["emissivity"] = 0.9
+        thermal["radiation"] = {"model": radiation}
+        if radiation == "surroundings":
+            thermal["radiation"]["environment_temperature"] = 300.0
     case["thermal"] = thermal
     return case
 
@@ -124,16 +148,16 @@ def rss_bytes() -> int:
 
 
 def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | None,
-          substeps: int) -> dict:  # fmt: skip
+          substeps: int, terms: tuple = (None, "cell", None)) -> dict:  # fmt: skip
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
     # baseline: interpreter, libraries and the compiled kernels, loaded on a tiny bed
-    Simulation(case_from_dict(case_dict(kind, indirect, substeps, True)), threads=threads).run(
-        steps=5
-    )
+    Simulation(case_from_dict(case_dict(kind, indirect, substeps, True, terms)),
+               threads=threads).run(steps=5)  # fmt: skip
     baseline = rss_bytes()
-    sim = Simulation(case_from_dict(case_dict(kind, indirect, substeps)), threads=threads)
+    sim = Simulation(case_from_dict(case_dict(kind, indirect, substeps, False, terms)),
+                     threads=threads)  # fmt: skip
     sim.run(steps=warmup)
     t0 = time.perf_counter()
     sim.run(steps=steps)
@@ -155,6 +179,9 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
         out["temperature_max"] = float(sim.particles.temperature.max())
         if sim.thermal.range_set is not None:
             out["range_pairs_per_particle"] = sim.thermal.range_set.count / n
+        ns = sim.thermal.field_provider.neighbourhood
+        if ns is not None:
+            out["neighbourhood_pairs_per_particle"] = ns.count / n
     return out
 
 
@@ -167,6 +194,9 @@ def main() -> None:
     ap.add_argument("--indirect", default=None, help="an indirect_conduction model")
     ap.add_argument("--indirect-param", nargs="*", default=[], help="KEY=VALUE parameters")
     ap.add_argument("--substeps", type=int, default=1)
+    ap.add_argument("--convection", default=None, help="a convection model")
+    ap.add_argument("--porosity", default="cell", choices=["cell", "shell", "global"])
+    ap.add_argument("--radiation", default=None, help="a radiation model")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -178,7 +208,9 @@ def main() -> None:
             indirect[key] = float(value)
     if args.child:
         kind, threads = args.child.split(":")
-        result = timed(kind, int(threads), args.steps, args.warmup, indirect, args.substeps)
+        terms = (args.convection, args.porosity, args.radiation)
+        result = timed(kind, int(threads), args.steps, args.warmup, indirect, args.substeps,
+                       terms)  # fmt: skip
         print(json.dumps(result))
         return
     particle_files()
@@ -191,6 +223,11 @@ def main() -> None:
                    "--substeps", str(args.substeps)]  # fmt: skip
             if args.indirect:
                 cmd += ["--indirect", args.indirect, "--indirect-param", *args.indirect_param]
+            if args.convection:
+                cmd += ["--convection", args.convection]
+            if args.radiation:
+                cmd += ["--radiation", args.radiation]
+            cmd += ["--porosity", args.porosity]
             proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
             result = json.loads(proc.stdout.strip().splitlines()[-1])
             results.append(result)
@@ -198,6 +235,9 @@ def main() -> None:
                 extra = ""
                 if "range_pairs_per_particle" in result:
                     extra = f", {result['range_pairs_per_particle']:.2f} range pairs/particle"
+                if "neighbourhood_pairs_per_particle" in result:
+                    extra += (f", {result['neighbourhood_pairs_per_particle']:.2f} "
+                              "neighbourhood pairs/particle")  # fmt: skip
                 print(
                     f"{kind:10s} {threads} thread(s): "
                     f"{result['particle_steps_per_s'] / 1e6:6.2f} M particle-steps/s, "

@@ -110,15 +110,20 @@ def test_the_section_is_always_there_with_air_defaults():
 
 def test_every_gas_property_a_model_reads_is_a_gas_key():
     users = {f"{s.family}.{s.name}": s.uses_gas for s in registry.all_models() if s.uses_gas}
-    assert set(users) == {
-        "direct_conduction.resistance_network",
-        "direct_conduction.batchelor_obrien_complete",
-        "direct_conduction.batchelor_obrien_modified",
-        "indirect_conduction.batchelor_obrien_separated",
-        "indirect_conduction.rong_horio1999",
-        "indirect_conduction.musser2011",
-        "indirect_conduction.vargas_mccarthy2002",
-    }
+    convection = {f"convection.{n}" for n in registry.names("convection") if n != "none"}
+    assert (
+        set(users)
+        == {
+            "direct_conduction.resistance_network",
+            "direct_conduction.batchelor_obrien_complete",
+            "direct_conduction.batchelor_obrien_modified",
+            "indirect_conduction.batchelor_obrien_separated",
+            "indirect_conduction.rong_horio1999",
+            "indirect_conduction.musser2011",
+            "indirect_conduction.vargas_mccarthy2002",
+        }
+        | convection
+    )  # the convection models read it as thermal.fluid.properties: gas
     for names in users.values():
         assert set(names) <= set(GasProperties.model_fields)
     for spec in registry.all_models():  # no model has the gas among its own parameters

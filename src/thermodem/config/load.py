@@ -146,4 +146,8 @@ def load_case(path: str | Path) -> Case:
     for entry in case.insertion:
         if getattr(entry, "kind", None) == "file" and not Path(entry.path).is_absolute():
             entry.path = str(path.parent / entry.path)
+    fluid = case.thermal.fluid if case.thermal is not None else None
+    for source in (fluid.temperature, fluid.velocity) if fluid is not None else ():
+        if getattr(source, "kind", None) == "grid" and not Path(source.file).is_absolute():
+            source.file = str(path.parent / source.file)
     return case

@@ -6,6 +6,8 @@ Example::
       contact_radius: geometric
       direct_conduction: batchelor_obrien_simple
       indirect_conduction: none    # e.g. {model: rong_horio1999, layer_thickness_ratio: 0.4}
+      convection: none             # e.g. gunn1978, with thermal.fluid and thermal.porosity
+      radiation: none              # e.g. {model: krause2017, radius_ratio: 3.0}
       gas: {thermal_conductivity: 0.0263}   # the interstitial gas (default: air, 300 K, 1 atm)
       substeps: 1                  # solve heat every n mechanical steps, or "auto"
       conductance_force_tolerance: 0   # resistance_network: reuse H while F_n is within tol
@@ -27,6 +29,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
+from thermodem.config.fluid import FluidSettings, PorositySettings, parse_porosity
 from thermodem.state.gas import GasProperties
 
 Vec3 = tuple[float, float, float]
@@ -209,6 +212,21 @@ class ThermalSettings(StrictModel):
         validate_default=True,
         description="radiation model (per-particle term)",
     )
+    convection: Any = Field(
+        default="none",
+        validate_default=True,
+        description="convection model: particle-fluid heat transfer (per-particle term)",
+    )
+    fluid: FluidSettings | None = Field(
+        default=None,
+        description="the fluid around the particles (temperature, velocity, properties), "
+        "read by convection and by radiation.zhou2009",
+    )
+    porosity: PorositySettings | None = Field(
+        default=None,
+        description="local porosity of each particle (global, cell, shell, voronoi), read by "
+        "the porosity-based correlations and radiation models",
+    )
     range_skin: float | None = Field(
         default=None,
         gt=0,
@@ -262,6 +280,16 @@ class ThermalSettings(StrictModel):
     @classmethod
     def _rad(cls, v: Any):  # noqa: ANN206
         return parse_thermal_choice("radiation", v, "none")
+
+    @field_validator("convection", mode="before")
+    @classmethod
+    def _conv(cls, v: Any):  # noqa: ANN206
+        return parse_thermal_choice("convection", v, "none")
+
+    @field_validator("porosity", mode="before")
+    @classmethod
+    def _porosity(cls, v: Any) -> Any:
+        return parse_porosity(v)
 
     @field_validator("substeps")
     @classmethod

@@ -23,7 +23,12 @@ from pydantic import BaseModel
 
 from thermodem.config.schema import Case, ModelChoice
 from thermodem.errors import ConfigError
-from thermodem.kernels.heat_terms import EVAL_INDIRECT, EVAL_RADIATION, EVAL_SEPARATED
+from thermodem.kernels.heat_terms import (
+    EVAL_CONVECTION,
+    EVAL_INDIRECT,
+    EVAL_RADIATION,
+    EVAL_SEPARATED,
+)
 from thermodem.models.registry import ModelSpec
 from thermodem.models.tables import material_table, pair_table
 from thermodem.state import heat
@@ -152,18 +157,20 @@ def build_terms(
                 k_columns=_k_columns(indirect.spec),
             )
         )
-    radiation = settings.radiation
-    if radiation.model != "none":
+    # per-particle terms: their fields come from engine/fields.py (the fluid, the porosity)
+    for family, evaluator in (("convection", EVAL_CONVECTION), ("radiation", EVAL_RADIATION)):
+        choice = getattr(settings, family)
+        if choice.model == "none":
+            continue
+        key = f"thermal.{family}"
         terms.append(
             HeatTerm(
-                key="thermal.radiation",
-                choice=radiation,
+                key=key,
+                choice=choice,
                 target="particles",
-                evaluator=EVAL_RADIATION,
-                table=material_table(
-                    radiation, case, names, particle_material, "thermal.radiation"
-                ),
-                column=heat.M_RADIATION,
+                evaluator=evaluator,
+                table=material_table(choice, case, names, particle_material, key),
+                column=heat.FAMILY_COLUMNS[family][0],
                 wall_column=-1,
                 k_columns=(-1, -1),
             )

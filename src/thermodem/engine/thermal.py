@@ -34,11 +34,14 @@ import numpy as np
 
 from thermodem.config.thermal import ThermalSettings
 from thermodem.engine.external_set import ExternalPairSet
+from thermodem.engine.fields import STATE_PREFIX as FIELDS_PREFIX
+from thermodem.engine.fields import FieldProvider
 from thermodem.engine.range_set import RangePairSet
 from thermodem.engine.terms import HeatTerm, build_terms
 from thermodem.engine.thermal_conditions import ThermalConditions
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
+from thermodem.kernels import fields as field_kernels
 from thermodem.kernels import heat_terms as passes
 from thermodem.kernels import thermal as kernels
 from thermodem.state import heat
@@ -48,7 +51,7 @@ if TYPE_CHECKING:
 
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
 SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty",
-        "_conditions_key")  # fmt: skip
+        "_conditions_key", "field_provider", "fields")  # fmt: skip
 #: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
 RANGE_PREFIX = "range_set__"
 EXTERNAL_PREFIX = "external__"
@@ -112,10 +115,10 @@ class ThermalEngine:
         self.term_conductance = [np.zeros(0) for _ in self.terms]
         self.term_wall_conductance = [np.zeros(0) for _ in self.terms]
         self.term_ready = np.zeros(len(self.terms), np.bool_)
-        #: per-particle fields read by per-particle terms, one column per field; filled by
-        #: their providers before the terms run (none of the present models reads one yet:
-        #: porosity and the fluid state come with convection)
-        self.fields = np.zeros((0, 0))
+        #: per-particle fields read by per-particle terms (columns: kernels/fields.py), filled
+        #: by the providers of engine/fields.py before the terms run (fluid, porosity, ...)
+        self.field_provider = FieldProvider(sim, settings, self.terms)
+        self.fields = np.zeros((0, field_kernels.NFIELDS))
         self._empty = np.zeros(0)
         self.conductance_sum = np.zeros(0)
         #: cumulative ledger [J]: heat in through every boundary mechanism, heat absorbed by
@@ -227,6 +230,7 @@ class ThermalEngine:
             self.range_set.invalidate()
         if self.external is not None:
             self.external.invalidate()
+        self.field_provider.invalidate()
         self.term_ready[:] = False
 
     def _fixed_and_sources(self, time: float) -> tuple[np.ndarray, np.ndarray]:
@@ -383,11 +387,17 @@ class ThermalEngine:
             gap, wall_gap = max(gap, g), max(wall_gap, w)
         return gap, wall_gap
 
-    def evaluate_terms(self) -> None:
-        """Add the heat of every term other than the contact conduction (at this state)."""
+    def evaluate_terms(self, time: float) -> None:
+        """Add the heat of every term other than the contact conduction (at this state and
+        ``time``; the per-particle fields are filled first)."""
         if not self.terms:
             return
         sim = self.sim
+        if self.field_provider.active:
+            n = sim.particles.count
+            if self.fields.shape[0] != n:
+                self.fields = np.zeros((n, field_kernels.NFIELDS))
+            self.field_provider.update(time, self.fields)
         ranged = any(t.target == "range" for t in self.terms)
         if ranged and self.range_set.due(sim):
             self.range_set.build(sim, *self._range_gaps())
@@ -439,8 +449,6 @@ class ThermalEngine:
 
     def _particle_term(self, term: HeatTerm) -> None:
         p = self.sim.particles
-        if self.fields.shape[0] != p.count:
-            self.fields = np.zeros((p.count, self.fields.shape[1]))
         passes.particle_pass(
             p.temperature, p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
             term.table, term.column, p.heat_rate_by_mechanism, self.conductance_sum,
@@ -535,7 +543,7 @@ class ThermalEngine:
         """
         self.prepare(time)
         self.conduction_passes()
-        self.evaluate_terms()
+        self.evaluate_terms(time)
         self.fresh = False
         return self.finish(time)
 
@@ -543,7 +551,7 @@ class ThermalEngine:
         """The fused contact pass has added the contact conduction of this state: add every
         other term and form the total heat rates, for the thermal step that follows."""
         self._fixed_and_sources(time)
-        self.evaluate_terms()
+        self.evaluate_terms(time)
         self.finish(time)
 
     def finish(self, time: float) -> np.ndarray:
@@ -568,7 +576,7 @@ class ThermalEngine:
         else:
             self.prepare(time)
             self.conduction_passes()
-            self.evaluate_terms()
+            self.evaluate_terms(time)
             fixed, source = self.fixed, self.source
         self.fresh = False
         by_mech = p.heat_rate_by_mechanism
@@ -693,6 +701,10 @@ class ThermalEngine:
                 sub = pairs.state_dict()
                 state["scalars"][name] = sub["scalars"]
                 state["arrays"].update({f"{prefix}{k}": v for k, v in sub["arrays"].items()})
+        if self.field_provider.active:
+            sub = self.field_provider.state_dict()
+            state["scalars"]["field_provider"] = sub["scalars"]
+            state["arrays"].update({f"{FIELDS_PREFIX}{k}": v for k, v in sub["arrays"].items()})
         return state
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -703,6 +715,12 @@ class ThermalEngine:
             k[len(RANGE_PREFIX) :]: arrays.pop(k)
             for k in list(arrays)
             if k.startswith(RANGE_PREFIX)
+        }
+        field_scalars = scalars.pop("field_provider", None)
+        field_arrays = {
+            k[len(FIELDS_PREFIX) :]: arrays.pop(k)
+            for k in list(arrays)
+            if k.startswith(FIELDS_PREFIX)
         }
         external_scalars = scalars.pop("external", None)
         external_arrays = {
@@ -730,4 +748,6 @@ class ThermalEngine:
             if self.external is None:  # a script had put a term on an external set
                 self.set_external_term(self.external_term, ExternalPairSet())
             self.external.load_state_dict({"scalars": external_scalars, "arrays": external_arrays})
+        if field_scalars is not None and self.field_provider.active:
+            self.field_provider.load_state_dict({"scalars": field_scalars, "arrays": field_arrays})
         self.conditions.invalidate()

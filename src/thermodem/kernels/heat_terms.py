@@ -16,8 +16,9 @@ and **adds** the heat rate into its particles' mechanism column and the conducta
 - :func:`external_pair_pass` and :func:`csr_heat`: pairs of an external pair set (not
   bounded by a cell edge): a conductance per pair, then every particle sums its pairs
   through a CSR index (``engine/external_set.py``);
-- :func:`particle_pass`: per-particle terms (radiation), each returning a heat rate and a
-  linearised conductance G = -dQ/dT_i that the stability limit adds to ``conductance_sum``;
+- :func:`particle_pass`: per-particle terms (radiation, convection), each returning a heat
+  rate and a linearised conductance G = -dQ/dT_i that the stability limit adds to
+  ``conductance_sum``;
 - :func:`pair_heat_from_conductance`, :func:`wall_heat_from_conductance`: heat rates from
   conductances stored by an earlier evaluation of the same pairs (frozen mechanics).
 
@@ -43,6 +44,7 @@ from thermodem.models.thermal.contact_radius import (
     contact_radius_dispatch,
     geometric_contact_radius,
 )
+from thermodem.models.thermal.convection import convection_dispatch
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.radiation import radiation_dispatch
@@ -53,6 +55,7 @@ EVAL_INDIRECT = 0
 EVAL_SEPARATED = 1
 #: Evaluators of per-particle terms.
 EVAL_RADIATION = 2
+EVAL_CONVECTION = 3
 
 WALL_CHUNK = 4096  # particles per chunk of the wall passes
 PARTICLE_CHUNK = 4096  # particles per chunk of the per-particle passes
@@ -303,6 +306,8 @@ def csr_heat(
 @njit(cache=True, inline="always", error_model="numpy")
 def particle_term(evaluator, model_id, p, t_i, r_i, fields, i):
     """(Q into particle i [W], G = -dQ/dT_i [W/K]) of a per-particle term."""
+    if evaluator == EVAL_CONVECTION:
+        return convection_dispatch(model_id, p, t_i, r_i, fields, i)
     return radiation_dispatch(model_id, p, t_i, r_i, fields, i)
 
 

@@ -4,8 +4,11 @@ One gas fills the space between the particles for the whole case. Every thermal 
 needs it reads it from the :class:`~thermodem.state.materials.PairContext` its ``pack``
 receives (``pair.gas``), never from its own parameters: the resistance network (k_g, and the
 gas parameter M from Λ, Pr and γ), the Batchelor & O'Brien complete and modified models (k_f),
-and later indirect conduction and convection. A model lists the gas properties it reads in its
-registry entry (``uses_gas``), which ``thermodem models`` prints.
+and the indirect conduction models. The convection models read it as the fluid's properties
+when ``thermal.fluid.properties`` is ``gas`` (the default): k_g, c_p, μ and the density ρ_g
+(``density``, or the ideal gas P M / (R T) of ``pressure``, ``temperature``, ``molar_mass``).
+A model lists the gas properties it reads in its registry entry (``uses_gas``), which
+``thermodem models`` prints.
 
 The defaults are air at 300 K and 101325 Pa (Incropera et al. 2006, Fundamentals of Heat and
 Mass Transfer, 6th ed., table A.4; kinetic diameter of air 0.366 nm): a case whose thermal
@@ -57,6 +60,15 @@ class GasProperties(StrictModel):
     )
     molecular_diameter: float | None = Field(
         default=None, gt=0, description="d [m] for Λ; 3.66e-10 unless mean_free_path is given"
+    )
+    density: float | None = Field(
+        default=None,
+        gt=0,
+        description="ρ_g [kg/m³] (convection); null: the ideal gas "
+        "P M / (R T) of pressure, temperature and molar_mass",
+    )
+    molar_mass: float = Field(
+        default=0.0289647, gt=0, description="M [kg/mol] for the ideal-gas density (air)"
     )
 
     @model_validator(mode="after")

@@ -1,0 +1,576 @@
+"""Per-particle fields: the fluid at each particle, the local porosity, the neighbourhood.
+
+The per-particle heat terms (convection, radiation) read a field array ``fields`` (n,
+``NFIELDS``) whose columns are defined in ``kernels/fields.py``. :class:`FieldProvider` fills
+the columns the case's terms need, at every thermal step, before those terms run
+(``ThermalEngine.evaluate_terms``):
+
+- **fluid temperature** T_f and **velocity** u_f (``thermal.fluid``): uniform, a table of
+  time, an expression of (t, x, y, z), or a grid file interpolated trilinearly to the
+  particles (``io/grid_field.py``); the relative speed |u_f − v_p|;
+- **fluid properties** k_f, ρ_f, c_f, μ_f at T_f and μ_fs at the particle temperature, Pr and
+  Pr^⅓: from ``thermal.gas`` (constant) or a liquid with temperature tables;
+- **local porosity** (``thermal.porosity``): global value, cell count, shell count, or a
+  provider registered for ``voronoi`` (:data:`POROSITY_PROVIDERS`, the hook of the Voronoi
+  tessellation);
+- **neighbourhood sums** of the continuum radiation models (particles whose centre lies in the
+  sphere of radiative influence) and the shell porosity, over a range pair set of their own
+  (``engine/range_set.py``: slab groups, rebuilt lazily, saved in checkpoints);
+- **walls in view** of the particle–wall radiation.
+
+It also evaluates the convection correlation's dimensionless numbers and warns once (a
+``RuntimeWarning``, logged by the runner) when a run leaves the correlation's validity range,
+naming the particle, the value, the range, the step and the time.
+
+The fluid is one-way coupled: the heat the particles exchange does not change it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+
+from thermodem.config.fluid import (
+    CellPorosity,
+    ExpressionSource,
+    GlobalPorosity,
+    GridSource,
+    LiquidFluid,
+    ShellPorosity,
+    TableSource,
+    UniformSource,
+    VoronoiPorosity,
+)
+from thermodem.engine.range_set import RangePairSet
+from thermodem.errors import ConfigError, SimulationError
+from thermodem.geometry import wall_layout as wall_cols
+from thermodem.kernels import fields as fk
+from thermodem.models.thermal import convection as conv
+from thermodem.models.thermal import radiation as rad
+
+if TYPE_CHECKING:
+    from thermodem.config.thermal import ThermalSettings
+    from thermodem.engine.simulation import Simulation
+    from thermodem.engine.terms import HeatTerm
+
+#: Ideal gas constant [J/(mol K)] (exact, SI 2019).
+GAS_CONSTANT = 8.314462618
+#: Prefix of the neighbourhood set's arrays in the engine's checkpoint.
+STATE_PREFIX = "fields__"
+
+
+class PorosityProvider(Protocol):
+    """Fills ``fields[:, F_POROSITY]`` for the current particles (the Voronoi hook)."""
+
+    def update(self, sim: Simulation, fields: np.ndarray) -> None: ...
+
+
+#: Porosity providers by ``thermal.porosity.kind`` registered from outside (the Voronoi
+#: tessellation registers ``voronoi``: a factory (sim, settings) -> PorosityProvider).
+POROSITY_PROVIDERS: dict[str, Callable[[Simulation, Any], PorosityProvider]] = {}
+
+
+class FieldProvider:
+    """Fills the per-particle field columns the terms need (see the module docstring)."""
+
+    def __init__(self, sim: Simulation, settings: ThermalSettings, terms: list[HeatTerm]) -> None:
+        self.sim = sim
+        self.settings = settings
+        self.fluid = settings.fluid
+        self.convection = next((t for t in terms if t.key == "thermal.convection"), None)
+        self.radiation = next((t for t in terms if t.key == "thermal.radiation"), None)
+        self.active = self.convection is not None or self.radiation is not None
+        self.needs_temperature = self.needs_velocity = self.needs_properties = False
+        self.needs_porosity = False
+        self.radiation_ratio = 0.0
+        self.walls: rad.WallRadiation | None = None
+        users: dict[str, list[str]] = {"fluid": [], "porosity": []}
+        if self.convection is not None:
+            name = self.convection.choice.model
+            who = f"thermal.convection = {name!r}"
+            self.needs_temperature = self.needs_properties = True
+            self.needs_velocity = name != "stagnant"
+            users["fluid"].append(who)
+            params = self.convection.params
+            if name in conv.USES_POROSITY or getattr(params, "reynolds_velocity", "") == (
+                "superficial"
+            ):
+                self.needs_porosity = True
+                users["porosity"].append(who)
+        if self.radiation is not None:
+            name = self.radiation.choice.model
+            params = self.radiation.params
+            who = f"thermal.radiation = {name!r}"
+            if name == "surroundings" and params.exposure != "all":
+                self.needs_porosity = True
+                users["porosity"].append(f"{who} (exposure: {params.exposure})")
+            if name == "zhou2009":
+                self.needs_temperature = True
+                self.needs_porosity = True
+                users["fluid"].append(who)
+                users["porosity"].append(who)
+            if name in rad.NEIGHBOURHOOD_MODELS:
+                self.radiation_ratio = float(params.radius_ratio)
+            if params.walls:
+                self.walls = params
+        if users["fluid"] and self.fluid is None:
+            raise ConfigError(
+                f"thermal.fluid: missing; required by {', '.join(users['fluid'])} (the fluid "
+                "temperature, velocity and properties), e.g. fluid: {temperature: 300.0, "
+                "velocity: [0.0, 0.0, 0.5]}"
+            )
+        self.porosity = settings.porosity
+        if users["porosity"] and self.porosity is None:
+            raise ConfigError(
+                f"thermal.porosity: missing; required by {', '.join(users['porosity'])} (the "
+                "local porosity), e.g. porosity: {kind: cell} or {kind: shell, radius_ratio: "
+                "3.0} or {kind: global, value: 0.4}"
+            )
+        for key, given, used in (("fluid", self.fluid, users["fluid"]),
+                                 ("porosity", self.porosity, users["porosity"])):  # fmt: skip
+            if given is not None and not used:
+                warnings.warn(
+                    f"thermal.{key} is given but no selected model reads it (thermal.convection "
+                    f"= {settings.convection.model!r}, thermal.radiation = "
+                    f"{settings.radiation.model!r}): it has no effect",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
+        if not self.needs_porosity:
+            self.porosity = None
+        self.shell_ratio = (
+            float(self.porosity.radius_ratio) if isinstance(self.porosity, ShellPorosity) else 0.0
+        )
+        self.external_porosity: PorosityProvider | None = None
+        if isinstance(self.porosity, VoronoiPorosity):
+            factory = POROSITY_PROVIDERS.get("voronoi")
+            if factory is None:
+                raise ConfigError(
+                    "thermal.porosity.kind = 'voronoi': needs the Voronoi tessellation, which "
+                    "this version does not have; use kind cell, shell or global"
+                )
+            self.external_porosity = factory(sim, self.porosity)
+        # the fluid
+        self._sources: dict[str, Any] = {}
+        if self.needs_temperature:
+            self._sources["temperature"] = self._source(self.fluid.temperature, "temperature", 1)
+        if self.needs_velocity:
+            self._sources["velocity"] = self._source(self.fluid.velocity, "velocity", 3)
+        self._constant_properties: dict[int, float] = {}
+        self._property_tables: list[tuple[int, np.ndarray, np.ndarray, bool]] = []
+        self.beta_mode, self.beta = 0, 0.0
+        if self.needs_properties:
+            self._properties_setup()
+        # neighbourhood (continuum radiation, shell porosity)
+        self.neighbourhood = (
+            RangePairSet(settings.range_skin)
+            if self.radiation_ratio > 0.0 or self.shell_ratio > 0.0
+            else None
+        )
+        self.emissivity = (
+            np.ascontiguousarray(self.radiation.table[:, 0], np.float64)
+            if self.radiation is not None and self.radiation.table.ndim == 2
+            else np.zeros(1)
+        )
+        self.radiation_mode = 0
+        if self.radiation is not None and self.radiation.choice.model == "krause2017":
+            self.radiation_mode = fk.NB_KRAUSE
+        elif self.radiation is not None and self.radiation.choice.model == "zhou2009":
+            self.radiation_mode = fk.NB_ZHOU
+        self.lattice = fk.unit_ball_points()
+        self.sums = np.zeros((0, 4))
+        self.weights = np.zeros((0, 4))
+        self.scratch = np.zeros((1, 4))
+        # cell porosity (the grid is set up at the first evaluation: its default size)
+        self.cell_size = 0.0
+        self.cell_dims = np.ones(3, np.int64)
+        self.cell_edge = np.ones(3)
+        self.cell_fluid = np.zeros(0)
+        self.cell_solid = np.zeros(0)
+        self.cell_of = np.zeros(0, np.int64)
+        self._cell_walls = np.zeros((0, wall_cols.WALL_WIDTH))
+        # validity ranges of the convection correlation
+        self.ranges: list[tuple[str, float, float]] = []
+        if self.convection is not None:
+            self.ranges = list(conv.VALIDITY[self.convection.choice.model])
+            if self.beta_mode == 0:
+                self.ranges = [r for r in self.ranges if r[0] != "Ra"]
+        self.warned: list[str] = []
+        self.numbers_buffer = np.zeros((0, len(conv.NUMBER_NAMES)))
+        self.velocity_buffer = np.zeros((1, 3))
+        self.part = np.zeros(1)
+        self._constants_for: np.ndarray | None = None
+
+    # ---------------------------------------------------------------------- set-up
+    def _source(self, source: Any, name: str, components: int) -> Any:
+        key = f"thermal.fluid.{name}"
+        if isinstance(source, GridSource):
+            from thermodem.io.grid_field import read_grid_field
+
+            try:
+                axes, values = read_grid_field(source.file, source.field, components,
+                                               source.location)  # fmt: skip
+            except ValueError as exc:
+                raise ConfigError(f"{key}.file: {exc}") from None
+            if components == 1 and not (values > 0).all():
+                k = np.argwhere(values <= 0)[0]
+                raise ConfigError(
+                    f"{key}.file: temperature {float(values[tuple(k)])!r} K at grid index "
+                    f"{tuple(int(v) for v in k[:3])} of {source.file}; temperatures must be > 0"
+                )
+            return ("grid", axes, values, source.file)
+        if isinstance(source, ExpressionSource):
+            from thermodem.engine.expressions import compile_expression
+
+            return ("expression", [compile_expression(e, ("t", "x", "y", "z"))
+                                   for e in source.expression], source.expression)  # fmt: skip
+        if isinstance(source, TableSource):
+            table = np.asarray(source.table, np.float64)
+            return ("table", table)
+        assert isinstance(source, UniformSource)
+        return ("uniform", np.asarray(source.value, np.float64))
+
+    def _properties_setup(self) -> None:
+        props = self.fluid.properties
+        if isinstance(props, LiquidFluid):
+            for col, value in (
+                (fk.F_FLUID_CONDUCTIVITY, props.thermal_conductivity),
+                (fk.F_FLUID_DENSITY, props.density),
+                (fk.F_FLUID_SPECIFIC_HEAT, props.specific_heat),
+                (fk.F_FLUID_VISCOSITY, props.dynamic_viscosity),
+            ):
+                if isinstance(value, list):
+                    arr = np.asarray(value, np.float64)
+                    nodes = np.ascontiguousarray(arr[:, 0])
+                    vals = np.ascontiguousarray(arr[:, 1])
+                    self._property_tables.append((col, nodes, vals, False))
+                    if col == fk.F_FLUID_VISCOSITY:
+                        self._property_tables.append((fk.F_SURFACE_VISCOSITY, nodes, vals, True))
+                else:
+                    self._constant_properties[col] = float(value)
+                    if col == fk.F_FLUID_VISCOSITY:
+                        self._constant_properties[fk.F_SURFACE_VISCOSITY] = float(value)
+            if props.thermal_expansion is not None:
+                self.beta_mode, self.beta = 2, float(props.thermal_expansion)
+        else:
+            gas = self.settings.gas
+            density = gas_density(gas)
+            self._constant_properties = {
+                fk.F_FLUID_CONDUCTIVITY: gas.thermal_conductivity,
+                fk.F_FLUID_DENSITY: density,
+                fk.F_FLUID_SPECIFIC_HEAT: gas.specific_heat,
+                fk.F_FLUID_VISCOSITY: gas.dynamic_viscosity,
+                fk.F_SURFACE_VISCOSITY: gas.dynamic_viscosity,
+            }
+            self.beta_mode = 1  # ideal gas: β = 1/T_f
+        c = self._constant_properties
+        if not self._property_tables:
+            pr = (c[fk.F_FLUID_SPECIFIC_HEAT] * c[fk.F_FLUID_VISCOSITY]
+                  / c[fk.F_FLUID_CONDUCTIVITY])  # fmt: skip
+            c[fk.F_PRANDTL] = pr
+            c[fk.F_PRANDTL_CBRT] = pr ** (1.0 / 3.0)
+
+    def _constant_columns(self) -> dict[int, float]:
+        """Columns that are the same for every particle at every step."""
+        out = dict(self._constant_properties)
+        if isinstance(self.porosity, GlobalPorosity):
+            out[fk.F_POROSITY] = float(self.porosity.value)
+        source = self._sources.get("temperature")
+        if source is not None and source[0] == "uniform":
+            out[fk.F_FLUID_TEMPERATURE] = float(source[1][0])
+        return out
+
+    # ---------------------------------------------------------------------- update
+    def invalidate(self) -> None:
+        """The particles were reordered or inserted (the neighbourhood set holds indices)."""
+        if self.neighbourhood is not None:
+            self.neighbourhood.invalidate()
+
+    def update(self, time: float, fields: np.ndarray) -> None:
+        """Fill the columns the terms need for the current state at ``time``."""
+        sim = self.sim
+        p = sim.particles
+        if p.count == 0 or not self.active:
+            return
+        if fields is not self._constants_for:  # a new array: its constant columns
+            for col, value in self._constant_columns().items():
+                fk.fill_column(fields, col, value)
+            self._constants_for = fields
+        if self.needs_temperature:
+            self._temperature(time, fields)
+        for col, nodes, values, at_particle in self._property_tables:
+            fk.table_column(fields, col, nodes, values, at_particle, p.temperature)
+        if self._property_tables:
+            fk.prandtl_columns(fields)
+        if self.needs_velocity:
+            self._velocity(time, fields)
+        if self.neighbourhood is not None:
+            self._neighbourhood(fields)
+        if isinstance(self.porosity, CellPorosity):
+            self._cell_porosity(fields)
+        elif self.external_porosity is not None:
+            self.external_porosity.update(sim, fields)
+        if self.walls is not None:
+            fk.wall_view(p.position, p.radius, sim.wall_kind, sim.wall_rows,
+                         float(self.walls.wall_range), float(self.walls.wall_view_factor),
+                         fields)  # fmt: skip
+        if self.ranges and len(self.warned) < len(self.ranges):
+            self._check_ranges(time, fields)
+
+    def _chunks(self) -> int:
+        return self.sim.particles.count // fk.CHUNK + 1
+
+    def _part(self) -> np.ndarray:
+        rows = self._chunks()
+        if self.part.shape[0] < rows:
+            self.part = np.zeros(rows)
+        return self.part
+
+    def _outside_warning(self, key: str, file: str, count: int, axes: Any, time: float) -> None:
+        if count and key not in self.warned:
+            self.warned.append(key)
+            extent = ", ".join(
+                f"{a} {ax[0]:.6g}..{ax[-1]:.6g}" for a, ax in zip("xyz", axes, strict=True)
+            )
+            warnings.warn(
+                f"{key}: {count} particles outside the grid of {file} ({extent} m) at step "
+                f"{self.sim.step_count} (t = {time:.6g} s): they take the value at the nearest "
+                "point of the grid's boundary (reported once)",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+
+    def _temperature(self, time: float, fields: np.ndarray) -> None:
+        p = self.sim.particles
+        source = self._sources["temperature"]
+        kind = source[0]
+        if kind == "uniform":
+            return  # a constant column
+        if kind == "table":
+            table = source[1]
+            fk.fill_column(fields, fk.F_FLUID_TEMPERATURE,
+                           float(np.interp(time, table[:, 0], table[:, 1])))  # fmt: skip
+        elif kind == "expression":
+            pos = p.position
+            values = np.broadcast_to(
+                source[1][0](time, pos[:, 0], pos[:, 1], pos[:, 2]), (p.count,)
+            )
+            bad = ~(np.isfinite(values) & (values > 0))
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise SimulationError(
+                    f"thermal.fluid.temperature: the expression {source[2][0]!r} gives "
+                    f"{float(values[k])!r} K at particle {int(p.global_id[k])} (x, y, z = "
+                    f"{tuple(float(v) for v in pos[k])}) at step {self.sim.step_count} "
+                    f"(t = {time:.6g} s); temperatures must be finite and > 0",
+                    self.sim.step_count,
+                    time,
+                    int(p.global_id[k]),
+                )
+            fields[:, fk.F_FLUID_TEMPERATURE] = values
+        else:
+            _, axes, values, file = source
+            outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values, fields,
+                                     fk.F_FLUID_TEMPERATURE, self._part())  # fmt: skip
+            self._outside_warning("thermal.fluid.temperature", file, outside, axes, time)
+
+    def _velocity(self, time: float, fields: np.ndarray) -> None:
+        p = self.sim.particles
+        source = self._sources["velocity"]
+        kind = source[0]
+        uniform = kind in ("uniform", "table")
+        if kind == "uniform":
+            self.velocity_buffer[0] = source[1]
+        elif kind == "table":
+            table = source[1]
+            for a in range(3):
+                self.velocity_buffer[0, a] = np.interp(time, table[:, 0], table[:, 1 + a])
+        else:
+            if self.velocity_buffer.shape[0] != p.count:
+                self.velocity_buffer = np.zeros((p.count, 3))
+            if kind == "expression":
+                pos = p.position
+                for a in range(3):
+                    self.velocity_buffer[:, a] = source[1][a](time, pos[:, 0], pos[:, 1],
+                                                              pos[:, 2])  # fmt: skip
+                bad = ~np.isfinite(self.velocity_buffer).all(axis=1)
+                if bad.any():
+                    k = int(np.argmax(bad))
+                    raise SimulationError(
+                        f"thermal.fluid.velocity: the expressions {list(source[2])} give "
+                        f"{self.velocity_buffer[k].tolist()} m/s at particle "
+                        f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s)",
+                        self.sim.step_count,
+                        time,
+                        int(p.global_id[k]),
+                    )
+            else:
+                _, axes, values, file = source
+                outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values,
+                                         self.velocity_buffer, 0, self._part())  # fmt: skip
+                self._outside_warning("thermal.fluid.velocity", file, outside, axes, time)
+        fk.relative_speed(p.velocity, self.velocity_buffer, uniform, fields)
+
+    def fluid_velocity(self) -> np.ndarray:
+        """u_f at the particles at the last update [m/s], (n, 3) (or (1, 3) if uniform)."""
+        return self.velocity_buffer.copy()
+
+    # ----------------------------------------------------------------- neighbourhood
+    def _neighbourhood_gap(self) -> float:
+        r = self.sim.particles.radius
+        r_max, r_min = float(r.max()), float(r.min())
+        gap = 0.0
+        if self.radiation_ratio > 0.0:
+            gap = max(gap, self.radiation_ratio * r_max - 2.0 * r_min)
+        if self.shell_ratio > 0.0:
+            gap = max(gap, (self.shell_ratio - 1.0) * r_max)
+        return gap
+
+    def _neighbourhood(self, fields: np.ndarray) -> None:
+        sim = self.sim
+        p = sim.particles
+        ns = self.neighbourhood
+        if ns.due(sim):
+            ns.build(sim, self._neighbourhood_gap(), 0.0)
+        n = p.count
+        if self.sums.shape[0] != n:
+            self.sums = np.zeros((n, 4))
+            self.weights = np.zeros((n, 4))
+        args = (p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower, sim.upper,
+                sim.periodic, self.weights)  # fmt: skip
+        if self.radiation_ratio > 0.0:
+            fk.neighbour_weights(p.radius, p.temperature, p.type_id, self.emissivity,
+                                 self.weights)  # fmt: skip
+            fk.zero_rows(self.sums)
+            fk.neighbourhood_pass(*args, self.radiation_mode, self.radiation_ratio, 0.0,
+                                  self.sums)  # fmt: skip
+            fk.neighbour_columns(self.sums, fields)
+        if self.shell_ratio > 0.0:
+            fk.zero_rows(self.sums)
+            fk.neighbourhood_pass(*args, fk.NB_SHELL, 0.0, self.shell_ratio, self.sums)
+            width = 4 * max(sim.wall_kind.shape[0], 1)
+            if self.scratch.shape[0] < self._chunks() or self.scratch.shape[1] < width:
+                self.scratch = np.zeros((self._chunks(), width))
+            fk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
+                              self.shell_ratio, self.lattice, self.sums, self.scratch,
+                              fields)  # fmt: skip
+
+    # ------------------------------------------------------------------ cell porosity
+    def _cell_grid(self, size: float) -> None:
+        """Cells of edge ``size`` (rounded to tile the domain)."""
+        sim = self.sim
+        self.cell_size = float(size)
+        dims = np.empty(3, np.int64)
+        for a in range(3):
+            dims[a] = max(int(round(float(sim.upper[a] - sim.lower[a]) / self.cell_size)), 1)
+        self.cell_dims = dims
+        self.cell_edge = np.ascontiguousarray((sim.upper - sim.lower) / dims, np.float64)
+        self.cell_fluid = np.zeros(int(dims.prod()))
+        self.cell_solid = np.zeros(int(dims.prod()))
+        self._cell_walls = np.zeros((0, wall_cols.WALL_WIDTH))
+
+    def _cell_porosity(self, fields: np.ndarray) -> None:
+        sim = self.sim
+        p = sim.particles
+        if self.cell_fluid.shape[0] == 0:
+            self._cell_grid(self.porosity.cell_size or 6.0 * float(p.radius.max()))
+        geometry = np.concatenate([sim.wall_rows[:, :6], sim.wall_rows[:, 9:15]], axis=1)
+        if self._cell_walls.shape != geometry.shape or not np.array_equal(
+            self._cell_walls, geometry
+        ):
+            fk.cell_fluid_volume(sim.lower, self.cell_edge, self.cell_dims, sim.wall_kind,
+                                 sim.wall_rows, 4, self.cell_fluid)  # fmt: skip
+            self._cell_walls = geometry
+        if self.cell_of.shape[0] != p.count:
+            self.cell_of = np.zeros(p.count, np.int64)
+        fk.cell_porosity(p.position, p.radius, sim.lower, self.cell_edge, self.cell_dims,
+                         self.cell_fluid, self.cell_solid, self.cell_of, fields)  # fmt: skip
+
+    # --------------------------------------------------------------- validity ranges
+    def numbers(self, fields: np.ndarray, nusselt: bool = True) -> dict[str, np.ndarray]:
+        """Re, Pr, Nu, μ_f/μ_fs, ε and Ra of every particle at the last update (copies)."""
+        if self.convection is None:
+            return {}
+        self._numbers(fields, nusselt)
+        return {name: self.numbers_buffer[:, k].copy()
+                for k, name in enumerate(conv.NUMBER_NAMES)}  # fmt: skip
+
+    def _numbers(self, fields: np.ndarray, nusselt: bool) -> None:
+        p = self.sim.particles
+        if self.numbers_buffer.shape[0] != p.count:
+            self.numbers_buffer = np.zeros((p.count, len(conv.NUMBER_NAMES)))
+        term = self.convection
+        gravity = float(np.linalg.norm(self.sim.gravity))
+        conv.convection_numbers(fields, p.radius, p.temperature, p.type_id, term.model_id,
+                                term.table, gravity, self.beta_mode, self.beta, nusselt,
+                                self.numbers_buffer)  # fmt: skip
+
+    def _check_ranges(self, time: float, fields: np.ndarray) -> None:
+        self._numbers(fields, False)
+        p = self.sim.particles
+        model = self.convection.choice.model
+        for name, lo, hi in self.ranges:
+            if name in self.warned:
+                continue
+            col = conv.NUMBER_NAMES.index(name)
+            k = conv.first_outside(self.numbers_buffer, col, lo, hi)
+            if k < 0:
+                continue
+            self.warned.append(name)
+            value = float(self.numbers_buffer[k, col])
+            others = ", ".join(
+                f"{n} = {self.numbers_buffer[k, conv.NUMBER_NAMES.index(n)]:.4g}"
+                for n in ("Re", "Pr", "porosity")
+                if n != name
+            )
+            warnings.warn(
+                f"thermal.convection = {model!r}: {name} = {value:.4g} of particle "
+                f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s) is "
+                f"outside the correlation's range {lo:g}–{hi:g} ({others}); the correlation is "
+                "extrapolated (reported once per quantity)",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+
+    # ---------------------------------------------------------------- checkpoints
+    def state_dict(self) -> dict[str, Any]:
+        """Scalars and arrays to save (the neighbourhood set: its order fixes the sums)."""
+        scalars: dict[str, Any] = {"warned": list(self.warned), "cell_size": self.cell_size}
+        arrays: dict[str, np.ndarray] = {}
+        if self.neighbourhood is not None:
+            sub = self.neighbourhood.state_dict()
+            scalars["neighbourhood"] = sub["scalars"]
+            arrays.update(sub["arrays"])
+        return {"scalars": scalars, "arrays": arrays}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        scalars, arrays = state["scalars"], state["arrays"]
+        self.warned = [str(w) for w in scalars.get("warned", [])]
+        cell_size = float(scalars.get("cell_size", 0.0))
+        if cell_size and isinstance(self.porosity, CellPorosity):
+            self._cell_grid(cell_size)  # the grid of the saved run (its default size)
+        if self.neighbourhood is not None and "neighbourhood" in scalars:
+            self.neighbourhood.load_state_dict(
+                {"scalars": scalars["neighbourhood"], "arrays": arrays}
+            )
+        self._constants_for = None
+
+
+def gas_density(gas: Any) -> float:
+    """ρ of the case gas [kg/m³]: ``density`` if given, else the ideal gas P M / (R T) of its
+    ``pressure``, ``temperature`` and ``molar_mass``."""
+    if getattr(gas, "density", None) is not None:
+        return float(gas.density)
+    if gas.pressure is None or gas.temperature is None:
+        raise ConfigError(
+            "thermal.gas.density: missing; needed by the convection models (the Reynolds "
+            "number) when the gas gives mean_free_path instead of pressure and temperature: "
+            "give thermal.gas.density [kg/m³]"
+        )
+    return float(gas.pressure * gas.molar_mass / (GAS_CONSTANT * gas.temperature))
+
+
+__all__ = ["FieldProvider", "POROSITY_PROVIDERS", "PorosityProvider", "gas_density"]

@@ -1,0 +1,631 @@
+"""Per-particle fields read by the per-particle heat terms (convection, radiation).
+
+The thermal engine holds one array ``fields`` of shape (n, NFIELDS); its columns are defined
+here, once, and filled by the providers of ``engine/fields.py`` at every thermal step before
+the per-particle terms run. A model kernel reads ``fields[i, F_...]``. Columns a case does not
+need stay zero (a zero wall view factor, for example, means "no wall in view").
+
+Kernels of this module (all compiled, no Python loops over particles; every particle writes
+only its own row, or a pair pass adds by slab groups, so the results do not depend on the
+thread count):
+
+- :func:`fill_column`, :func:`zero_columns`: constant columns;
+- :func:`table_column`: a property table of temperature at the fluid or particle temperature;
+- :func:`grid_sample`: trilinear interpolation of a rectilinear grid field at the particles;
+- :func:`relative_speed`: |u_f - v_p|;
+- :func:`cell_fluid_volume`, :func:`cell_porosity`: porosity by a cell count;
+- :func:`neighbour_weights`, :func:`neighbourhood_pass`, :func:`neighbour_columns`: sums over
+  the neighbours within a sphere of influence (count, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2;
+  or the solid volume within a shell);
+- :func:`shell_porosity`: 1 - solid volume / shell volume inside the walls;
+- :func:`wall_view`: view factors and Σ F T_w⁴ of the fixed-temperature walls in view.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from thermodem.geometry.wall_layout import (
+    COL_AXIS,
+    COL_HALF_LENGTH,
+    COL_HALF_U,
+    COL_HALF_V,
+    COL_NORMAL,
+    COL_POINT,
+    COL_RADIUS,
+    COL_SIDE,
+    COL_TEMPERATURE,
+    COL_THERMAL_KIND,
+    COL_U,
+    CYLINDER,
+    PLANE,
+    RECTANGLE,
+)
+from thermodem.kernels.neighbors import pair_separation, wall_distance
+
+#: Columns of the per-particle field array (the engine's ``fields``).
+F_POROSITY = 0  # local porosity ε [-]
+F_FLUID_TEMPERATURE = 1  # T_f at the particle [K]
+F_RELATIVE_SPEED = 2  # |u_f - v_p| [m/s]
+F_FLUID_CONDUCTIVITY = 3  # k_f at T_f [W/(m K)]
+F_FLUID_DENSITY = 4  # ρ_f at T_f [kg/m³]
+F_FLUID_SPECIFIC_HEAT = 5  # c_f at T_f [J/(kg K)]
+F_FLUID_VISCOSITY = 6  # μ_f at T_f [Pa s]
+F_SURFACE_VISCOSITY = 7  # μ_fs at the particle (surface) temperature [Pa s]
+F_PRANDTL = 8  # Pr = c_f μ_f / k_f [-]
+F_PRANDTL_CBRT = 9  # Pr^(1/3) [-]
+F_NEIGHBOURS = 10  # n_p: particles whose centre lies in the sphere of radiative influence
+F_NEIGHBOUR_TEMPERATURE = 11  # Σ_j T_j over them [K]
+F_NEIGHBOUR_EMISSION = 12  # Σ_j ε_j A_j T_j⁴ / 2 over them [m² K⁴]
+F_NEIGHBOUR_AREA = 13  # Σ_j ε_j A_j / 2 over them [m²]
+F_WALL_VIEW = 14  # Σ_w F_iw over the fixed-temperature walls in view [-]
+F_WALL_EMISSION = 15  # Σ_w F_iw T_w⁴ [K⁴]
+NFIELDS = 16
+
+FIELD_NAMES: tuple[str, ...] = (
+    "porosity",
+    "fluid_temperature",
+    "relative_speed",
+    "fluid_conductivity",
+    "fluid_density",
+    "fluid_specific_heat",
+    "fluid_viscosity",
+    "surface_viscosity",
+    "prandtl",
+    "prandtl_cbrt",
+    "neighbour_count",
+    "neighbour_temperature_sum",
+    "neighbour_emission",
+    "neighbour_emissive_area",
+    "wall_view_factor",
+    "wall_emission",
+)
+
+CHUNK = 4096  # particles per chunk of the parallel passes
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def fill_column(fields, column, value):
+    """fields[:, column] = value."""
+    n = fields.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            fields[i, column] = value
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def zero_columns(fields, first, last):
+    """fields[:, first:last] = 0."""
+    n = fields.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            for k in range(first, last):
+                fields[i, k] = 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def interp_held(x, nodes, values):
+    """Linear interpolation in a table, held at the first / last value outside it."""
+    m = nodes.shape[0]
+    if m == 1 or x <= nodes[0]:
+        return values[0]
+    if x >= nodes[m - 1]:
+        return values[m - 1]
+    lo = 0
+    hi = m - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if nodes[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    w = (x - nodes[lo]) / (nodes[hi] - nodes[lo])
+    return values[lo] + w * (values[hi] - values[lo])
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def table_column(fields, column, nodes, values, at_particle, temperature):
+    """fields[:, column] = table(T) with T the fluid temperature at the particle
+    (``at_particle`` False) or the particle's temperature (True)."""
+    n = fields.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            t = temperature[i] if at_particle else fields[i, F_FLUID_TEMPERATURE]
+            fields[i, column] = interp_held(t, nodes, values)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def prandtl_columns(fields):
+    """Pr = c_f μ_f / k_f and Pr^(1/3) from the property columns."""
+    n = fields.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            pr = (
+                fields[i, F_FLUID_SPECIFIC_HEAT]
+                * fields[i, F_FLUID_VISCOSITY]
+                / fields[i, F_FLUID_CONDUCTIVITY]
+            )
+            fields[i, F_PRANDTL] = pr
+            fields[i, F_PRANDTL_CBRT] = pr ** (1.0 / 3.0)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _bracket(axis, x):
+    """(k, w): axis[k] <= x <= axis[k + 1] with weight w of axis[k + 1], clamped to the ends
+    (w = 0 or 1 outside), and whether x was outside."""
+    m = axis.shape[0]
+    if m == 1:
+        return 0, 0.0, x != axis[0]
+    if x <= axis[0]:
+        return 0, 0.0, x < axis[0]
+    if x >= axis[m - 1]:
+        return m - 2, 1.0, x > axis[m - 1]
+    lo = 0
+    hi = m - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if axis[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return lo, (x - axis[lo]) / (axis[hi] - axis[lo]), False
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def grid_sample(position, axis_x, axis_y, axis_z, values, out, first, part):
+    """Trilinear interpolation of ``values`` (nx, ny, nz, nc) on the rectilinear grid of the
+    three axes at every particle into ``out[i, first:first + nc]``; a position outside the
+    grid takes the value at the nearest point of the grid's boundary (held). Returns the number
+    of particles outside (``part``: a scratch value per chunk)."""
+    n = position.shape[0]
+    nc = values.shape[3]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    one_x = axis_x.shape[0] == 1
+    one_y = axis_y.shape[0] == 1
+    one_z = axis_z.shape[0] == 1
+    for c in prange(nchunks):
+        outside = 0
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            kx, wx, ox = _bracket(axis_x, position[i, 0])
+            ky, wy, oy = _bracket(axis_y, position[i, 1])
+            kz, wz, oz = _bracket(axis_z, position[i, 2])
+            if ox or oy or oz:
+                outside += 1
+            kx1 = kx if one_x else kx + 1
+            ky1 = ky if one_y else ky + 1
+            kz1 = kz if one_z else kz + 1
+            for q in range(nc):
+                c00 = values[kx, ky, kz, q] * (1.0 - wx) + values[kx1, ky, kz, q] * wx
+                c10 = values[kx, ky1, kz, q] * (1.0 - wx) + values[kx1, ky1, kz, q] * wx
+                c01 = values[kx, ky, kz1, q] * (1.0 - wx) + values[kx1, ky, kz1, q] * wx
+                c11 = values[kx, ky1, kz1, q] * (1.0 - wx) + values[kx1, ky1, kz1, q] * wx
+                c0 = c00 * (1.0 - wy) + c10 * wy
+                c1 = c01 * (1.0 - wy) + c11 * wy
+                out[i, first + q] = c0 * (1.0 - wz) + c1 * wz
+        part[c] = outside
+    total = 0
+    for c in range(nchunks):
+        total += int(part[c])
+    return total
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def relative_speed(velocity, fluid_velocity, uniform, fields):
+    """fields[:, F_RELATIVE_SPEED] = |u_f - v_p| (``uniform``: u_f is fluid_velocity[0])."""
+    n = velocity.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            k = 0 if uniform else i
+            dx = fluid_velocity[k, 0] - velocity[i, 0]
+            dy = fluid_velocity[k, 1] - velocity[i, 1]
+            dz = fluid_velocity[k, 2] - velocity[i, 2]
+            fields[i, F_RELATIVE_SPEED] = math.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def point_in_fluid(kind, row, x0, x1, x2):
+    """Whether a point is on the particles' side of a wall: in front of a plane, not behind a
+    rectangle within its extent (box faces), inside (side +1) or outside (side -1) of a
+    cylinder's mantle within its length."""
+    rx = x0 - row[COL_POINT]
+    ry = x1 - row[COL_POINT + 1]
+    rz = x2 - row[COL_POINT + 2]
+    if kind == PLANE:
+        return rx * row[COL_NORMAL] + ry * row[COL_NORMAL + 1] + rz * row[COL_NORMAL + 2] >= 0.0
+    if kind == RECTANGLE:
+        nx = row[COL_NORMAL]
+        ny = row[COL_NORMAL + 1]
+        nz = row[COL_NORMAL + 2]
+        s = rx * nx + ry * ny + rz * nz
+        if s >= 0.0:
+            return True
+        ux = row[COL_U]
+        uy = row[COL_U + 1]
+        uz = row[COL_U + 2]
+        vx = ny * uz - nz * uy
+        vy = nz * ux - nx * uz
+        vz = nx * uy - ny * ux
+        a = rx * ux + ry * uy + rz * uz
+        b = rx * vx + ry * vy + rz * vz
+        return abs(a) > row[COL_HALF_U] or abs(b) > row[COL_HALF_V]
+    if kind == CYLINDER:
+        ax = row[COL_AXIS]
+        ay = row[COL_AXIS + 1]
+        az = row[COL_AXIS + 2]
+        h = rx * ax + ry * ay + rz * az
+        if abs(h) > row[COL_HALF_LENGTH]:
+            return True
+        ox = rx - h * ax
+        oy = ry - h * ay
+        oz = rz - h * az
+        rho2 = ox * ox + oy * oy + oz * oz
+        r2 = row[COL_RADIUS] * row[COL_RADIUS]
+        if row[COL_SIDE] > 0.0:
+            return rho2 <= r2
+        return rho2 >= r2
+    return True
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def cell_fluid_volume(lower, edge, dims, wall_kind, wall_rows, samples, out):
+    """Volume of every cell on the particles' side of all walls, by a midpoint rule of
+    ``samples``³ points per cell (``out``: one value per cell, x fastest)."""
+    ncell = dims[0] * dims[1] * dims[2]
+    nw = wall_kind.shape[0]
+    cell_volume = edge[0] * edge[1] * edge[2]
+    total = samples * samples * samples
+    for c in prange(ncell):
+        cx = c % dims[0]
+        cy = (c // dims[0]) % dims[1]
+        cz = c // (dims[0] * dims[1])
+        inside = 0
+        for a in range(samples):
+            x0 = lower[0] + (cx + (a + 0.5) / samples) * edge[0]
+            for b in range(samples):
+                x1 = lower[1] + (cy + (b + 0.5) / samples) * edge[1]
+                for d in range(samples):
+                    x2 = lower[2] + (cz + (d + 0.5) / samples) * edge[2]
+                    ok = True
+                    for w in range(nw):
+                        if not point_in_fluid(wall_kind[w], wall_rows[w], x0, x1, x2):
+                            ok = False
+                            break
+                    if ok:
+                        inside += 1
+        out[c] = cell_volume * inside / total
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _cell_index(x, lower, edge, dims):
+    c = 0
+    stride = 1
+    for a in range(3):
+        k = int(math.floor((x[a] - lower[a]) / edge[a]))
+        if k < 0:
+            k = 0
+        if k >= dims[a]:
+            k = dims[a] - 1
+        c += k * stride
+        stride *= dims[a]
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def _bin_solid(position, radius, lower, edge, dims, solid, cell):
+    """Solid volume of the particles by the cell of their centre (serial: a fixed order)."""
+    for c in range(solid.shape[0]):
+        solid[c] = 0.0
+    for i in range(position.shape[0]):
+        k = _cell_index(position[i], lower, edge, dims)
+        cell[i] = k
+        r = radius[i]
+        solid[k] += 4.0 / 3.0 * math.pi * r * r * r
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def cell_porosity(position, radius, lower, edge, dims, fluid_volume, solid, cell, fields):
+    """Porosity of the cell of each particle's centre, 1 - V_solid / V_cell, clipped to
+    [0, 1]: V_solid the volume of the particles whose centre is in the cell, V_cell the
+    cell's volume on the particles' side of the walls (:func:`cell_fluid_volume`)."""
+    _bin_solid(position, radius, lower, edge, dims, solid, cell)
+    n = position.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            k = cell[i]
+            v = fluid_volume[k]
+            eps = 1.0 - solid[k] / v if v > 0.0 else 0.0
+            fields[i, F_POROSITY] = min(max(eps, 0.0), 1.0)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def lens_volume(a, b, d):
+    """Volume of the intersection of two spheres of radii a and b whose centres are d apart."""
+    if d >= a + b:
+        return 0.0
+    if d <= abs(a - b):
+        r = min(a, b)
+        return 4.0 / 3.0 * math.pi * r * r * r
+    s = a + b - d
+    return math.pi * s * s * (d * d + 2.0 * d * (a + b) - 3.0 * (a - b) * (a - b)) / (12.0 * d)
+
+
+#: What :func:`neighbourhood_pass` sums (bits of its ``mode``).
+NB_KRAUSE = 1  # Σ ε_j A_j T_j⁴ / 2 and Σ ε_j A_j / 2 (krause2017)
+NB_ZHOU = 2  # n_p and Σ T_j (zhou2009)
+NB_SHELL = 4  # the neighbours' volume in the shell (shell porosity)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def neighbour_weights(radius, temperature, type_id, emissivity, weights):
+    """Per particle: weights[i] = (ε_i A_i / 2, ε_i A_i T_i⁴ / 2, T_i, 0), read by the pairs."""
+    n = radius.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            t = temperature[i]
+            w = 2.0 * math.pi * radius[i] * radius[i] * emissivity[type_id[i]]
+            weights[i, 0] = w
+            weights[i, 1] = w * (t * t) * (t * t)
+            weights[i, 2] = t
+            weights[i, 3] = 0.0
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def neighbourhood_pass(
+    position, radius, pair_i, pair_j, group_start, lower, upper, periodic, weights, mode,
+    radiation_ratio, shell_ratio, sums,
+):  # fmt: skip
+    """Sums over the pairs of a range set, by slab groups (race-free, fixed order), into
+    ``sums`` (n, 4), zeroed by the caller: for every particle i, over the particles j whose
+    centre is within radiation_ratio × R_i, [n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2]
+    (``mode`` bits NB_ZHOU, NB_KRAUSE; ``weights`` from :func:`neighbour_weights`); with
+    ``mode`` = NB_SHELL (a pass of its own), sums[i, 0] is instead the volume of the
+    neighbours inside the sphere of radius shell_ratio × R_i."""
+    length = upper - lower
+    ngroups = group_start.shape[0] - 1
+    krause = (mode & NB_KRAUSE) != 0
+    zhou = (mode & NB_ZHOU) != 0
+    shell = (mode & NB_SHELL) != 0
+    q2 = radiation_ratio * radiation_ratio
+    for parity in range(2):
+        for half in prange((ngroups + 1 - parity) // 2):
+            g = 2 * half + parity
+            for k in range(group_start[g], group_start[g + 1]):
+                i = pair_i[k]
+                j = pair_j[k]
+                dx, dy, dz, d = pair_separation(position, i, j, length, periodic)
+                d2 = dx * dx + dy * dy + dz * dz
+                ri = radius[i]
+                rj = radius[j]
+                if shell:
+                    sums[i, 0] += lens_volume(shell_ratio * ri, rj, d)
+                    sums[j, 0] += lens_volume(shell_ratio * rj, ri, d)
+                    continue
+                if d2 < q2 * ri * ri:
+                    if zhou:
+                        sums[i, 0] += 1.0
+                        sums[i, 1] += weights[j, 2]
+                    if krause:
+                        sums[i, 2] += weights[j, 1]
+                        sums[i, 3] += weights[j, 0]
+                if d2 < q2 * rj * rj:
+                    if zhou:
+                        sums[j, 0] += 1.0
+                        sums[j, 1] += weights[i, 2]
+                    if krause:
+                        sums[j, 2] += weights[i, 1]
+                        sums[j, 3] += weights[i, 0]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def neighbour_columns(sums, fields):
+    """fields[:, F_NEIGHBOURS:F_NEIGHBOUR_AREA + 1] = sums (n, 4)."""
+    n = sums.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            for q in range(4):
+                fields[i, F_NEIGHBOURS + q] = sums[i, q]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def zero_rows(values):
+    """values[:, :] = 0 (parallel)."""
+    n = values.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            for q in range(values.shape[1]):
+                values[i, q] = 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def cap_volume(r, d):
+    """Volume of the part of a sphere of radius r beyond a plane at distance d from its centre
+    (0 for d >= r; the whole sphere for d <= -r)."""
+    if d >= r:
+        return 0.0
+    if d <= -r:
+        return 4.0 / 3.0 * math.pi * r * r * r
+    h = r - d
+    return math.pi * h * h * (3.0 * r - h) / 3.0
+
+
+def _halton(count: int, base: int) -> np.ndarray:
+    out = np.zeros(count)
+    for i in range(count):
+        f, r, k = 1.0, 0.0, i + 1
+        while k > 0:
+            f /= base
+            r += f * (k % base)
+            k //= base
+        out[i] = r
+    return out
+
+
+def unit_ball_points(count: int = 8000) -> np.ndarray:
+    """Quasi-random points in the unit ball (m, 3): the Halton points (bases 2, 3, 5) of the
+    cube [-1, 1]³ that fall in the ball (m ≈ 0.52 count). Not a lattice, so that planes
+    aligned with the axes (box walls) do not meet rows of points (no staircase bias)."""
+    cube = np.column_stack([_halton(count, b) for b in (2, 3, 5)]) * 2.0 - 1.0
+    return np.ascontiguousarray(cube[(cube**2).sum(axis=1) <= 1.0])
+
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
+GL_X = np.ascontiguousarray(_GL_X)
+GL_W = np.ascontiguousarray(_GL_W)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _segment(rho, e):
+    """Area of the part of a disc of radius rho beyond a chord at signed distance e."""
+    if e >= rho:
+        return 0.0
+    if e <= -rho:
+        return math.pi * rho * rho
+    return rho * rho * math.acos(e / rho) - e * math.sqrt(rho * rho - e * e)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _overlap_slices(r, d2, c, q, a, b):
+    """∫_a^b of the slice areas of the sphere beyond the second plane, 16-point Gauss."""
+    if b <= a:
+        return 0.0
+    half = 0.5 * (b - a)
+    mid = 0.5 * (b + a)
+    total = 0.0
+    for k in range(GL_X.shape[0]):
+        s = mid + half * GL_X[k]
+        rho2 = r * r - s * s
+        if rho2 > 0.0:
+            total += GL_W[k] * _segment(math.sqrt(rho2), (d2 + s * c) / q)
+    return total * half
+
+
+@njit(cache=True, error_model="numpy")
+def cap_overlap(r, d1, n1x, n1y, n1z, d2, n2x, n2y, n2z):
+    """Volume of the part of a sphere (radius r, centre 0) behind two planes at distances d1,
+    d2 from the centre with unit normals n1, n2 pointing to the centre (points u with
+    u·n < −d): slices along n1, each a disc cut by the second plane's chord (circular
+    segments), integrated piecewise between the slices where the chord touches the disc."""
+    c = n1x * n2x + n1y * n2y + n1z * n2z
+    q2 = 1.0 - c * c
+    lo = -r
+    hi = -d1
+    if hi <= lo:
+        return 0.0
+    if q2 < 1e-24:  # parallel planes: behind both is a slab of the sphere
+        if c > 0.0:
+            return cap_volume(r, max(d1, d2))
+        a = max(lo, d2)
+        if hi <= a:
+            return 0.0
+        return math.pi * (r * r * (hi - a) - (hi**3 - a**3) / 3.0)
+    q = math.sqrt(q2)
+    breaks = np.empty(4)
+    breaks[0] = lo
+    m = 1
+    if d2 < r:
+        root = q * math.sqrt(r * r - d2 * d2)
+        for s in (-d2 * c - root, -d2 * c + root):
+            if lo < s < hi:
+                breaks[m] = s
+                m += 1
+    breaks[m] = hi
+    m += 1
+    if m == 4 and breaks[1] > breaks[2]:
+        breaks[1], breaks[2] = breaks[2], breaks[1]
+    total = 0.0
+    for k in range(m - 1):
+        total += _overlap_slices(r, d2, c, q, breaks[k], breaks[k + 1])
+    return total
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def shell_porosity(
+    position, radius, wall_kind, wall_rows, shell_ratio, lattice, solid, scratch, fields
+):  # solid: (n, 4), the neighbours' volume in column 0
+    """ε_i = 1 - (V_i + solid_i) / V_shell,i, clipped to [0, 1]: V_i the particle's own
+    volume, solid_i the neighbours' volume inside the shell (:func:`neighbourhood_pass`),
+    V_shell,i the volume of the sphere of radius shell_ratio × R_i on the particles' side of
+    the walls. Each wall closer than the shell radius cuts a cap (the wall taken as its
+    tangent plane at the closest point: exact for planes and box faces). Inclusion and
+    exclusion: the caps are removed, the overlaps of each two caps added back
+    (:func:`cap_overlap`, a quadrature), and where three or more caps overlap (a corner) the
+    remainder is estimated from quasi-random points in the shell (``lattice``:
+    :func:`unit_ball_points`; a point in k caps was removed 1 - k + k(k - 1)/2 times too
+    few). ``scratch``: a row of 4 × (number of walls) values per
+    chunk of particles."""
+    n = position.shape[0]
+    nw = wall_kind.shape[0]
+    npts = lattice.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        row = scratch[c]
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            ri = radius[i]
+            rs = shell_ratio * ri
+            full = 4.0 / 3.0 * math.pi * rs * rs * rs
+            volume = full
+            cuts = 0
+            for w in range(nw):
+                res = wall_distance(wall_kind[w], wall_rows[w], position[i])
+                d = res[0]
+                if d < rs:
+                    volume -= cap_volume(rs, d)
+                    row[4 * cuts] = d
+                    row[4 * cuts + 1] = res[1]
+                    row[4 * cuts + 2] = res[2]
+                    row[4 * cuts + 3] = res[3]
+                    cuts += 1
+            for a in range(cuts):
+                for b in range(a + 1, cuts):
+                    volume += cap_overlap(
+                        rs, row[4 * a], row[4 * a + 1], row[4 * a + 2], row[4 * a + 3],
+                        row[4 * b], row[4 * b + 1], row[4 * b + 2], row[4 * b + 3],
+                    )  # fmt: skip
+            if cuts > 2:
+                extra = 0
+                for q in range(npts):
+                    inside = 0
+                    for w in range(cuts):
+                        s = rs * (
+                            lattice[q, 0] * row[4 * w + 1]
+                            + lattice[q, 1] * row[4 * w + 2]
+                            + lattice[q, 2] * row[4 * w + 3]
+                        )
+                        if s < -row[4 * w]:  # behind the wall's plane
+                            inside += 1
+                    if inside > 2:
+                        extra += (inside - 1) * (inside - 2) // 2
+                volume -= extra * full / npts
+            own = 4.0 / 3.0 * math.pi * ri * ri * ri
+            eps = 1.0 - (own + solid[i, 0]) / volume if volume > 0.0 else 0.0
+            fields[i, F_POROSITY] = min(max(eps, 0.0), 1.0)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def wall_view(position, radius, wall_kind, wall_rows, range_ratio, view_factor, fields):
+    """For every particle, the fixed-temperature walls whose surface gap is below
+    range_ratio × R_i: Σ F_iw (each wall ``view_factor``) into F_WALL_VIEW and Σ F_iw T_w⁴
+    into F_WALL_EMISSION; a sum above 1 (a corner) is scaled down to 1 with the emission."""
+    n = position.shape[0]
+    nw = wall_kind.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            ri = radius[i]
+            view = 0.0
+            emission = 0.0
+            for w in range(nw):
+                row = wall_rows[w]
+                if row[COL_THERMAL_KIND] == 0.0:
+                    continue
+                d = wall_distance(wall_kind[w], row, position[i])[0]
+                if d - ri < range_ratio * ri:
+                    tw = row[COL_TEMPERATURE]
+                    view += view_factor
+                    emission += view_factor * (tw * tw) * (tw * tw)
+            if view > 1.0:
+                emission /= view
+                view = 1.0
+            fields[i, F_WALL_VIEW] = view
+            fields[i, F_WALL_EMISSION] = emission
