@@ -243,6 +243,10 @@ class Case(StrictModel):
                 f"{spec.name!r} also depends on the overlap, contact time or impact velocity: "
                 "use 0"
             )
+        refusal = spec.extra.get("conductance_reuse_refusal")  # a choice of the parameters
+        reason = refusal(th.direct_conduction.params) if refusal is not None else None
+        if reason:
+            raise ValueError(f"{key}: {tol} {reason}")
         tabled = [n for n, m in self.materials.items() if m.thermal_conductivity_table]
         if tabled:
             raise ValueError(
