@@ -293,7 +293,7 @@ def test_solid_layer_beyond_validity_blocks_instead_of_reversing() -> None:
 
 
 # ------------------------------------------------------------ maximum pressure P_0 (issue 17)
-def spec_conductance(r_i, r_j, f, overlap, mode, *, e_real_i=None, e_real_j=None, m_gas=None):
+def spec_conductance(r_i, r_j, f, overlap, mode, *, e_real_i=None, e_real_j=None):
     """The network of MAT_I and MAT_J written out from the spec (.rst) with scipy's erfc⁻¹;
     P_0 by ``mode``: 'force' 3F/(2π r_c²), 'overlap' 2 E*_real δ (E*/E*_real)^{2/3}/(π r_c)
     (Lethe's form; the spec's 2E*δ/(π r_c) when not softened); both capped as documented."""
@@ -313,8 +313,7 @@ def spec_conductance(r_i, r_j, f, overlap, mode, *, e_real_i=None, e_real_j=None
     sigma, tau = math.sqrt(1e-12 + 4e-12), math.sqrt(0.05**2 + 0.1**2)
     gas = rn.GasProperties()
     k_g = gas.thermal_conductivity
-    if m_gas is None:
-        m_gas = (1.2 / 0.8 + 1.4 / 0.6) * (2 * 1.4 / 2.4) * gas.mean_free_path_value() / gas.prandtl()
+    m_gas = (1.2 / 0.8 + 1.4 / 0.6) * (2 * 1.4 / 2.4) * gas.mean_free_path_value() / gas.prandtl()
     a1 = float(sp_erfcinv(min(2 * p0 / h, 1.0)))
     a2 = float(sp_erfcinv(0.03 * p0 / h)) - a1
     r_l = 1 / (2 * k_h * r_c)
