@@ -5,7 +5,12 @@ rolling agrees with its family dispatcher, and the laws have the properties they
   the model's own kernel returns (a missing or wrong branch of a dispatcher fails here);
 * Hertz: the elastic force equals the closed form (4/3) E* sqrt(R*) δ^{3/2} and the derivative of
   the elastic energy it reports (central finite difference); the same for the linear law;
-* tangential laws: |F_t| <= μ max(F_n, 0) for any history, velocity and normal force;
+* tangential laws: |F_t| <= μ max(F_n, 0) for any history, velocity and normal force; the
+  step's energies close: ΔU_t + damping + friction = the work of the force on the relative
+  displacement with the spring force averaged over the step (docs/architecture.md, "Work of
+  the tangential force"), damping >= 0, friction = 0 below the limit and >= 0 unless the step
+  reverses the spring;
+* EPSD rolling: the same closure for the rolling spring, dissipation >= 0 unless reversing;
 * constant-torque rolling: |M| = μ_r R* F_n while rolling, opposing the relative rotation;
 * Hertz damping calibration: e(α(e)) = e to 1e-9.
 """
@@ -240,10 +245,65 @@ def test_tangential_force_never_exceeds_coulomb(
         dt,
     )
     f_t = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
-    assert f_t <= pair.sliding_friction * max(normal_force, 0.0) * (1.0 + 1e-12)
-    # the slip energy is what the spring gives up: never negative (to round-off)
-    trial = 0.5 * out[6] * sum((si + vi * dt) ** 2 for si, vi in zip(s, v, strict=True))
-    assert out[8] >= -1e-12 * trial
+    limit = pair.sliding_friction * max(normal_force, 0.0)
+    assert f_t <= limit * (1.0 + 1e-12)
+    # energies of the step, recomputed here from the returned force and displacement
+    force, s_new, k_t = np.array(out[:3]), np.array(out[3:6]), out[6]
+    damping, friction = out[7], out[8]
+    s0, vel = np.array(s), np.array(v)
+    du = vel * dt
+    d_stored = 0.5 * k_t * (s_new @ s_new - s0 @ s0)
+    # work on the contact: minus the force, its spring part averaged over the step, along du
+    work = -(force + 0.5 * k_t * (s_new - s0)) @ du
+    scale = abs(d_stored) + abs(damping) + abs(friction) + abs(work)
+    scale += 0.5 * k_t * (s0 + du) @ (s0 + du) + abs(force @ du)
+    assert d_stored + damping + friction == pytest.approx(work, abs=1e-10 * scale + 1e-300)
+    assert damping >= 0.0
+    # no slip (the spring took the whole displacement): no sliding energy. (Not decided from
+    # |F_t| < limit: a limit near 1e-262 squares to 0 in |F_t|.)
+    if k_t > 0.0 and np.array_equal(s_new, s0 + du):
+        assert friction == 0.0
+    if k_t > 0.0 and f_t < limit * (1.0 - 1e-9) and f_t > 1e-150:  # below the limit: stick
+        np.testing.assert_array_equal(s_new, s0 + du)
+        assert friction == 0.0
+    if s0 @ vel >= 0.0:  # no reversal of the spring: sliding never gives energy back
+        assert friction >= -1e-10 * scale
+
+
+@SETTINGS
+@given(
+    mu_r=st.floats(1e-4, 1.0),
+    ref_stiffness=st.floats(1.0, 1e9),
+    eff_radius=st.floats(1e-5, 0.1),
+    rolling_inertia=st.floats(1e-14, 1e-4),
+    normal_force=st.floats(-100.0, 1e4),
+    w=st.tuples(component, component, component),
+    m=st.tuples(spring, spring, spring),
+    dt=st.floats(1e-8, 1e-3),
+    plastic=st.floats(0.0, 1.0),
+)
+def test_epsd_rolling_energies_close(
+    mu_r, ref_stiffness, eff_radius, rolling_inertia, normal_force, w, m, dt, plastic
+):
+    spec = registry.get("rolling", "epsd")
+    mat = Material(density=2500.0, youngs_modulus=1e7, poisson_ratio=0.3, rolling_friction=mu_r)
+    params = spec.params(plastic_damping_factor=plastic)
+    p = spec.pack(params, resolve_pair(mat, mat))
+    out = dispatch.rolling_dispatch(
+        spec.model_id, p, ref_stiffness, eff_radius, rolling_inertia, normal_force, *w, *m, dt
+    )
+    torque, m_new, k_r, dissipated = np.array(out[:3]), np.array(out[3:6]), out[6], out[7]
+    m0, omega = np.array(m), np.array(w)
+    limit = mu_r * eff_radius * max(normal_force, 0.0)
+    assert math.sqrt(m_new @ m_new) <= limit * (1.0 + 1e-12) + 1e-300
+    d_stored = 0.5 * (m_new @ m_new - m0 @ m0) / k_r
+    # work on the contact: minus the torque, its spring part averaged over the step, along ω dt
+    work = -(torque + 0.5 * (m0 - m_new)) @ omega * dt
+    scale = abs(d_stored) + abs(dissipated) + abs(work) + 0.5 * (m0 @ m0) / k_r
+    scale += abs(torque @ omega) * dt
+    assert d_stored + dissipated == pytest.approx(work, abs=1e-10 * scale + 1e-300)
+    if m0 @ omega <= 0.0:  # the spring is not reversed by the step
+        assert dissipated >= -1e-10 * scale
 
 
 @SETTINGS

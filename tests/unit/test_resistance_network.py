@@ -290,3 +290,122 @@ def test_solid_layer_beyond_validity_blocks_instead_of_reversing() -> None:
         1.0, 20.0, 2e-4, np.inf, 3.0625, 5e6, 1.0, 3e9, 1e-6, 0.1, 0.0263, 3e-7, 0.0
     )
     assert h > 0.0 and np.isfinite(h)
+
+
+# ------------------------------------------------------------ maximum pressure P_0 (issue 17)
+def spec_conductance(r_i, r_j, f, overlap, mode, *, e_real_i=None, e_real_j=None):
+    """The network of MAT_I and MAT_J written out from the spec (.rst) with scipy's erfc⁻¹;
+    P_0 by ``mode``: 'force' 3F/(2π r_c²), 'overlap' 2 E*_real δ (E*/E*_real)^{2/3}/(π r_c)
+    (Lethe's form; the spec's 2E*δ/(π r_c) when not softened); both capped as documented."""
+    k_i, k_j, nu = 2.0, 6.0, 0.25
+    e = 1 / ((1 - nu**2) / 1e8 + (1 - nu**2) / 2e8)
+    e_real = 1 / ((1 - nu**2) / (e_real_i or 1e8) + (1 - nu**2) / (e_real_j or 2e8))
+    c = (e / e_real) ** 0.2
+    r_eff = r_i if math.isinf(r_j) else r_i * r_j / (r_i + r_j)
+    r_c = c * (3 * f * r_eff / (4 * e)) ** (1 / 3)
+    if mode == "force":
+        p0 = 3 * f / (2 * PI * r_c**2)
+    else:
+        p0 = 2 * e_real * overlap * (e / e_real) ** (2 / 3) / (PI * r_c)
+    h = 2 * 5e9 * 2e9 / (5e9 + 2e9)
+    p0 = min(p0, h)
+    k_h = 2 * k_i * k_j / (k_i + k_j)
+    sigma, tau = math.sqrt(1e-12 + 4e-12), math.sqrt(0.05**2 + 0.1**2)
+    gas = rn.GasProperties()
+    k_g = gas.thermal_conductivity
+    m_gas = (1.2 / 0.8 + 1.4 / 0.6) * (2 * 1.4 / 2.4) * gas.mean_free_path_value() / gas.prandtl()
+    a1 = float(sp_erfcinv(min(2 * p0 / h, 1.0)))
+    a2 = float(sp_erfcinv(0.03 * p0 / h)) - a1
+    r_l = 1 / (2 * k_h * r_c)
+    r_s = (h / p0) ** 0.96 * 1.184 / (PI * r_c**2 * k_h) * (sigma / tau)
+    s2 = 2 * SQ2 * sigma
+    r_g = s2 * a2 / (PI * k_g * r_c**2 * math.log(1 + a2 / (a1 + m_gas / s2)))
+    r_cs = (PI * r_i / 4) / (k_i * PI * (r_i**2 - r_c**2))
+    if not math.isinf(r_j):
+        r_cs += (PI * r_j / 4) / (k_j * PI * (r_j**2 - r_c**2))
+    r_h = 2 * r_eff
+    big_a = 2 * math.sqrt(r_h**2 - r_c**2)
+    big_s = 2 * (r_h - r_c**2 / (2 * r_h)) + m_gas
+    r_big_g = 2 / (PI * k_g * (big_s * math.log(big_s / (big_s - big_a)) - big_a))
+    return 1 / (r_l + 1 / (1 / r_s + 1 / r_g)) + 1 / (r_cs + r_big_g)
+
+
+def test_pressure_mode_columns():
+    p = network_row()
+    assert p[rn.COL_P0_MODE] == rn.P0_FORCE  # the default
+    e = 1 / ((1 - 0.25**2) / 1e8 + (1 - 0.25**2) / 2e8)
+    assert p[rn.COL_P0_OVERLAP_FACTOR] == pytest.approx(2 * e / PI, rel=1e-14)
+    soft = material(youngs_modulus_real=6.3e10)
+    p = network_row(soft, MAT_J, maximum_pressure="overlap")
+    assert p[rn.COL_P0_MODE] == rn.P0_OVERLAP
+    e_real = 1 / ((1 - 0.25**2) / 6.3e10 + (1 - 0.25**2) / 2e8)
+    factor = 2 * e_real * (e / e_real) ** (2 / 3) / PI
+    assert p[rn.COL_P0_OVERLAP_FACTOR] == pytest.approx(factor, rel=1e-14)
+    assert rn.COL_P0_OVERLAP_FACTOR < registry.PARAM_WIDTH
+    with pytest.raises(ValueError, match="maximum_pressure"):
+        rn.ResistanceNetworkParams(maximum_pressure="hertz")
+
+
+@pytest.mark.parametrize("mode", ["force", "overlap"])
+@pytest.mark.parametrize("softened", [False, True])
+@pytest.mark.parametrize(("r_i", "r_j"), [(1e-3, 2e-3), (1e-3, np.inf)])
+def test_both_pressures_equal_the_spec_written_out(mode, softened, r_i, r_j):
+    """Forces from 1e-4 N to past the plastic caps, overlaps off the Hertz value by ±30 %."""
+    real = {"youngs_modulus_real": 6.3e10} if softened else {}
+    mi, mj = material(**real), MAT_J
+    p = network_row(mi, mj, is_wall=math.isinf(r_j), maximum_pressure=mode)
+    r_eff = r_i if math.isinf(r_j) else r_i * r_j / (r_i + r_j)
+    e = 1 / ((1 - 0.25**2) / 1e8 + (1 - 0.25**2) / 2e8)
+    for f in np.geomspace(1e-4, 30.0, 12):
+        hertz = (3 * f / (4 * e * math.sqrt(r_eff))) ** (2 / 3)
+        for overlap in (0.7 * hertz, hertz, 1.3 * hertz):
+            expected = spec_conductance(
+                r_i, r_j, f, overlap, mode, e_real_i=real.get("youngs_modulus_real")
+            )
+            assert heat(p, r_i, r_j, f, overlap) == pytest.approx(10 * expected, rel=1e-11)
+
+
+def test_overlap_form_is_the_spec_line_without_softening():
+    """No youngs_modulus_real: P_0 = 2E*δ/(π r_c), the spec's line; for a Hertz contact
+    (F = (4/3) E* sqrt(R*) δ^{3/2}) both forms give the same conductance."""
+    e = 1 / ((1 - 0.25**2) / 1e8 + (1 - 0.25**2) / 2e8)
+    r_i, r_j = 1e-3, 2e-3
+    r_eff = r_i * r_j / (r_i + r_j)
+    by_force = network_row(maximum_pressure="force")
+    by_overlap = network_row(maximum_pressure="overlap")
+    for overlap in np.geomspace(1e-8, 1e-5, 7):
+        f = 4 / 3 * e * math.sqrt(r_eff) * overlap**1.5
+        h_overlap = heat(by_overlap, r_i, r_j, f, overlap)
+        assert h_overlap == pytest.approx(heat(by_force, r_i, r_j, f, overlap), rel=1e-12)
+        assert h_overlap == pytest.approx(10 * spec_conductance(r_i, r_j, f, overlap, "force"))
+
+
+def test_lethe_unit_test_case():
+    """Lethe's particle_particle_thermal_resistances test (chaos-polymtl/lethe, tests/dem):
+    two 10 mm spheres, E = 5 MPa, E_real = 65 GPa, ν = 0.22, δ = 0.1 mm, Hertz force; its
+    output: total conductance 0.00294375 W/K. The overlap form reproduces it (to 5e-6: Lethe
+    prints 6 digits, and its printed microgap resistance 1087.75 differs from the formula with
+    the test's gas parameter, 1089.96, by 2e-3, which moves H by 7e-6); the force form gives
+    P_0 (E*_real/E*)^{-2/15} = 0.28 times smaller and H 1.3e-3 lower."""
+    nu, e_sim, e_real, radius, overlap = 0.22, 5e6, 65e9, 5e-3, 1e-4
+    glass = material(
+        youngs_modulus=e_sim, poisson_ratio=nu, youngs_modulus_real=e_real,
+        thermal_conductivity=1.0, microhardness=9e9, surface_roughness=25e-9 / SQ2,
+        surface_slope=0.078 / SQ2, thermal_accommodation=0.7,
+    )  # fmt: skip
+    gas = rn.GasProperties(
+        thermal_conductivity=0.027, dynamic_viscosity=1.85e-5, specific_heat=1006.0,
+        mean_free_path=68e-9,
+    )  # fmt: skip
+    # Lethe's test takes γ = 1 (2γ/(1+γ) = 1): M = 2 (2 - α)/α Λ/Pr
+    m_gas = 2 * (2 - 0.7) / 0.7 * 68e-9 / (1.85e-5 * 1006.0 / 0.027)
+    e_star = e_sim / (2 * (1 - nu**2))
+    force = 4 / 3 * e_star * math.sqrt(radius / 2) * overlap**1.5
+    spec = registry.get("direct_conduction", "resistance_network")
+    out = {}
+    for mode in ("force", "overlap"):
+        p = spec.pack(spec.params(maximum_pressure=mode), resolve_pair(glass, glass, gas=gas))
+        p[10] = m_gas
+        out[mode] = spec.kernel(p, 0.0, 1.0, radius, radius, 0.0, overlap, 0.0, force, 0, 0, 0)
+    assert out["overlap"] == pytest.approx(0.00294375, rel=1e-5)
+    assert out["force"] / 0.00294375 - 1.0 == pytest.approx(-1.29e-3, abs=0.05e-3)

@@ -183,6 +183,11 @@ def test_without_reuse_the_engine_equals_the_exact_model(tmp_path: Path) -> None
     [
         ({"direct_conduction": "batchelor_obrien_simple"}, {}, "resistance_network"),
         (
+            {"direct_conduction": {"model": "resistance_network", "maximum_pressure": "overlap"}},
+            {},
+            "maximum_pressure = 'overlap' also reads the overlap",
+        ),
+        (
             {},
             {"steel": dict(GLASS, thermal_conductivity_table=[[300, 20.0], [400, 18.0]])},
             "steel have a thermal_conductivity_table",

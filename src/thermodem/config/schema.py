@@ -8,13 +8,13 @@ registry (with a "did you mean") and the remaining keys against that model's own
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Annotated, Any
 
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.config.insertion import InsertionEntry
-from thermodem.config.thermal import ThermalSettings
+from thermodem.config.thermal import Selection, ThermalSettings
 from thermodem.geometry.walls import Wall
 from thermodem.models import registry
 from thermodem.state.materials import InteractionOverride, Material
@@ -185,6 +185,36 @@ def _fmt(values: list[float]) -> str:
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
 
 
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class ExternalForce(StrictModel):
+    """A constant force and torque on every selected particle, applied at every step
+    (docs/case-file.md, ``external_force``).
+
+    ``select`` is a :class:`~thermodem.config.thermal.Selection` (material, box region, global
+    ids: every given criterion must hold), evaluated once per particle when it is added to the
+    simulation (construction or pouring): the region on its position then. Entries add up.
+    """
+
+    select: Selection
+    force: tuple[FiniteFloat, FiniteFloat, FiniteFloat] = Field(
+        default=(0.0, 0.0, 0.0), description="[N] on each selected particle"
+    )
+    torque: tuple[FiniteFloat, FiniteFloat, FiniteFloat] = Field(
+        default=(0.0, 0.0, 0.0), description="[N m] on each selected particle"
+    )
+
+    @model_validator(mode="after")
+    def _something(self) -> ExternalForce:
+        if "force" not in self.model_fields_set and "torque" not in self.model_fields_set:
+            raise ValueError("give force [fx, fy, fz] (N) and/or torque [tx, ty, tz] (N m)")
+        if self.select.ids is not None and any(i < 0 for i in self.select.ids):
+            ids = self.select.ids
+            raise ValueError(f"select.ids must be >= 0 (global particle ids), got {ids}")
+        return self
+
+
 class Case(StrictModel):
     """A whole case file."""
 
@@ -199,6 +229,9 @@ class Case(StrictModel):
     output: Output = Field(default_factory=Output)
     thermal: ThermalSettings | None = Field(
         default=None, description="heat transfer; absent = mechanics only"
+    )
+    external_force: list[ExternalForce] = Field(
+        default_factory=list, description="constant force/torque on selected particles"
     )
 
     @model_validator(mode="after")
@@ -224,6 +257,13 @@ class Case(StrictModel):
                     raise ValueError(
                         f"interactions.{k}.materials: unknown material {m!r}; allowed: {allowed}"
                     )
+        for k, entry in enumerate(self.external_force):
+            m = entry.select.material
+            if m is not None and m not in known:
+                raise ValueError(
+                    f"external_force.{k}.select.material: unknown material {m!r}; "
+                    f"allowed: {allowed}"
+                )
         th = self.thermal
         if th is not None:
             for key in ("fixed_temperature", "heat_flux", "volumetric_source"):
@@ -332,6 +372,10 @@ class Case(StrictModel):
                 f"{spec.name!r} also depends on the overlap, contact time or impact velocity: "
                 "use 0"
             )
+        refusal = spec.extra.get("conductance_reuse_refusal")  # a choice of the parameters
+        reason = refusal(th.direct_conduction.params) if refusal is not None else None
+        if reason:
+            raise ValueError(f"{key}: {tol} {reason}")
         tabled = [n for n, m in self.materials.items() if m.thermal_conductivity_table]
         if tabled:
             raise ValueError(

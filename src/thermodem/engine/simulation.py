@@ -9,11 +9,13 @@ Order inside one step (``Simulation.step``):
    and nothing moves;
 1. first half kick and drift (velocity Verlet); in the same pass each particle is checked
    (non-finite value, outside the domain) and the largest displacement since the last
-   neighbour build is found; a failed check raises before anything else moves;
+   neighbour build is found; a failed check raises before anything else moves; the work of
+   the external loads over the drift is added to the ledger;
 2. walls translate; pouring inserts the particles that are due;
 3. the pair lists are rebuilt if a particle moved more than half the skin, or a particle plus
    a wall moved more than the skin, or particles were inserted (history carried by identity);
-4. forces set to the weights, torques to zero (and the conduction sums, when heat is due);
+4. forces set to the weights, torques to zero, plus the constant external loads (and the
+   conduction sums, when heat is due);
    pair passes: geometry and contact forces of every particle and wall pair, added straight
    into the particles by slab group (``thermodem.kernels.slabs``), dissipation per mechanism,
    history, ledger rows per group; when a thermal step follows, the same passes evaluate the
@@ -33,6 +35,7 @@ import numpy as np
 
 from thermodem.config.schema import Case
 from thermodem.engine import diagnostics as D
+from thermodem.engine import external_loads as EL
 from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
 from thermodem.engine.validation import check_completeness, check_insertion_memory
@@ -132,7 +135,8 @@ class Simulation:
             self.thermal = ThermalEngine(self, case.thermal)
         # particles
         self.mechanisms = len(HEAT_MECHANISMS) if self.thermal is not None else 0
-        self.particles = Particles.empty(self.mechanisms)
+        # constant external loads (engine/external_loads.py): two more particle arrays
+        self.particles = Particles.empty(self.mechanisms, external=bool(case.external_force))
         self.next_global_id = 0
         self.pourers: list[Pourer] = []
         if insert_particles:
@@ -152,6 +156,8 @@ class Simulation:
                         max_overlap_ratio=sim.max_overlap_ratio,
                     )
                 )
+        if case.external_force and insert_particles:
+            EL.check_selected(case, self.particles, self.material_index)
         # neighbour list
         nb = case.neighbors
         self.extra = float(nb.extra_distance)
@@ -166,9 +172,8 @@ class Simulation:
         self.rebuild_count = 0
         self._needs_rebuild = True
         # ledger
-        self.ledger_cumulative = dict.fromkeys(
-            (*LEDGER_DISSIPATION, "stiffness_work", "wall_work", "inserted_energy"), 0.0
-        )
+        ledger_keys = ("stiffness_work", "wall_work", "external_work", "inserted_energy")
+        self.ledger_cumulative = dict.fromkeys((*LEDGER_DISSIPATION, *ledger_keys), 0.0)
         self.elastic = np.zeros(3)
         self.max_overlap_ratio = 0.0
         self.contact_count = 0
@@ -229,7 +234,9 @@ class Simulation:
             new.velocity,
             temperature,
             mechanisms=self.mechanisms,
+            external=bool(self.case.external_force),
         )
+        EL.assign(self.case, extra, self.material_index)
         if hasattr(self, "ledger_cumulative"):
             self.ledger_cumulative["inserted_energy"] += float(
                 0.5 * np.sum(extra.mass * np.sum(extra.velocity**2, axis=1))
@@ -277,11 +284,12 @@ class Simulation:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
             pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
-            reset_forces(p.force, p.torque, p.mass, self.gravity, True,
-                         p.heat_rate_by_mechanism, th.conductance_sum)  # fmt: skip
+            reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_rate_by_mechanism,
+                         th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
             no_mech, no_sum = self._no_heat[0][-3:-1]
-            reset_forces(p.force, p.torque, p.mass, self.gravity, False, no_mech, no_sum)
+            reset_forces(p.force, p.torque, p.mass, self.gravity, False, no_mech, no_sum,
+                         p.external_force, p.external_torque)  # fmt: skip
         pair_pass(
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, pb.i, pb.j, pb.group_start, pb.history, self.lower, self.upper,
@@ -359,6 +367,8 @@ class Simulation:
         self.moved, bad, code = reduce_checks(self.chunk_check, p.count)
         if bad >= 0:
             self._particle_failure(bad, code)
+        if p.external_force.shape[1]:
+            self.ledger_cumulative["external_work"] += EL.step_work(self)
         self.time = (self.step_count + 1) * self.dt
         self.step_count += 1
         if self.wall_rows.shape[0]:
@@ -461,6 +471,7 @@ class Simulation:
         )
         out["stiffness_work"] = self.ledger_cumulative["stiffness_work"]
         out["wall_work"] = self.ledger_cumulative["wall_work"]
+        out["external_work"] = self.ledger_cumulative.get("external_work", 0.0)
         out["inserted_energy"] = self.ledger_cumulative["inserted_energy"]
         return out
 
@@ -477,7 +488,7 @@ class Simulation:
         )
 
     def energy_balance_error(self) -> float:
-        """E(t) + dissipated - stiffness work - wall work - inserted - E(0) [J]; ~0."""
+        """E(t) + dissipated - stiffness, wall and external work - inserted - E(0) [J]; ~0."""
         e = self.energies()
         dissipated = sum(e[f"dissipated_{k}"] for k in LEDGER_DISSIPATION)
         return (
@@ -485,6 +496,7 @@ class Simulation:
             + dissipated
             - e["stiffness_work"]
             - e["wall_work"]
+            - e["external_work"]
             - e["inserted_energy"]
             - self.initial_energy
         )

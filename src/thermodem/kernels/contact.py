@@ -127,7 +127,7 @@ def contact_response(
     vty = vry - rate * ny
     vtz = vrz - rate * nz
     sx, sy, sz = _rotate_into_plane(history, k, H_SPRING, nx, ny, nz)
-    ftx, fty, ftz, sx, sy, sz, k_t, p_tdamp, e_slip = tangential_dispatch(
+    ftx, fty, ftz, sx, sy, sz, k_t, e_tdamp, e_slip = tangential_dispatch(
         tangential_id,
         p_tangential,
         k_ref,
@@ -201,8 +201,8 @@ def contact_response(
         history[k, H_ROLL_ENERGY] = u_r
     p_ndamp = f_damp * rate
     out_diss[k, D_NORMAL_DAMPING] = p_ndamp
-    out_diss[k, D_TANGENTIAL_DAMPING] = p_tdamp
     inv_dt = 1.0 / dt if dt > 0.0 else 0.0
+    out_diss[k, D_TANGENTIAL_DAMPING] = e_tdamp * inv_dt
     out_diss[k, D_SLIDING_FRICTION] = e_slip * inv_dt
     out_diss[k, D_ROLLING_FRICTION] = e_roll * inv_dt
     out_normal_force[k] = f_n
@@ -210,7 +210,7 @@ def contact_response(
     ledger_row[L_ELASTIC_TANGENTIAL] += u_t
     ledger_row[L_ELASTIC_ROLLING] += u_r
     ledger_row[L_NORMAL_DAMPING] += p_ndamp * dt
-    ledger_row[L_TANGENTIAL_DAMPING] += p_tdamp * dt
+    ledger_row[L_TANGENTIAL_DAMPING] += e_tdamp
     ledger_row[L_SLIDING_FRICTION] += e_slip
     ledger_row[L_ROLLING_FRICTION] += e_roll
     ledger_row[L_STIFFNESS_WORK] += stiffness_work

@@ -91,19 +91,58 @@ def reduce_checks(chunk_check, n):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def reset_forces(force, torque, mass, gravity, heat_on, by_mechanism, conductance_sum):
-    """Set each particle's force to its weight and its torque to zero before the pair passes
-    add the contacts; with ``heat_on`` also zero the heat sums the passes and the thermal terms
-    add to (every column of ``by_mechanism``, ``conductance_sum``)."""
+def reset_forces(
+    force,
+    torque,
+    mass,
+    gravity,
+    heat_on,
+    by_mechanism,
+    conductance_sum,
+    external_force,
+    external_torque,
+):
+    """Set each particle's force to its weight plus its constant external force and its
+    torque to the external torque (none when ``external_force`` has no columns) before the
+    pair passes add the contacts; with ``heat_on`` also zero the heat sums the passes and the
+    thermal terms add to (every column of ``by_mechanism``, ``conductance_sum``)."""
+    external = external_force.shape[1] == 3
     for i in prange(force.shape[0]):
         m = mass[i]
-        for a in range(3):
-            force[i, a] = m * gravity[a]
-            torque[i, a] = 0.0
+        if external:
+            for a in range(3):
+                force[i, a] = m * gravity[a] + external_force[i, a]
+                torque[i, a] = external_torque[i, a]
+        else:
+            for a in range(3):
+                force[i, a] = m * gravity[a]
+                torque[i, a] = 0.0
         if heat_on:
-            for m in range(by_mechanism.shape[1]):
-                by_mechanism[i, m] = 0.0
+            for c in range(by_mechanism.shape[1]):
+                by_mechanism[i, c] = 0.0
             conductance_sum[i] = 0.0
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def external_power(velocity, angular_velocity, external_force, external_torque, scratch):
+    """Σ_i F_ext,i · v_i + T_ext,i · ω_i [W] (constant external loads), summed per chunk of
+    CHECK_CHUNK particles in parallel (into column 0 of ``scratch``, the chunk check array of
+    :func:`kick_drift` once :func:`reduce_checks` has read it) and over the chunks in a fixed
+    order. Called with the half-step velocities right after :func:`kick_drift`, times Δt it is
+    the work of the loads over the step's displacement and rotation."""
+    n = velocity.shape[0]
+    nchunks = (n + CHECK_CHUNK - 1) // CHECK_CHUNK
+    for c in prange(nchunks):
+        s = 0.0
+        for i in range(c * CHECK_CHUNK, min(n, (c + 1) * CHECK_CHUNK)):
+            for a in range(3):
+                s += external_force[i, a] * velocity[i, a]
+                s += external_torque[i, a] * angular_velocity[i, a]
+        scratch[c, 0] = s
+    total = 0.0
+    for c in range(nchunks):
+        total += scratch[c, 0]
+    return total
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

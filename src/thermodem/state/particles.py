@@ -4,6 +4,9 @@ Every per-particle quantity is a contiguous NumPy array with the particle as fir
 ``global_id`` is the stable identity of a particle (history keys, restarts, output); the array
 order changes when the neighbour list sorts particles by cell. ``heat_rate_by_mechanism`` has
 one column per heat transfer mechanism (:data:`thermodem.state.heat.MECHANISMS`).
+``external_force`` and ``external_torque`` hold the constant loads of the case key
+``external_force`` (added to the weight at every force reset); without that key they have no
+columns (0 B per particle).
 """
 
 from __future__ import annotations
@@ -32,13 +35,15 @@ class Particles:
     heat_rate_by_mechanism: np.ndarray  # (n, len(HEAT_MECHANISMS)) [W]
     type_id: np.ndarray  # (n,) int32, index into the material table
     global_id: np.ndarray  # (n,) int64, stable identity
+    external_force: np.ndarray  # (n, 3) [N], constant; (n, 0) when the case has none
+    external_torque: np.ndarray  # (n, 3) [N m], constant; (n, 0) when the case has none
 
     @property
     def count(self) -> int:
         return int(self.radius.shape[0])
 
     @classmethod
-    def empty(cls, mechanisms: int = len(HEAT_MECHANISMS)) -> Particles:
+    def empty(cls, mechanisms: int = len(HEAT_MECHANISMS), external: bool = False) -> Particles:
         return cls.create(
             np.zeros((0, 3)),
             np.zeros(0),
@@ -46,6 +51,7 @@ class Particles:
             np.zeros(0, np.int32),
             np.zeros(0, np.int64),
             mechanisms=mechanisms,
+            external=external,
         )
 
     @classmethod
@@ -59,11 +65,14 @@ class Particles:
         velocity: np.ndarray | None = None,
         temperature: np.ndarray | None = None,
         mechanisms: int = len(HEAT_MECHANISMS),
+        external: bool = False,
     ) -> Particles:
         """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R².
 
         ``mechanisms`` is the number of columns of ``heat_rate_by_mechanism``: all of
         :data:`HEAT_MECHANISMS` with a thermal engine, 0 for mechanics only (64 B/particle less).
+        ``external``: the case has external loads (``external_force`` and ``external_torque``
+        get 3 columns, zero until the simulation assigns them).
         """
         n = radius.shape[0]
         radius = np.ascontiguousarray(radius, dtype=np.float64)
@@ -86,6 +95,8 @@ class Particles:
             heat_rate_by_mechanism=np.zeros((n, mechanisms)),
             type_id=np.ascontiguousarray(type_id, dtype=np.int32),
             global_id=np.ascontiguousarray(global_id, dtype=np.int64),
+            external_force=np.zeros((n, 3 if external else 0)),
+            external_torque=np.zeros((n, 3 if external else 0)),
         )
 
     def permute(self, order: np.ndarray) -> None:

@@ -93,27 +93,35 @@ def pack_epsd(params: EPSDParams, pair: PairContext) -> np.ndarray:
 
 @njit(cache=True, error_model="numpy")
 def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt):
+    """One step of model C; the dissipated energy is C |ω|² Δt plus, at the limit, the work of
+    the spring torque (averaged over the step as velocity Verlet sees it) along the plastic
+    rotation: ½ (M0 + M) · (M1 - M) / k_r with M0, M1, M the stored, trial and capped torques
+    (docs/architecture.md, "Work of the tangential force"; the rolling spring is the same
+    algebra with M = -k_r θ)."""
     mu_r = p[0]
     k_r = 2.25 * ref_stiffness * mu_r * mu_r * eff_radius * eff_radius
     c_r = p[1] * 2.0 * math.sqrt(rolling_inertia * k_r)
     m_lim = mu_r * eff_radius * max(normal_force, 0.0)
-    # elastic part: incremental rotation of the spring
-    mx -= k_r * wx * dt
-    my -= k_r * wy * dt
-    mz -= k_r * wz * dt
-    trial_energy = 0.5 * (mx * mx + my * my + mz * mz) / k_r if k_r > 0.0 else 0.0
-    m_mag = math.sqrt(mx * mx + my * my + mz * mz)
-    damp = c_r
-    if m_mag > m_lim:
-        scale = m_lim / m_mag if m_mag > 0.0 else 0.0
-        mx *= scale
-        my *= scale
-        mz *= scale
-        damp = p[2] * c_r
-    energy = 0.5 * (mx * mx + my * my + mz * mz) / k_r if k_r > 0.0 else 0.0
     w2 = wx * wx + wy * wy + wz * wz
-    dissipated = (trial_energy - energy) + damp * w2 * dt
-    return mx - damp * wx, my - damp * wy, mz - damp * wz, mx, my, mz, k_r, dissipated
+    # elastic part: incremental rotation of the spring
+    tx = mx - k_r * wx * dt
+    ty = my - k_r * wy * dt
+    tz = mz - k_r * wz * dt
+    m_mag2 = tx * tx + ty * ty + tz * tz
+    if m_mag2 <= m_lim * m_lim:
+        return tx - c_r * wx, ty - c_r * wy, tz - c_r * wz, tx, ty, tz, k_r, c_r * w2 * dt
+    m_mag = math.sqrt(m_mag2)
+    scale = m_lim / m_mag if m_mag > 0.0 else 0.0
+    nx = scale * tx
+    ny = scale * ty
+    nz = scale * tz
+    damp = p[2] * c_r
+    dissipated = damp * w2 * dt
+    if k_r > 0.0:
+        dissipated += (
+            0.5 * ((mx + nx) * (tx - nx) + (my + ny) * (ty - ny) + (mz + nz) * (tz - nz)) / k_r
+        )
+    return nx - damp * wx, ny - damp * wy, nz - damp * wz, nx, ny, nz, k_r, dissipated
 
 
 register(

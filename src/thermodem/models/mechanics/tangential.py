@@ -4,16 +4,21 @@ Kernel signature (all float64)::
 
     kernel(p, ref_stiffness, normal_damping, eff_radius, overlap, normal_force,
            vtx, vty, vtz, sx, sy, sz, dt)
-        -> (ftx, fty, ftz, sx, sy, sz, stiffness, damping_power, slip_energy)
+        -> (ftx, fty, ftz, sx, sy, sz, stiffness, damping_energy, friction_energy)
 
 ``v_t`` is the tangential velocity of i relative to j at the contact point; ``s`` the
 accumulated tangential spring displacement (history), already rotated into the current tangent
 plane by the caller. Returned: the tangential force on i, the updated displacement, the spring
-stiffness k_t (the stored elastic energy is ½ k_t |s|²), the power dissipated by the
-tangential dashpot and the energy released by sliding this step (the spring energy given up
-when the trial force exceeds the Coulomb limit μ max(F_n, 0)). When the cap is reached, force
-and dashpot are scaled by λ = limit/|trial| and the displacement is rescaled so that spring
-plus scaled dashpot force equals the limit (the history is "rescaled when the cap is reached").
+stiffness k_t (the stored elastic energy is ½ k_t |s|²), and the energies dissipated this step
+by the tangential dashpot and by sliding [J]. When the trial force exceeds the Coulomb limit
+μ max(F_n, 0), force and dashpot are scaled by λ = limit/|trial| and the displacement by λ,
+so that spring plus scaled dashpot force equals the limit (the history is "rescaled when the
+cap is reached"); the relative displacement v_t Δt of the step is then split into an elastic
+part (the change of s) and a slip (the rest). The dashpot dissipates the work of its force
+along the elastic part, sliding the work of the capped force along the slip, with the spring
+force averaged over the step as velocity Verlet sees it; with the change of ½ k_t |s|² the
+two add up to the work of the tangential force on the relative motion (docs/architecture.md,
+"Work of the tangential force").
 
 The tangential dashpot uses the damping ratio of the normal law: γ_t = γ_n sqrt(k_t / k_n),
 where k_n is the normal law's reference stiffness (Tsuji et al. 1992 use the same α for both
@@ -39,34 +44,48 @@ LINEAR = 2
 
 @njit(cache=True, error_model="numpy")
 def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy, sz, dt):
-    """Shared algorithm: incremental spring + dashpot, Coulomb cap with history rescale."""
-    sx += vtx * dt
-    sy += vty * dt
-    sz += vtz * dt
-    fx = -k_t * sx - gamma_t * vtx
-    fy = -k_t * sy - gamma_t * vty
-    fz = -k_t * sz - gamma_t * vtz
-    trial_energy = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
+    """Shared algorithm: incremental spring + dashpot, Coulomb cap with history rescale.
+
+    Energies of the step (docs/architecture.md, "Work of the tangential force"): with s0 the
+    stored displacement, s1 = s0 + v Δt the trial one, s the new one and λ the cap scale,
+    the elastic increment is s - s0 and the slip s1 - s; the dashpot dissipates
+    λ γ v · (s - s0) (clipped to [0, total]) and sliding the work of the capped force along
+    the slip, (λ γ v + ½ k (s0 + s)) · (s1 - s). Below the cap: γ |v|² Δt and 0.
+    """
+    v2 = vtx * vtx + vty * vty + vtz * vtz
+    tx = sx + vtx * dt
+    ty = sy + vty * dt
+    tz = sz + vtz * dt
+    fx = -k_t * tx - gamma_t * vtx
+    fy = -k_t * ty - gamma_t * vty
+    fz = -k_t * tz - gamma_t * vtz
     f_mag2 = fx * fx + fy * fy + fz * fz
     f_cap = mu * max(normal_force, 0.0)
-    damping_power = gamma_t * (vtx * vtx + vty * vty + vtz * vtz)
-    if f_mag2 > f_cap * f_cap:  # squares: the root is only needed when the cap applies
-        f_mag = math.sqrt(f_mag2)
-        scale = f_cap / f_mag if f_mag > 0.0 else 0.0
-        fx *= scale
-        fy *= scale
-        fz *= scale
-        damping_power *= scale
-        if k_t > 0.0:
-            sx = -(fx + gamma_t * scale * vtx) / k_t
-            sy = -(fy + gamma_t * scale * vty) / k_t
-            sz = -(fz + gamma_t * scale * vtz) / k_t
-        else:
-            sx = 0.0
-            sy = 0.0
-            sz = 0.0
-    slip_energy = trial_energy - 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
-    return fx, fy, fz, sx, sy, sz, k_t, damping_power, slip_energy
+    if f_mag2 <= f_cap * f_cap:  # squares: the root is only needed when the cap applies
+        return fx, fy, fz, tx, ty, tz, k_t, gamma_t * v2 * dt, 0.0
+    f_mag = math.sqrt(f_mag2)
+    lam = f_cap / f_mag if f_mag > 0.0 else 0.0
+    fx *= lam
+    fy *= lam
+    fz *= lam
+    # new spring: spring + scaled dashpot = the limit, i.e. s = λ s1 (nothing held if k_t = 0)
+    scale = lam if k_t > 0.0 else 0.0
+    nx = scale * tx
+    ny = scale * ty
+    nz = scale * tz
+    g = lam * gamma_t  # the dashpot coefficient at the limit
+    damping = g * (vtx * (nx - sx) + vty * (ny - sy) + vtz * (nz - sz))
+    half_k = 0.5 * k_t
+    friction = (
+        (g * vtx + half_k * (sx + nx)) * (tx - nx)
+        + (g * vty + half_k * (sy + ny)) * (ty - ny)
+        + (g * vtz + half_k * (sz + nz)) * (tz - nz)
+    )
+    # a dashpot gives no energy back: when the spring unloads while sliding, the energy it
+    # releases goes to the slider (the sum is kept, so the ledger still closes)
+    total = damping + friction
+    damping = min(max(damping, 0.0), max(total, 0.0))
+    return fx, fy, fz, nx, ny, nz, k_t, damping, total - damping
 
 
 # ------------------------------------------------------------------------------------ none

@@ -18,8 +18,11 @@ Choices (details and their reasons in ``docs/models/direct_conduction-resistance
 - r_c = c (3 F_n R*/(4 E*))^{1/3}, c = (E*_sim/E*_real)^{1/5} (Zhou et al. 2010) when a
   material gives ``youngs_modulus_real`` (a material without it is taken as not softened),
   else c = 1. The ``contact_radius`` input of the kernel is not used.
-- P_0 = 3 F_n / (2π r_c²), the maximum Hertz pressure of the force over that circle; without
-  correction it equals the spec's 2 E* δ/(π r_c) for a Hertz contact.
+- P_0 (parameter ``maximum_pressure``): ``force`` (default) P_0 = 3 F_n / (2π r_c²), the
+  maximum Hertz pressure of the force over that circle; ``overlap`` P_0 = 2 E*_real δ_real /
+  (π r_c) with δ_real = δ (E*/E*_real)^{2/3}, Lethe's form. Both equal the spec's
+  2 E* δ/(π r_c) for a Hertz contact at rest without softening (E*_real = E*, c = 1); with a
+  softened modulus ``overlap`` is (E*_real/E*)^{2/15} times ``force``.
 - Out of the domain of erfc⁻¹: P_0 is capped at H' (the contact pressure cannot exceed the
   microhardness: fully plastic), so 0.03 P_0/H' stays in (0, 0.03]; and 2P_0/H' is capped at 1,
   i.e. a1 >= 0: the mean planes of the rough surfaces are not allowed to cross (for P_0 > H'/2
@@ -36,6 +39,7 @@ Choices (details and their reasons in ``docs/models/direct_conduction-resistance
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 from numba import njit
@@ -54,6 +58,13 @@ from thermodem.state.gas import GasProperties
 from thermodem.state.materials import PairContext, effective_youngs_modulus
 
 RESISTANCE_NETWORK = 9
+
+# Columns of the parameter row (PARAM_WIDTH = 16) that the positional list in pack does not
+# name: how P_0 is computed, and the factor of the overlap form.
+COL_P0_MODE = 12  # P0_FORCE or P0_OVERLAP
+COL_P0_OVERLAP_FACTOR = 13  # (2/π) E*_real (E*/E*_real)^{2/3} [Pa]: P_0 = factor δ / r_c
+P0_FORCE = 0.0
+P0_OVERLAP = 1.0
 
 BOLTZMANN = 1.380649e-23  # J/K (exact, SI 2019)
 _LN_2 = math.log(2.0)
@@ -127,17 +138,23 @@ def resistance_macrogap(k_g, r_h, r_c, m_gas, b):
 
 
 @njit(cache=True, error_model="numpy")
-def resistance_network_conductance(
-    k_i, k_j, r_i, r_j, f_n, e_star, c_zhou, h_micro, sigma, tau, k_g, m_gas, b
-):
+def network_conductance(
+    k_i, k_j, r_i, r_j, f_n, e_star, c_zhou, h_micro, sigma, tau, k_g, m_gas, b, overlap,
+    p0_overlap,
+):  # fmt: skip
     """1/R_ij [W/K] of Beaulieu (2020) for two touching particles (r_j = inf: a wall).
+
+    ``p0_overlap`` = 0: P_0 = 3 F_n/(2π r_c²) (``maximum_pressure: force``); > 0: P_0 =
+    p0_overlap δ / r_c with p0_overlap = (2/π) E*_real (E*/E*_real)^{2/3}
+    (``maximum_pressure: overlap``, needs δ = ``overlap`` > 0).
 
     The resistance functions above, rearranged so that the costly operations are few and
     independent of each other (equal to them to ~1e-15 relative, tested):
 
     - with u = 3 F_n R*/(4 E*): r_c = c u^{1/3} = c exp(ln(u)/3) and
       q = P0/H' = 3F_n/(2π r_c² H') = 2E* u^{1/3}/(π R* c² H'), so
-      ln q = ln(2E*/(π R* c² H')) + ln(u)/3, capped at 0 (P0 <= H');
+      ln q = ln(2E*/(π R* c² H')) + ln(u)/3, capped at 0 (P0 <= H'); the overlap form
+      q = p0_overlap δ/(r_c H') gives ln q = ln(p0_overlap δ/(c H')) - ln(u)/3;
     - ln q gives both erfc⁻¹ from their logarithms, -ln(2q) and -ln(0.03q) (no further log),
       and (H'/P0)^0.96 = exp(-0.96 ln q);
     - R_s and R_g are inverted in closed form; the contact-surface branch is
@@ -150,8 +167,11 @@ def resistance_network_conductance(
     if f_n > 0.0:
         log_u = math.log(0.75 * f_n * r_eff / e_star)
         r_c = c_zhou * math.exp(log_u / 3.0)
-        log_scale = math.log(2.0 * e_star / (math.pi * r_eff * c_zhou * c_zhou * h_micro))
-        log_q = min(log_scale + log_u / 3.0, 0.0)
+        if p0_overlap > 0.0:
+            log_q = min(math.log(p0_overlap * overlap / (c_zhou * h_micro)) - log_u / 3.0, 0.0)
+        else:
+            log_scale = math.log(2.0 * e_star / (math.pi * r_eff * c_zhou * c_zhou * h_micro))
+            log_q = min(log_scale + log_u / 3.0, 0.0)
     res_solid = resistance_solid_layer(k_i, r_i, r_c) + resistance_solid_layer(k_j, r_j, r_c)
     # macrogap branch 1/(R_c + R_G) = x/(1 + x R_c), x = 1/R_G = π k_g bracket/2 (one division;
     # 0 when the gas region is empty or the solid layers are blocked, R_c = inf)
@@ -183,15 +203,28 @@ def resistance_network_conductance(
 
 
 @njit(cache=True, error_model="numpy")
+def resistance_network_conductance(
+    k_i, k_j, r_i, r_j, f_n, e_star, c_zhou, h_micro, sigma, tau, k_g, m_gas, b
+):
+    """:func:`network_conductance` with P_0 from the force (``maximum_pressure: force``)."""
+    return network_conductance(
+        k_i, k_j, r_i, r_j, f_n, e_star, c_zhou, h_micro, sigma, tau, k_g, m_gas, b, 0.0, 0.0
+    )
+
+
+@njit(cache=True, error_model="numpy")
 def resistance_network_rate(
     p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff
 ):
-    """Heat rate into i [W]. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M, B/r_h]."""
+    """Heat rate into i [W]. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M, B/r_h, P_0 mode,
+    P_0 overlap factor]."""
     if overlap <= 0.0:
         return 0.0
-    h = resistance_network_conductance(
-        p[0], p[1], r_i, r_j, max(f_n, 0.0), p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11]
-    )
+    p0_overlap = p[COL_P0_OVERLAP_FACTOR] if p[COL_P0_MODE] == P0_OVERLAP else 0.0
+    h = network_conductance(
+        p[0], p[1], r_i, r_j, max(f_n, 0.0), p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11],
+        overlap, p0_overlap,
+    )  # fmt: skip
     return h * (t_j - t_i)
 
 
@@ -204,11 +237,21 @@ class ResistanceNetworkParams(StrictModel):
     B/r_h in [0, 2)). The gas is the case's ``thermal.gas`` (``pair.gas``). Materials need
     thermal_conductivity, microhardness, surface_roughness, surface_slope and
     thermal_accommodation; a wall material too. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M,
-    B/r_h].
+    B/r_h, P_0 mode (column COL_P0_MODE = 12: P0_FORCE 0 or P0_OVERLAP 1), P_0 overlap factor
+    (COL_P0_OVERLAP_FACTOR = 13: (2/π) E*_real (E*/E*_real)^{2/3} [Pa])].
+
+    ``maximum_pressure``: ``force`` P_0 = 3 F_n/(2π r_c²) (default; allows
+    thermal.conductance_force_tolerance), ``overlap`` P_0 = 2 E*_real δ (E*/E*_real)^{2/3} /
+    (π r_c) as Lethe computes it (docs/models/direct_conduction-resistance_network.md).
     """
 
     packing_constant: float = Field(
         default=0.0, ge=0, lt=2, description="B / r_h [-] of the macrogap integral (0: cubic)"
+    )
+    maximum_pressure: Literal["force", "overlap"] = Field(
+        default="force",
+        description="P_0 from the normal force, 3F/(2π r_c²), or from the overlap, "
+        "2 E*_real δ (E*/E*_real)^(2/3)/(π r_c)",
     )
 
 
@@ -236,7 +279,9 @@ def pack_resistance_network(params: ResistanceNetworkParams, pair: PairContext) 
     a_i, a_j = both("thermal_accommodation")
     e_sim = pair.effective_youngs_modulus
     real = mi.youngs_modulus_real is not None or mj.youngs_modulus_real is not None
-    c = (e_sim / effective_youngs_modulus(mi, mj, real=True)) ** 0.2 if real else 1.0
+    e_real = effective_youngs_modulus(mi, mj, real=True) if real else e_sim
+    c = (e_sim / e_real) ** 0.2
+    overlap_mode = params.maximum_pressure == "overlap"
     return pad_row(
         [
             k_i,
@@ -251,8 +296,21 @@ def pack_resistance_network(params: ResistanceNetworkParams, pair: PairContext) 
             pair.gas.thermal_conductivity,
             gas_parameter(a_i, a_j, pair.gas),
             params.packing_constant,
+            P0_OVERLAP if overlap_mode else P0_FORCE,  # COL_P0_MODE
+            2.0 / math.pi * e_real * (e_sim / e_real) ** (2.0 / 3.0),  # COL_P0_OVERLAP_FACTOR
         ]
     )
+
+
+def _refuse_reuse(params: ResistanceNetworkParams) -> str | None:
+    """Why thermal.conductance_force_tolerance cannot be used with these parameters."""
+    if params.maximum_pressure == "overlap":
+        return (
+            "needs the conductance to depend on the contact through the normal force only, "
+            "but direct_conduction.maximum_pressure = 'overlap' also reads the overlap: use "
+            "maximum_pressure: force, or 0"
+        )
+    return None
 
 
 register(
@@ -276,7 +334,9 @@ register(
     ),
     swap_pairs=((0, 1), (2, 3)),
     # H depends on the contact through F_n only: thermal.conductance_force_tolerance allowed
+    # (with maximum_pressure: force; _refuse_reuse says why not otherwise)
     conductance_from_force=True,
+    conductance_reuse_refusal=_refuse_reuse,
     # thermal.gas read by pack (k_g; M from Λ, Pr = μ c_p / k_g and γ)
     uses_gas=(
         "thermal_conductivity",
