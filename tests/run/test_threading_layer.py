@@ -126,7 +126,8 @@ def test_thermodem_takes_openmp_with_tbb_present() -> None:
         n = 8
         force, torque, mass = np.ones((n, 3)), np.ones((n, 3)), np.full(n, 2.0)
         reset_forces(force, torque, mass, np.array([0.0, 0.0, -10.0]), False,
-                     np.zeros((1, 7)), np.zeros(0))  # a parallel kernel
+                     np.zeros((1, 8)), np.zeros(0), np.zeros((n, 0)),
+                     np.zeros((n, 0)))  # a parallel kernel
         assert (force[:, 2] == -20.0).all() and not torque.any()
         import os
         print(numba.threading_layer(), "|", threading_layer(), "|", os.environ["OMP_WAIT_POLICY"])

@@ -372,7 +372,7 @@ class Case(StrictModel):
                 f"{spec.name!r} also depends on the overlap, contact time or impact velocity: "
                 "use 0"
             )
-        refusal = spec.extra.get("conductance_reuse_refusal")  # a choice of the parameters
+        refusal = spec.conductance_reuse_refusal  # a choice of the parameters
         reason = refusal(th.direct_conduction.params) if refusal is not None else None
         if reason:
             raise ValueError(f"{key}: {tol} {reason}")

@@ -77,6 +77,7 @@ class ModelSpec:
     target: str = "contacts"
     symmetric: bool = False
     conductance_from_force: bool = False
+    conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
     example_params: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -116,6 +117,7 @@ def register(
     target: str = "contacts",
     symmetric: bool = False,
     conductance_from_force: bool = False,
+    conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
     example_params: dict[str, Any] | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
@@ -125,8 +127,10 @@ def register(
     and j swap; ``target`` where a thermal term runs (:data:`TARGETS`); ``symmetric`` that
     the kernel's value is unchanged when i and j swap (contact radii);
     ``conductance_from_force`` that the conductance depends on a contact through its normal
-    force only (allows ``thermal.conductance_force_tolerance``); ``example_params`` parameters
-    the conformance tests use for a model without defaults.
+    force only (allows ``thermal.conductance_force_tolerance``), and
+    ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
+    None); ``example_params`` parameters the conformance tests use for a model without
+    defaults.
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -165,6 +169,7 @@ def register(
         target=target,
         symmetric=symmetric,
         conductance_from_force=conductance_from_force,
+        conductance_reuse_refusal=conductance_reuse_refusal,
         example_params=dict(example_params or {}),
     )
     models[name] = spec

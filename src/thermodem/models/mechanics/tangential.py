@@ -42,6 +42,10 @@ MINDLIN = 1
 LINEAR = 2
 
 
+#: Squares below this lose precision (subnormal near 1e-308): compared by their roots.
+_TINY_SQUARE = 1e-280
+
+
 @njit(cache=True, error_model="numpy")
 def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy, sz, dt):
     """Shared algorithm: incremental spring + dashpot, Coulomb cap with history rescale.
@@ -61,9 +65,14 @@ def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy
     fz = -k_t * tz - gamma_t * vtz
     f_mag2 = fx * fx + fy * fy + fz * fz
     f_cap = mu * max(normal_force, 0.0)
-    if f_mag2 <= f_cap * f_cap:  # squares: the root is only needed when the cap applies
+    cap2 = f_cap * f_cap
+    # squares: the root is only needed when the cap applies (not for forces so small that
+    # their squares lose precision or vanish, below ~1e-140 N: those are compared exactly)
+    if f_mag2 <= cap2 and cap2 > _TINY_SQUARE:
         return fx, fy, fz, tx, ty, tz, k_t, gamma_t * v2 * dt, 0.0
-    f_mag = math.sqrt(f_mag2)
+    f_mag = math.sqrt(f_mag2) if f_mag2 > _TINY_SQUARE else math.hypot(fx, math.hypot(fy, fz))
+    if f_mag <= f_cap:
+        return fx, fy, fz, tx, ty, tz, k_t, gamma_t * v2 * dt, 0.0
     lam = f_cap / f_mag if f_mag > 0.0 else 0.0
     fx *= lam
     fy *= lam
