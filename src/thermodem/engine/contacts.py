@@ -134,12 +134,13 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
                 p.position, p.radius, p.temperature, p.type_id, pb.i, pb.j, pb.group_start,
                 sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table,
                 k_i, k_j, th.k_p, scratch, term.column, by_mech, sums, True, pair_h,
+                term.needs_contact_radius,
             )  # fmt: skip
             heat_terms.range_wall_pass(
                 p.position, p.radius, p.temperature, p.type_id, wb.j, sim.wall_row_start,
                 sim.wall_kind, sim.wall_rows, sim.wall_material, term.evaluator, term.model_id,
                 term.table, k_i, k_j, th.k_p, th.k_w, scratch, term.wall_column, by_mech, sums,
-                True, wall_h,
+                True, wall_h, term.needs_contact_radius,
             )  # fmt: skip
         else:
             heat_terms.contact_term_pair_pass(

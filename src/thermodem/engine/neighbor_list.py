@@ -60,6 +60,7 @@ def rebuild_lists(sim: Simulation) -> None:
             )
     dims, edge = NB.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
     axis = int(SL.choose_axis(p.position, sim.lower, edge, dims))
+    sim.slab_axis = axis  # the particles' memory order is by layers along it (range set)
     axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
     ncell = int(dims[0] * dims[1] * dims[2])
     order = np.empty(n, np.int32)

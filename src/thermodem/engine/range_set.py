@@ -119,7 +119,11 @@ class RangePairSet:
                     sim.time,
                 )
         dims, edge = nbr.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
-        axis = int(slabs.choose_axis(p.position, sim.lower, edge, dims))
+        # the slab axis of the contact list: the particles lie in memory by layers along it,
+        # so each group of this set touches a compact block of memory (see below)
+        axis = getattr(sim, "slab_axis", None)
+        if axis is None:
+            axis = int(slabs.choose_axis(p.position, sim.lower, edge, dims))
         axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
         order = np.empty(n, np.int32)
         cell_start = np.zeros(int(dims[0] * dims[1] * dims[2]) + 1, np.int64)
@@ -149,6 +153,10 @@ class RangePairSet:
             sorted_i, sorted_j = np.empty_like(new_i), np.empty_like(new_j)
             slabs.sort_pairs_by_group(*args, sorted_i, sorted_j, np.empty(count, np.int32))
             new_i, new_j = sorted_i, sorted_j
+        # within each group, pairs in the order of their lower particle index: the pass then
+        # walks the particle arrays forwards (found in this set's own cell order, consecutive
+        # pairs were ~250 particles apart in memory: a cache miss per pair)
+        nbr_order_within_groups(new_i, new_j, count, group_start)
         self.i, self.j, self.count, self.group_start = new_i, new_j, count, group_start
         # particle-wall pairs, grouped by particle
         if self.wall_row_start.shape[0] != n + 1:
@@ -193,6 +201,19 @@ class RangePairSet:
         self.wall_w = _buffer(a["wall_w"])
         self.wall_row_start = np.array(a["wall_row_start"], np.int64)
         self.wall_reference = np.array(a["wall_reference"], np.float64).reshape(-1, 3)
+
+
+def nbr_order_within_groups(
+    pair_i: np.ndarray, pair_j: np.ndarray, count: int, group_start: np.ndarray
+) -> None:
+    """Sort the pairs of each group (in place) by their lower particle index (stable)."""
+    if count == 0:
+        return
+    lower = np.minimum(pair_i[:count], pair_j[:count]).astype(np.int64)
+    group = np.repeat(np.arange(group_start.shape[0] - 1), np.diff(group_start))
+    order = np.argsort(group * (int(lower.max()) + 1) + lower, kind="stable")
+    pair_i[:count] = pair_i[:count][order]
+    pair_j[:count] = pair_j[:count][order]
 
 
 def _buffer(values: Any) -> np.ndarray:

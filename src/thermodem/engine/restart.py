@@ -51,6 +51,7 @@ SCALARS: tuple[str, ...] = (
     "initial_energy",
     "max_overlap_ratio",
     "contact_count",
+    "slab_axis",
 )
 #: Array attributes of Simulation that are state (saved whole).
 ARRAYS: tuple[str, ...] = (
@@ -310,8 +311,10 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
         **{k: np.ascontiguousarray(state["particles"][k]) for k in sorted(names)}
     )
     for name in SCALARS:
-        value = s[name]
-        if name in ("step_count", "next_global_id", "rebuild_count", "contact_count"):
+        value = s.get(name) if name == "slab_axis" else s[name]
+        if name in ("step_count", "next_global_id", "rebuild_count", "contact_count") or (
+            name == "slab_axis" and value is not None
+        ):
             value = int(value)
         elif name == "_needs_rebuild":
             value = bool(value)

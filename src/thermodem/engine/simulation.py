@@ -170,6 +170,7 @@ class Simulation:
         self.chunk_check = np.zeros((1, 3))
         self.moved = 0.0
         self.rebuild_count = 0
+        self.slab_axis: int | None = None  # set by each neighbour rebuild
         self._needs_rebuild = True
         # ledger
         ledger_keys = ("stiffness_work", "wall_work", "external_work", "inserted_energy")

@@ -82,6 +82,12 @@ class HeatTerm:
     def model_id(self) -> int:
         return self.spec.model_id
 
+    @property
+    def needs_contact_radius(self) -> bool:
+        """Whether the range passes compute R_c^geo for the kernel (separated-pair parts of
+        direct models and kernels that ignore r_c do not need it)."""
+        return self.evaluator != EVAL_SEPARATED and self.spec.uses_contact_radius
+
     def max_gap(self, radius: float) -> tuple[float, float]:
         """Largest conducting surface gap [m] of particle pairs and particle-wall pairs for
         particles up to ``radius`` (ranges grow with the radii: ratio × R*, ratio × R_k)."""

@@ -490,12 +490,13 @@ class ThermalEngine:
             p.position, p.radius, p.temperature, p.type_id, rs.i, rs.j, rs.group_start,
             sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table, k_i,
             k_j, self.k_p, scratch, term.column, by_mech, self.conductance_sum, store, pair_h,
+            term.needs_contact_radius,
         )  # fmt: skip
         passes.range_wall_pass(
             p.position, p.radius, p.temperature, p.type_id, rs.wall_w, rs.wall_row_start,
             sim.wall_kind, sim.wall_rows, sim.wall_material, term.evaluator, term.model_id,
             term.table, k_i, k_j, self.k_p, self.k_w, scratch, term.wall_column, by_mech,
-            self.conductance_sum, store, wall_h,
+            self.conductance_sum, store, wall_h, term.needs_contact_radius,
         )  # fmt: skip
         self.term_ready[index] = store
 

@@ -85,9 +85,10 @@ def _row(table_row, k_col_i, k_col_j, k_i, k_j, scratch_row):
 def range_pair_pass(
     position, radius, temperature, type_id, pair_i, pair_j, group_start, lower, upper,
     periodic, evaluator, model_id, table, k_col_i, k_col_j, k_particle, scratch, column,
-    by_mechanism, conductance_sum, store, out_conductance,
+    by_mechanism, conductance_sum, store, out_conductance, need_rc,
 ):  # fmt: skip
-    """One pair term over the range pair set (slab groups; ``scratch``: a row per group)."""
+    """One pair term over the range pair set (slab groups; ``scratch``: a row per group;
+    ``need_rc``: compute the geometric contact radius of touching pairs for the kernel)."""
     length = upper - lower
     ngroups = group_start.shape[0] - 1
     for parity in range(2):
@@ -100,7 +101,7 @@ def range_pair_pass(
                 dist = pair_separation(position, i, j, length, periodic)[3]
                 ri = radius[i]
                 rj = radius[j]
-                r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+                r_c = geometric_contact_radius(ri, rj, ri + rj - dist) if need_rc else 0.0
                 ki = kj = 0.0
                 if k_col_i >= 0:
                     ki = k_particle[i]
@@ -121,7 +122,7 @@ def range_pair_pass(
 def range_wall_pass(
     position, radius, temperature, type_id, wall_pair_w, wall_row_start, wall_kind, wall_rows,
     wall_material, evaluator, model_id, table, k_col_i, k_col_j, k_particle, k_wall, scratch,
-    column, by_mechanism, conductance_sum, store, out_conductance,
+    column, by_mechanism, conductance_sum, store, out_conductance, need_rc,
 ):  # fmt: skip
     """One pair term over the particle-wall pairs of the range set (``wall_row_start``: the
     wall pairs of each particle); adiabatic walls give nothing."""
@@ -137,7 +138,7 @@ def range_wall_pass(
                 if wrow[COL_THERMAL_KIND] != 0.0:
                     d = wall_distance(wall_kind[w], wrow, position[i])[0]
                     ri = radius[i]
-                    r_c = geometric_contact_radius(ri, math.inf, ri - d)
+                    r_c = geometric_contact_radius(ri, math.inf, ri - d) if need_rc else 0.0
                     ki = kw = 0.0
                     if k_col_i >= 0:
                         ki = k_particle[i]

@@ -78,6 +78,7 @@ class ModelSpec:
     symmetric: bool = False
     conductance_from_force: bool = False
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
+    uses_contact_radius: bool = True
     example_params: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -118,6 +119,7 @@ def register(
     symmetric: bool = False,
     conductance_from_force: bool = False,
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
+    uses_contact_radius: bool = True,
     example_params: dict[str, Any] | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
@@ -129,8 +131,9 @@ def register(
     ``conductance_from_force`` that the conductance depends on a contact through its normal
     force only (allows ``thermal.conductance_force_tolerance``), and
     ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
-    None); ``example_params`` parameters the conformance tests use for a model without
-    defaults.
+    None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
+    argument (the range pass then does not compute it); ``example_params`` parameters the
+    conformance tests use for a model without defaults.
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -170,6 +173,7 @@ def register(
         symmetric=symmetric,
         conductance_from_force=conductance_from_force,
         conductance_reuse_refusal=conductance_reuse_refusal,
+        uses_contact_radius=uses_contact_radius,
         example_params=dict(example_params or {}),
     )
     models[name] = spec

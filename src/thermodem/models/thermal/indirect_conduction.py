@@ -258,6 +258,7 @@ register(
     requires=("thermal_conductivity",),
     uses_gas=("thermal_conductivity",),
     interaction_range=bob_separated_range,
+    uses_contact_radius=False,
     antisymmetric=False,
     symmetric=True,
     columns=BOB_COLUMNS,

@@ -374,6 +374,7 @@ register(
     "65-70" + _WALL + _PENG,
     interaction_range=rong_horio1999_range,
     columns=RH_COLUMNS,
+    uses_contact_radius=False,
     **_COMMON,
 )
 register(
