@@ -15,7 +15,11 @@ untimed steps, then the timed steps; throughput = N × steps / loop seconds.
         [--cases mechanics heat region material]
         [--indirect MODEL [--indirect-param KEY=VALUE ...]]
         [--substeps N] [--convection MODEL] [--porosity cell|shell|global]
-        [--radiation MODEL] [--json]
+        [--radiation MODEL] [--frozen DT] [--json]
+
+``--frozen DT`` freezes the mechanics (every step a thermal step of DT seconds): with
+``--indirect voronoi_a`` the 50k bed's tessellation time and the heat pass time per thermal
+step (issue 11); the tessellation counts and seconds are printed when a Voronoi model runs.
 
 ``--convection`` adds convection to air at 300 K flowing upwards at 0.5 m/s (uniform) with
 the local porosity of ``--porosity`` (default cell), ``--radiation`` a radiation model (e.g.
@@ -71,6 +75,9 @@ def particle_files(tiny: bool = False) -> tuple[Path, Path, Path]:
 Terms = tuple[str | None, str, str | None]  # (convection, porosity kind, radiation)
 
 
+FROZEN = {"dt": 0.0}  # --frozen: the thermal time step of frozen mechanics (0: off)
+
+
 def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = False,
               terms: Terms = (None, "cell", None)) -> dict:  # fmt: skip
     all_path, hot_path, cold_path = particle_files(tiny)
@@ -124,6 +131,9 @@ def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = Fals
         thermal["fixed_temperature"] = [{"select": {"material": "hot"}, "temperature": 400.0}]
     if indirect is not None:
         thermal["indirect_conduction"] = indirect
+    if FROZEN["dt"] > 0.0:
+        thermal.update(frozen_mechanics=True, time_step=FROZEN["dt"])
+        thermal.pop("substeps")
     convection, porosity, radiation = terms
     if convection:
         thermal["convection"] = convection
@@ -182,6 +192,13 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
         ns = sim.thermal.field_provider.neighbourhood
         if ns is not None:
             out["neighbourhood_pairs_per_particle"] = ns.count / n
+        vor = sim.thermal.voronoi
+        if vor is not None:
+            out["tessellations"] = vor.count
+            out["tessellation_seconds"] = vor.seconds
+            out["last_tessellation_seconds"] = vor.last_seconds
+            out["voronoi_pairs_per_particle"] = sim.thermal.external.count / n
+    out["seconds_per_step"] = elapsed / steps
     return out
 
 
@@ -197,9 +214,11 @@ def main() -> None:
     ap.add_argument("--convection", default=None, help="a convection model")
     ap.add_argument("--porosity", default="cell", choices=["cell", "shell", "global"])
     ap.add_argument("--radiation", default=None, help="a radiation model")
+    ap.add_argument("--frozen", type=float, default=0.0, help="frozen mechanics, thermal dt [s]")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    FROZEN["dt"] = args.frozen
     indirect = None
     if args.indirect:
         indirect = {"model": args.indirect}
@@ -227,7 +246,7 @@ def main() -> None:
                 cmd += ["--convection", args.convection]
             if args.radiation:
                 cmd += ["--radiation", args.radiation]
-            cmd += ["--porosity", args.porosity]
+            cmd += ["--porosity", args.porosity, "--frozen", str(args.frozen)]
             proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
             result = json.loads(proc.stdout.strip().splitlines()[-1])
             results.append(result)
@@ -235,6 +254,14 @@ def main() -> None:
                 extra = ""
                 if "range_pairs_per_particle" in result:
                     extra = f", {result['range_pairs_per_particle']:.2f} range pairs/particle"
+                if "tessellations" in result:
+                    extra += (
+                        f", {result['tessellations']} tessellations "
+                        f"({result['tessellation_seconds']:.3g} s, last "
+                        f"{result['last_tessellation_seconds']:.3g} s), "
+                        f"{result['voronoi_pairs_per_particle']:.2f} Voronoi "
+                        f"pairs/particle, {1e3 * result['seconds_per_step']:.3g} ms/step"
+                    )
                 if "neighbourhood_pairs_per_particle" in result:
                     extra += (f", {result['neighbourhood_pairs_per_particle']:.2f} "
                               "neighbourhood pairs/particle")  # fmt: skip

@@ -26,6 +26,11 @@ class SimulationError(RuntimeError):
         self.checkpoint = checkpoint
 
 
+class RunNotice(RuntimeWarning):
+    """Information for the run log (a cost, a rebuild), issued as a warning: the runner logs
+    it as a plain line, not as a warning."""
+
+
 class RunInterrupted(KeyboardInterrupt):
     """A run stopped by Ctrl-C (SIGINT) or SIGTERM after writing a checkpoint.
 

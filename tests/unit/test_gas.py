@@ -121,6 +121,8 @@ def test_every_gas_property_a_model_reads_is_a_gas_key():
             "indirect_conduction.rong_horio1999",
             "indirect_conduction.musser2011",
             "indirect_conduction.vargas_mccarthy2002",
+            "indirect_conduction.voronoi_a",
+            "indirect_conduction.voronoi_b",
         }
         | convection
     )  # the convection models read it as thermal.fluid.properties: gas

@@ -15,6 +15,7 @@ from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
 from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch, swap_row
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
+from thermodem.models.thermal.voronoi import voronoi_dispatch
 from thermodem.state.materials import Material, resolve_pair
 
 DISPATCH = {
@@ -85,6 +86,9 @@ def random_inputs(rng, wall: bool):
         t_contact=rng.uniform(0, 1e-4),
         v=rng.uniform(0, 2),
         m=rng.uniform(1e-7, 1e-4),
+        # the input row of an external pair set (no extra draw: the other inputs stay as they
+        # were)
+        face_area=(1.0 + 2000.0 * r_i) * r_i * r_i,
     )
 
 
@@ -94,6 +98,9 @@ def call(spec, fn, p, x, swap=False):
     tail = (x["f_n"], x["t_contact"], x["v"], x["m"])
     if spec.family == "contact_radius":
         return fn(p, *geo, *tail)
+    if spec.family == "indirect_conduction" and spec.target == "external":
+        inputs = np.array([x["face_area"]])
+        return fn(p, x[f"r_{i}"], x[f"r_{j}"], x["dist"], x["r_c"], inputs)
     if spec.family == "indirect_conduction":
         return fn(p, x[f"r_{i}"], x[f"r_{j}"], x["dist"], x["r_c"], x["f_n"])
     if spec.family in PARTICLE_FAMILIES:
@@ -134,7 +141,8 @@ def test_dispatcher_agrees_with_kernel_and_swap(spec, wall):
     p = spec.pack(params_of(spec), resolve_pair(MAT_I, MAT_J, is_wall=wall))
     assert p.dtype == np.float64 and p.shape == (spec.width,)
     rng = np.random.default_rng(spec.model_id + 100 * wall)
-    dispatch = DISPATCH[spec.family]
+    # models of the external pair set (the Voronoi faces) have their own dispatcher
+    dispatch = voronoi_dispatch if spec.target == "external" else DISPATCH[spec.family]
     for _ in range(60):
         x = random_inputs(rng, wall)
         own = call(spec, spec.kernel, p, x)

@@ -190,6 +190,33 @@ class ThermalStability(StrictModel):
     allow_unstable: bool = False
 
 
+class TessellationSettings(StrictModel):
+    """The Voronoi tessellation of the Voronoi conduction models and of ``porosity: {kind:
+    voronoi}`` (``engine/voronoi.py``; docs/models/indirect_conduction-voronoi_a.md).
+
+    The tessellation is made at the first thermal step and again when ``every_steps``
+    mechanical steps have passed since the last one, or when a particle has moved more than
+    ``displacement_ratio`` × R_min since the last one (like a neighbour skin); with neither
+    (or frozen mechanics) it is made once. Non-periodic domain faces and plane walls clip the
+    cells (mirror particles); the cell faces on walls are the particle-wall faces.
+    """
+
+    method: Literal["plain", "radical"] = Field(
+        default="plain",
+        description="plain: Voronoi (freud); radical: the radical (Laguerre, power) "
+        "tessellation of the spheres (pyvoro2), for polydisperse beds",
+    )
+    every_steps: int | None = Field(
+        default=None, ge=1, description="re-tessellate every this many mechanical steps"
+    )
+    displacement_ratio: float | None = Field(
+        default=0.1,
+        gt=0,
+        description="re-tessellate when a particle moved more than this × R_min since the "
+        "last tessellation; null: never for that reason",
+    )
+
+
 class ThermalSettings(StrictModel):
     """Heat transfer between particles (explicit Euler, spec section 1.2)."""
 
@@ -226,6 +253,11 @@ class ThermalSettings(StrictModel):
         default=None,
         description="local porosity of each particle (global, cell, shell, voronoi), read by "
         "the porosity-based correlations and radiation models",
+    )
+    tessellation: TessellationSettings | None = Field(
+        default=None,
+        description="the Voronoi tessellation (method, update policy) of the Voronoi models "
+        "and of porosity kind voronoi; null: the defaults",
     )
     range_skin: float | None = Field(
         default=None,

@@ -116,6 +116,18 @@ class FieldProvider:
                 self.radiation_ratio = float(params.radius_ratio)
             if params.walls:
                 self.walls = params
+        # a Voronoi model with the porosity closure (Zhou et al. 2009) reads ε of each particle
+        self.closure = next(
+            (t for t in terms
+             if t.target == "external" and getattr(t.params, "geometry", "") == "porosity"),
+            None,
+        )  # fmt: skip
+        if self.closure is not None:
+            self.active = True
+            self.needs_porosity = True
+            users["porosity"].append(
+                f"{self.closure.key} = {self.closure.choice.model!r} (geometry: porosity)"
+            )
         if users["fluid"] and self.fluid is None:
             raise ConfigError(
                 f"thermal.fluid: missing; required by {', '.join(users['fluid'])} (the fluid "
@@ -149,8 +161,9 @@ class FieldProvider:
             factory = POROSITY_PROVIDERS.get("voronoi")
             if factory is None:
                 raise ConfigError(
-                    "thermal.porosity.kind = 'voronoi': needs the Voronoi tessellation, which "
-                    "this version does not have; use kind cell, shell or global"
+                    "thermal.porosity.kind = 'voronoi': needs the Voronoi tessellation "
+                    "(thermodem.engine.voronoi), which is not loaded; use kind cell, shell or "
+                    "global"
                 )
             self.external_porosity = factory(sim, self.porosity)
         # the fluid

@@ -68,7 +68,7 @@ from thermodem.engine.validation import (
     format_duration,
     total_steps,
 )
-from thermodem.errors import ConfigError, RunInterrupted, SimulationError
+from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
 from thermodem.io.checkpoint import (
     Checkpoint,
     checkpoint_name,
@@ -255,7 +255,9 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     try:
         with _StopRequest(log) as stop, progress, warnings.catch_warnings():
             warnings.simplefilter("always", RuntimeWarning)
-            warnings.showwarning = lambda msg, *a, **k: log.warn(str(msg))
+            warnings.showwarning = lambda msg, cat, *a, **k: (
+                log.info if issubclass(cat, RunNotice) else log.warn
+            )(str(msg))
             while sim.step_count < run.total:
                 if stop.signum:
                     raise KeyboardInterrupt

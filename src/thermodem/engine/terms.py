@@ -28,6 +28,7 @@ from thermodem.kernels.heat_terms import (
     EVAL_INDIRECT,
     EVAL_RADIATION,
     EVAL_SEPARATED,
+    EVAL_VORONOI,
 )
 from thermodem.models.registry import ModelSpec
 from thermodem.models.tables import material_table, pair_table
@@ -156,7 +157,8 @@ def build_terms(
                 key="thermal.indirect_conduction",
                 choice=indirect,
                 target=indirect.spec.target,
-                evaluator=EVAL_INDIRECT,
+                # models made for the external set read its input rows (the Voronoi faces)
+                evaluator=EVAL_VORONOI if indirect.spec.target == "external" else EVAL_INDIRECT,
                 table=table(indirect, "thermal.indirect_conduction"),
                 column=pair_col,
                 wall_column=wall_col,

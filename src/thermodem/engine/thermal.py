@@ -39,6 +39,7 @@ from thermodem.engine.fields import FieldProvider
 from thermodem.engine.range_set import RangePairSet
 from thermodem.engine.terms import HeatTerm, build_terms
 from thermodem.engine.thermal_conditions import ThermalConditions
+from thermodem.engine.voronoi import INPUT_WIDTH, VoronoiProvider
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as field_kernels
@@ -51,10 +52,12 @@ if TYPE_CHECKING:
 
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
 SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty",
-        "_conditions_key", "field_provider", "fields")  # fmt: skip
+        "_conditions_key", "field_provider", "fields", "voronoi", "external_wall_conductance",
+        "external_stamp")  # fmt: skip
 #: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
 RANGE_PREFIX = "range_set__"
 EXTERNAL_PREFIX = "external__"
+VORONOI_PREFIX = "voronoi__"
 
 
 class ThermalEngine:
@@ -103,6 +106,13 @@ class ThermalEngine:
         #: the external pair set of terms with target "external" (set_external_term)
         self.external: ExternalPairSet | None = None
         self.external_term = ""
+        #: the tessellation (or porosity closure) that fills it for the Voronoi models
+        self.voronoi: VoronoiProvider | None = None
+        self.external_wall_conductance = np.zeros(0)
+        self.external_stamp = -1  # the external set's update count of the stored H (frozen)
+        for term in self.terms:
+            if term.target == "external":
+                self._voronoi_term(term)
         self.range_set = (
             RangePairSet(settings.range_skin)
             if any(t.target == "range" for t in self.terms)
@@ -398,6 +408,8 @@ class ThermalEngine:
             if self.fields.shape[0] != n:
                 self.fields = np.zeros((n, field_kernels.NFIELDS))
             self.field_provider.update(time, self.fields)
+        if self.voronoi is not None:
+            self.voronoi.update(self.fields)
         ranged = any(t.target == "range" for t in self.terms)
         if ranged and self.range_set.due(sim):
             self.range_set.build(sim, *self._range_gaps())
@@ -429,19 +441,47 @@ class ThermalEngine:
         self.term_ready[:] = False
         self.in_use = self._mechanisms_in_use()
 
+    def _voronoi_term(self, term: HeatTerm) -> None:
+        """A Voronoi model: its external set, filled by the tessellation (or, with
+        ``geometry: porosity``, by the near pairs and the porosity closure)."""
+        closure = getattr(term.params, "geometry", "tessellation") == "porosity"
+        self.external = ExternalPairSet(INPUT_WIDTH)
+        self.external_term = term.key
+        gap = (lambda r_max: max(term.max_gap(r_max))) if closure else None
+        self.voronoi = VoronoiProvider(self.sim, self.settings.tessellation, self.external, gap)
+
     def _external_term(self, index: int, term: HeatTerm) -> None:
         sim = self.sim
         p = sim.particles
         ext = self.external
         ext.prepare(sim)
         h, _ = self._stored(index, ext.count, 0)
+        if self.external_wall_conductance.shape[0] < ext.wall_count:
+            self.external_wall_conductance = np.zeros(ext.wall_count)
+            self.external_stamp = -1
         k_i, k_j = term.k_columns if self.override else (-1, -1)
-        rows = ext.count // passes.PARTICLE_CHUNK + 1
-        passes.external_pair_pass(
-            p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
-            sim.periodic, term.evaluator, term.model_id, term.table, k_i, k_j, self.k_p,
-            self._term_rows(rows), h,
-        )  # fmt: skip
+        # frozen mechanics, constant properties, a tessellation that did not change: the
+        # conductances of the last evaluation hold (the heat is recomputed from them)
+        frozen = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        reuse = (frozen and self.voronoi is not None and not self.voronoi.closure
+                 and self.external_stamp == ext.updates)  # fmt: skip
+        rows = max(ext.count // passes.PARTICLE_CHUNK, p.count // passes.WALL_CHUNK) + 1
+        scratch = self._term_rows(rows)
+        if not reuse:
+            passes.external_pair_pass(
+                p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
+                sim.periodic, term.evaluator, term.model_id, term.table, k_i, k_j, self.k_p,
+                scratch, h,
+            )  # fmt: skip
+            self.external_stamp = ext.updates
+        if term.evaluator == passes.EVAL_VORONOI and ext.wall_count:
+            passes.external_wall_pass(
+                p.position, p.radius, p.temperature, p.type_id, ext.wall_i, ext.wall_w,
+                ext.wall_offsets, ext.wall_inputs, sim.wall_kind, sim.wall_rows,
+                sim.wall_material, term.model_id, term.table, k_i, k_j, self.k_p, self.k_w,
+                scratch, term.wall_column, p.heat_rate_by_mechanism, self.conductance_sum,
+                not reuse, self.external_wall_conductance,
+            )  # fmt: skip
         passes.csr_heat(
             ext.offsets, ext.entries, ext.i, ext.j, h, p.temperature, term.column,
             p.heat_rate_by_mechanism, self.conductance_sum,
@@ -687,6 +727,10 @@ class ThermalEngine:
         out["thermal_limit"] = self.limit
         if self.range_set is not None:
             out["range_pair_count"] = self.range_set.count
+        if self.voronoi is not None:
+            out["voronoi_pair_count"] = self.external.count
+            out["tessellation_count"] = self.voronoi.count
+            out["tessellation_seconds"] = self.voronoi.seconds
         return out
 
     # ------------------------------------------------------------------------ checkpoints
@@ -702,6 +746,10 @@ class ThermalEngine:
                 sub = pairs.state_dict()
                 state["scalars"][name] = sub["scalars"]
                 state["arrays"].update({f"{prefix}{k}": v for k, v in sub["arrays"].items()})
+        if self.voronoi is not None:
+            sub = self.voronoi.state_dict()
+            state["scalars"]["voronoi"] = sub["scalars"]
+            state["arrays"].update({f"{VORONOI_PREFIX}{k}": v for k, v in sub["arrays"].items()})
         if self.field_provider.active:
             sub = self.field_provider.state_dict()
             state["scalars"]["field_provider"] = sub["scalars"]
@@ -722,6 +770,12 @@ class ThermalEngine:
             k[len(FIELDS_PREFIX) :]: arrays.pop(k)
             for k in list(arrays)
             if k.startswith(FIELDS_PREFIX)
+        }
+        voronoi_scalars = scalars.pop("voronoi", None)
+        voronoi_arrays = {
+            k[len(VORONOI_PREFIX) :]: arrays.pop(k)
+            for k in list(arrays)
+            if k.startswith(VORONOI_PREFIX)
         }
         external_scalars = scalars.pop("external", None)
         external_arrays = {
@@ -749,6 +803,13 @@ class ThermalEngine:
             if self.external is None:  # a script had put a term on an external set
                 self.set_external_term(self.external_term, ExternalPairSet())
             self.external.load_state_dict({"scalars": external_scalars, "arrays": external_arrays})
+        if self.voronoi is not None:
+            if voronoi_scalars is None:
+                raise ConfigError(
+                    f"checkpoint has no tessellation state but this case's {self.external_term}"
+                    " is a Voronoi model"
+                )
+            self.voronoi.load_state_dict({"scalars": voronoi_scalars, "arrays": voronoi_arrays})
         if field_scalars is not None and self.field_provider.active:
             self.field_provider.load_state_dict({"scalars": field_scalars, "arrays": field_arrays})
         self.conditions.invalidate()

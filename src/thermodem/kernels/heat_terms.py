@@ -48,6 +48,7 @@ from thermodem.models.thermal.convection import convection_dispatch
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.radiation import radiation_dispatch
+from thermodem.models.thermal.voronoi import voronoi_dispatch
 
 #: Evaluators of pair terms: an indirect_conduction model, or the separated-pair part of a
 #: direct_conduction model with an interaction range.
@@ -56,6 +57,9 @@ EVAL_SEPARATED = 1
 #: Evaluators of per-particle terms.
 EVAL_RADIATION = 2
 EVAL_CONVECTION = 3
+#: Evaluator of the models of an external pair set that read the pair's input row (the
+#: Voronoi models: models/thermal/voronoi.py).
+EVAL_VORONOI = 4
 
 WALL_CHUNK = 4096  # particles per chunk of the wall passes
 PARTICLE_CHUNK = 4096  # particles per chunk of the per-particle passes
@@ -280,7 +284,50 @@ def external_pair_pass(
                 ki = k_particle[i]
                 kj = k_particle[j]
             p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
-            out_conductance[k] = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+            if evaluator == EVAL_VORONOI:
+                out_conductance[k] = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
+            else:
+                out_conductance[k] = term_conductance(
+                    evaluator, model_id, p, ri, rj, dist, r_c, 0.0
+                )
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def external_wall_pass(
+    position, radius, temperature, type_id, wall_i, wall_w, wall_offsets, inputs, wall_kind,
+    wall_rows, wall_material, model_id, table, k_col_i, k_col_j, k_particle, k_wall, scratch,
+    column, by_mechanism, conductance_sum, store, out_conductance,
+):  # fmt: skip
+    """The particle-wall pairs of an external pair set (``wall_offsets``: the pairs of each
+    particle), for the models that read the input row (EVAL_VORONOI): H from the distance to
+    the wall and the input row; adiabatic walls give no heat. With ``store`` H is written
+    per pair; otherwise ``out_conductance`` holds H from an earlier evaluation and only the
+    heat is recomputed from it."""
+    n = radius.shape[0]
+    nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
+    for c in prange(nchunks):
+        srow = scratch[c]
+        for i in range(c * WALL_CHUNK, min(n, (c + 1) * WALL_CHUNK)):
+            for k in range(wall_offsets[i], wall_offsets[i + 1]):
+                w = wall_w[k]
+                wrow = wall_rows[w]
+                if store and wrow[COL_THERMAL_KIND] == 0.0:
+                    out_conductance[k] = 0.0
+                elif store:
+                    d = wall_distance(wall_kind[w], wrow, position[i])[0]
+                    ri = radius[i]
+                    r_c = geometric_contact_radius(ri, math.inf, ri - d)
+                    ki = kw = 0.0
+                    if k_col_i >= 0:
+                        ki = k_particle[i]
+                        kw = k_wall[w]
+                    p = _row(table[type_id[i], wall_material[w]], k_col_i, k_col_j, ki, kw, srow)
+                    out_conductance[k] = voronoi_dispatch(model_id, p, ri, math.inf, d, r_c,
+                                                          inputs[k])  # fmt: skip
+                h = out_conductance[k]
+                if h != 0.0:
+                    by_mechanism[i, column] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    conductance_sum[i] += h
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

@@ -22,6 +22,7 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
+from thermodem.models.mechanics.tangential import _TINY_SQUARE
 from thermodem.models.registry import pad_row, register
 from thermodem.state.materials import PairContext
 
@@ -108,9 +109,13 @@ def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz
     ty = my - k_r * wy * dt
     tz = mz - k_r * wz * dt
     m_mag2 = tx * tx + ty * ty + tz * tz
-    if m_mag2 <= m_lim * m_lim:
+    lim2 = m_lim * m_lim
+    # squares below ~1e-280 lose precision (subnormal): those torques are compared by roots
+    if m_mag2 <= lim2 and lim2 > _TINY_SQUARE:
         return tx - c_r * wx, ty - c_r * wy, tz - c_r * wz, tx, ty, tz, k_r, c_r * w2 * dt
-    m_mag = math.sqrt(m_mag2)
+    m_mag = math.sqrt(m_mag2) if m_mag2 > _TINY_SQUARE else math.hypot(tx, math.hypot(ty, tz))
+    if m_mag <= m_lim:
+        return tx - c_r * wx, ty - c_r * wy, tz - c_r * wz, tx, ty, tz, k_r, c_r * w2 * dt
     scale = m_lim / m_mag if m_mag > 0.0 else 0.0
     nx = scale * tx
     ny = scale * ty

@@ -1,0 +1,732 @@
+"""The Voronoi tessellation of the particles: face areas, cell volumes, faces on walls.
+
+The Voronoi conduction models (``models/thermal/voronoi.py``) run on the external pair set
+(``engine/external_set.py``): its pairs are the particles whose cells share a face, each with
+the face's area A_n as input; its wall pairs are the cells' faces on flat walls.
+:class:`VoronoiProvider` fills it on its update policy (``thermal.tessellation``), and the
+``voronoi`` porosity provider reads its cell volumes (ε_i = 1 - V_particle / V_cell).
+
+**Libraries.** ``method: plain``: freud (``freud.locality.Voronoi``, voro++ inside, periodic
+boxes, face areas as neighbour-list weights). freud needs coordinates of order 1: in metres
+(mm particles) its neighbour list comes back empty without a warning, so every coordinate is
+divided by the mean radius R̄ and the areas and volumes are multiplied by R̄² and R̄³. freud
+works in single precision (face areas to ~1e-7 relative). freud has no radical tessellation;
+``method: radical`` uses pyvoro2 (voro++'s power / Laguerre mode with the particle radii;
+an optional dependency). The error of the plain tessellation for a polydisperse bed is
+measured in ``docs/models/indirect_conduction-voronoi_a.md``.
+
+**Boundaries without phantom cells.** The clipping planes are the non-periodic faces of the
+domain and the plane walls. Each particle whose cell may reach a clipping plane gets a mirror
+image across it: the bisector of a particle and its own mirror is the plane itself, and (for a
+point on the particles' side) a mirror is never nearer than its original, so the cells of the
+real particles are exactly their unbounded cells clipped by the planes, and the face between a
+particle and its own mirror is the cell's face on the plane (area A_n of the particle-wall
+pair; its double pyramid to the mirror is the spec's cone to the wall). Which particles need a
+mirror is not known beforehand: those within a layer (FIRST_LAYER × R_max) of the most
+recessed nearest particle of the columns around their own across the plane are mirrored, and
+the result is checked: (1) no real cell has a face with another particle's mirror, (2) no real
+cell is bounded through the padding of a non-periodic axis, (3) the real cells' volumes add up
+to the clipped domain's volume. If a check fails, the layer of the leaking planes grows
+fourfold (at most until every particle is mirrored); a tessellation that still fails, or a
+particle centre outside a clipping plane, is a :class:`SimulationError`, never silent zeros.
+Free surfaces: an open domain face is moved in to FREE_SURFACE × R_max beyond the outermost
+centres (see :func:`clipping_planes`).
+
+The walls a face lies on are found from the wall rows: a plane wall is its own clipping plane;
+a rectangle (the faces of a box wall) lying in a domain face, or with every particle on its
+inner side, clips by its plane and takes the faces of the particles whose projection falls on
+it. Cylinders and rectangles with particles on both sides do not clip the cells and exchange
+no Voronoi heat (a warning says so when such a wall has a fixed temperature).
+
+Checkpoints: the pairs and inputs are the external set's; the provider saves its counters and
+the reference positions of its last tessellation, so a restart continues bit-identically.
+"""
+
+from __future__ import annotations
+
+import math
+import time as wallclock
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numba import njit, prange
+
+from thermodem.errors import ConfigError, RunNotice, SimulationError
+from thermodem.geometry import wall_layout as wl
+from thermodem.models.thermal.voronoi import INPUT_FACE_AREA, INPUT_WIDTH, closure_face_area
+
+if TYPE_CHECKING:
+    from thermodem.config.thermal import TessellationSettings
+    from thermodem.engine.external_set import ExternalPairSet
+    from thermodem.engine.simulation import Simulation
+
+#: Faces smaller than this × R̄² are degenerate (edge or vertex contacts of cells).
+AREA_TOLERANCE = 1e-7
+#: A face of a real cell with another particle's mirror larger than this × R̄² means the cell
+#: is not clipped (a leak; exact geometry gives such faces zero area, single precision gives
+#: slivers up to ~2e-3 R̄² along the long edges of free-surface cells).
+LEAK_AREA = 1e-2
+#: Relative tolerance of the volume check (freud works in single precision).
+VOLUME_TOLERANCE = 1e-6
+#: Mirror layer beyond the nearest particles of a plane (see ``_column_depth``), in R_max.
+FIRST_LAYER = 4.0
+#: An open domain face is moved in to this × R_max beyond the outermost centre.
+FREE_SURFACE = 2.0
+
+
+@dataclass
+class Plane:
+    """A clipping plane: points x with (x - point) · normal >= 0 are on the particles' side."""
+
+    point: np.ndarray
+    normal: np.ndarray
+    walls: tuple[int, ...]  # wall rows lying in it (a plane wall: itself)
+    name: str
+
+
+@dataclass
+class Faces:
+    """One tessellation: particle indices, areas [m²], volumes [m³]."""
+
+    pair_i: np.ndarray
+    pair_j: np.ndarray
+    pair_area: np.ndarray
+    wall_particle: np.ndarray
+    wall_index: np.ndarray
+    wall_area: np.ndarray
+    volume: np.ndarray
+    mirrors: int
+    attempts: int
+
+
+# ------------------------------------------------------------------------- geometry
+def clipping_planes(sim: Simulation) -> tuple[list[Plane], list[int], np.ndarray, np.ndarray]:
+    """The clipping planes of the current walls, the fixed-temperature walls that are not in
+    any (they exchange no Voronoi heat), and the box the domain faces bound.
+
+    A non-periodic domain face that carries no wall (an open top above a bed) is a free
+    surface: it is moved in to FREE_SURFACE × R_max beyond the outermost particle centre (not
+    past the domain), so that the cells of the surface particles end in the gas a diameter
+    above them rather than at a far domain face (columns tens of radii tall, whose faces would
+    make every surface pair conduct over a whole hemisphere, and which voro++ builds slowly).
+    """
+    planes: list[Plane] = []
+    kinds, rows = sim.wall_kind, sim.wall_rows
+    used: set[int] = set()
+    lower = np.array(sim.lower, float)
+    upper = np.array(sim.upper, float)
+    pos = sim.particles.position
+    reach = FREE_SURFACE * float(sim.particles.radius.max()) if pos.shape[0] else 0.0
+    for a in range(3):
+        if sim.periodic[a]:
+            continue
+        for side, value in ((1.0, sim.lower[a]), (-1.0, sim.upper[a])):
+            point = np.zeros(3)
+            point[a] = value
+            normal = np.zeros(3)
+            normal[a] = side
+            on = []
+            for w in range(kinds.shape[0]):
+                if kinds[w] not in (wl.PLANE, wl.RECTANGLE):
+                    continue
+                n_w = rows[w, wl.COL_NORMAL : wl.COL_NORMAL + 3]
+                p_w = rows[w, wl.COL_POINT : wl.COL_POINT + 3]
+                if abs(abs(float(n_w @ normal)) - 1.0) < 1e-9 and abs(p_w[a] - value) <= 1e-9 * (
+                    1.0 + abs(value)
+                ):
+                    on.append(w)
+            used.update(on)
+            name = f"domain {'xyz'[a]} {'lower' if side > 0 else 'upper'} face"
+            if not on and pos.shape[0]:
+                name = f"free surface beyond the particles (open {name})"
+                if side > 0:
+                    value = max(float(value), float(pos[:, a].min()) - reach)
+                    lower[a] = point[a] = value
+                else:
+                    value = min(float(value), float(pos[:, a].max()) + reach)
+                    upper[a] = point[a] = value
+            planes.append(Plane(point, normal, tuple(on), name))
+    for w in range(kinds.shape[0]):
+        if w in used or kinds[w] not in (wl.PLANE, wl.RECTANGLE):
+            continue
+        point = rows[w, wl.COL_POINT : wl.COL_POINT + 3].copy()
+        normal = rows[w, wl.COL_NORMAL : wl.COL_NORMAL + 3].copy()
+        if kinds[w] == wl.RECTANGLE and (
+            pos.shape[0] == 0 or not np.all((pos - point) @ normal > 0.0)
+        ):
+            continue  # a rectangle with particles on both sides (a baffle): not a clip plane
+        same = next((q for q in planes if abs(float(q.normal @ normal) - 1.0) < 1e-9
+                     and abs(float((point - q.point) @ normal)) < 1e-12 * (1.0 + float(
+                         np.abs(point).max()))), None)  # fmt: skip
+        if same is not None:  # coplanar walls share one clipping plane
+            same.walls = (*same.walls, w)
+        else:
+            kind = "plane" if kinds[w] == wl.PLANE else "rectangle"
+            planes.append(Plane(point, normal, (w,), f"{kind} wall {w}"))
+        used.add(w)
+    hot_elsewhere = [
+        w for w in range(kinds.shape[0]) if w not in used and rows[w, wl.COL_THERMAL_KIND] != 0.0
+    ]
+    return planes, hot_elsewhere, lower, upper
+
+
+def clipped_volume(lower: np.ndarray, upper: np.ndarray, planes: list[Plane],
+                   inside: np.ndarray) -> float:  # fmt: skip
+    """Volume of the domain box cut by the planes (``inside``: a point strictly inside)."""
+    box = float(np.prod(upper - lower))
+    extra = [p for p in planes if " wall " in p.name]
+    if not extra:
+        return box
+    from scipy.spatial import ConvexHull, HalfspaceIntersection
+
+    halfspaces = []
+    for a in range(3):
+        n = np.zeros(3)
+        n[a] = -1.0
+        halfspaces.append([*n, lower[a]])  # -x + lower <= 0
+        n = np.zeros(3)
+        n[a] = 1.0
+        halfspaces.append([*n, -upper[a]])
+    for p in extra:  # (x - point)·n >= 0  <=>  -n·x + n·point <= 0
+        halfspaces.append([*(-p.normal), float(p.normal @ p.point)])
+    hs = HalfspaceIntersection(np.array(halfspaces), inside)
+    return float(ConvexHull(hs.intersections).volume)
+
+
+@njit(cache=True, error_model="numpy")
+def polygon_areas(vertices, vertex_start, face_vertices, face_start, face_cell, out):
+    """Areas of planar polygons (Newell's formula): face f of cell face_cell[f] has the vertex
+    indices face_vertices[face_start[f]:face_start[f + 1]] into that cell's vertices."""
+    for f in range(face_start.shape[0] - 1):
+        base = vertex_start[face_cell[f]]
+        nx = ny = nz = 0.0
+        a = face_start[f]
+        b = face_start[f + 1]
+        for k in range(a, b):
+            p = vertices[base + face_vertices[k]]
+            q = vertices[base + face_vertices[a + (k - a + 1) % (b - a)]]
+            nx += (p[1] - q[1]) * (p[2] + q[2])
+            ny += (p[2] - q[2]) * (p[0] + q[0])
+            nz += (p[0] - q[0]) * (p[1] + q[1])
+        out[f] = 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz)
+
+
+def _freud_faces(points: np.ndarray, lengths: np.ndarray, n_real: int) -> tuple:
+    """(cell, neighbour, area, vector, volumes of the real cells) from freud, coordinates
+    centred on 0 in a periodic box of ``lengths`` (units of R̄)."""
+    try:
+        import freud
+    except ImportError as exc:  # pragma: no cover - a dependency
+        raise ConfigError(
+            "thermal.tessellation.method = 'plain' needs the freud-analysis package "
+            f"(pip install freud-analysis): {exc}"
+        ) from None
+    box = freud.box.Box(float(lengths[0]), float(lengths[1]), float(lengths[2]))
+    voro = freud.locality.Voronoi()
+    voro.compute((box, points))
+    nl = voro.nlist
+    cell = np.asarray(nl.query_point_indices, np.int64)
+    keep = cell < n_real
+    return (cell[keep], np.asarray(nl.point_indices, np.int64)[keep],
+            np.asarray(nl.weights, np.float64)[keep],
+            np.asarray(nl.vectors, np.float64)[keep],
+            np.asarray(voro.volumes, np.float64)[:n_real].copy())  # fmt: skip
+
+
+def _pyvoro2_faces(points: np.ndarray, radii: np.ndarray, lengths: np.ndarray,
+                   periodic: np.ndarray, n_real: int) -> tuple:  # fmt: skip
+    """The same as _freud_faces from pyvoro2's power (radical) tessellation; non-periodic
+    axes are container walls (the padding keeps the real cells away from them)."""
+    try:
+        import pyvoro2 as pv
+    except ImportError as exc:
+        raise ConfigError(
+            "thermal.tessellation.method = 'radical' needs the pyvoro2 package (pip install "
+            f"pyvoro2; the radical / Laguerre tessellation of voro++): {exc}"
+        ) from None
+    half = 0.5 * lengths
+    bounds = tuple((-float(h), float(h)) for h in half)
+    domain = pv.OrthorhombicCell(bounds, periodic=tuple(bool(x) for x in periodic))
+    pts = points.copy()
+    for a in range(3):
+        if periodic[a]:
+            pts[:, a] = np.mod(pts[:, a] + half[a], lengths[a]) - half[a]
+    cells = pv.compute(pts, domain=domain, mode="power", radii=radii, return_vertices=True,
+                       return_adjacency=False, return_faces=True, output="cells")  # fmt: skip
+    cells = [c for c in cells if c["id"] < n_real]
+    volumes = np.zeros(n_real)
+    ids, vert_blocks, vertex_start = [], [], [0]
+    face_cell, neighbour, face_start, face_vertices = [], [], [0], []
+    for k, c in enumerate(cells):
+        volumes[c["id"]] = c["volume"]
+        vert_blocks.append(np.asarray(c["vertices"], np.float64).reshape(-1, 3))
+        vertex_start.append(vertex_start[-1] + vert_blocks[-1].shape[0])
+        for f in c["faces"]:
+            ids.append(c["id"])
+            face_cell.append(k)
+            neighbour.append(f["adjacent_cell"])
+            face_vertices.extend(f["vertices"])
+            face_start.append(len(face_vertices))
+    area = np.zeros(len(ids))
+    polygon_areas(np.concatenate(vert_blocks), np.array(vertex_start, np.int64),
+                  np.array(face_vertices, np.int64), np.array(face_start, np.int64),
+                  np.array(face_cell, np.int64), area)  # fmt: skip
+    cell = np.array(ids, np.int64)
+    nbr = np.array(neighbour, np.int64)
+    # the neighbour's displacement (no wrap on non-periodic axes: walls of the container)
+    vector = np.full((cell.size, 3), np.nan)
+    ok = nbr >= 0
+    vector[ok] = pts[nbr[ok]] - pts[cell[ok]]
+    for a in range(3):
+        if periodic[a]:
+            vector[ok, a] -= lengths[a] * np.round(vector[ok, a] / lengths[a])
+    return cell, nbr, area, vector, volumes
+
+
+def _column_depth(x: np.ndarray, signed: np.ndarray, normal: np.ndarray,
+                  r_max: float) -> np.ndarray:  # fmt: skip
+    """For each particle, the distance to the plane of the most recessed nearest particle of
+    the columns (width 2 R_max, across the plane) around its own: a particle whose cell
+    reaches the plane is within a few radii of that depth, also under a rough free surface
+    or where a free surface meets a wall."""
+    u = np.cross(normal, [1.0, 0.0, 0.0])
+    if np.linalg.norm(u) < 0.5:
+        u = np.cross(normal, [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    cu = np.floor((x @ u) / (2.0 * r_max)).astype(np.int64)
+    cv = np.floor((x @ v) / (2.0 * r_max)).astype(np.int64)
+    cu -= cu.min() - 1
+    cv -= cv.min() - 1
+    grid = np.full((int(cu.max()) + 2, int(cv.max()) + 2), -np.inf)
+    nearest = np.full(grid.shape, np.inf)
+    np.minimum.at(nearest, (cu, cv), signed)
+    grid[np.isfinite(nearest)] = nearest[np.isfinite(nearest)]
+    around = grid.copy()
+    for du in (-1, 0, 1):
+        for dv in (-1, 0, 1):
+            around[1:-1, 1:-1] = np.maximum(around[1:-1, 1:-1],
+                                            grid[1 + du : grid.shape[0] - 1 + du,
+                                                 1 + dv : grid.shape[1] - 1 + dv])  # fmt: skip
+    return around[cu, cv]
+
+
+def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+               periodic: np.ndarray, planes: list[Plane], method: str) -> Faces:  # fmt: skip
+    """The clipped Voronoi (or radical) tessellation of the spheres (see the module
+    docstring). Raises ValueError with the reason if it cannot be made."""
+    n = position.shape[0]
+    unit = float(radius.mean())
+    r_max = float(radius.max()) / unit
+    lo = np.asarray(lower, float) / unit
+    hi = np.asarray(upper, float) / unit
+    centre = 0.5 * (lo + hi)
+    x = position / unit - centre
+    lo, hi = lo - centre, hi - centre
+    periodic = np.asarray(periodic, bool)
+    normals = np.array([p.normal for p in planes]).reshape(-1, 3)
+    points = np.array([p.point / unit - centre for p in planes]).reshape(-1, 3)
+    signed = np.einsum("ika,ka->ik", x[:, None, :] - points[None], normals)
+    if planes:
+        bad = np.argwhere(signed <= 0.0)
+        if bad.size:
+            k, q = bad[0]
+            raise ValueError(
+                f"particle index {k} (centre {position[k].tolist()} m) is not on the particles' "
+                f"side of the {planes[q].name}: its cell cannot be clipped by it"
+            )
+    span = hi - lo
+    inside = position.mean(axis=0)
+    expected = clipped_volume(np.asarray(lower, float), np.asarray(upper, float), planes,
+                              inside) / unit**3  # fmt: skip
+    depth = [_column_depth(x, signed[:, q], normals[q], r_max) for q in range(len(planes))]
+    layers = np.full(len(planes), FIRST_LAYER * r_max)
+    reason = ""
+    attempt = 0
+    for _ in range(30):
+        attempt += 1
+        # mirrors
+        idx, plane_of = [], []
+        everything = bool(layers.size) and bool(np.all(layers > float(span.max()) + 2 * r_max))
+        for q in range(len(planes)):
+            s = signed[:, q]
+            sel = np.nonzero(s < depth[q] + layers[q])[0]
+            idx.append(sel)
+            plane_of.append(np.full(sel.size, q, np.int64))
+        origin = np.concatenate(idx) if idx else np.zeros(0, np.int64)
+        plane_of = np.concatenate(plane_of) if plane_of else np.zeros(0, np.int64)
+        mirror = x[origin] - 2.0 * signed[origin, plane_of][:, None] * normals[plane_of]
+        gen = np.concatenate([x, mirror])
+        # a tight box: the mirror cells at its ends meet their periodic images (cheap, and
+        # never a real cell's neighbour: the checks below)
+        lengths = span.copy()
+        shift = np.zeros(3)
+        for a in range(3):
+            if not periodic[a]:
+                top, bottom = float(gen[:, a].max()), float(gen[:, a].min())
+                lengths[a] = top - bottom + 4.0 * r_max
+                shift[a] = -0.5 * (top + bottom)
+        gen = gen + shift
+        if method == "radical":
+            rad = np.concatenate([radius, radius[origin]]) / unit
+            cell, nbr, area, vector, volume = _pyvoro2_faces(gen, rad, lengths, periodic, n)
+        else:
+            cell, nbr, area, vector, volume = _freud_faces(gen, lengths, n)
+        big = area > AREA_TOLERANCE
+        real = nbr < n
+        own = np.zeros(cell.size, bool)
+        m = ~real
+        own[m] = origin[nbr[m] - n] == cell[m]
+        foreign = m & ~own & (area > LEAK_AREA)
+        wrapped = np.zeros(cell.size, bool)
+        r = real & big
+        direct = gen[nbr[r]] - gen[cell[r]]
+        for a in range(3):
+            if not periodic[a]:
+                wrapped[np.nonzero(r)[0]] |= np.abs(vector[r, a] - direct[:, a]) > 1e-3
+        volume_error = abs(float(volume.sum()) - expected) / expected
+        missing = np.nonzero(volume <= 0.0)[0]
+        if (
+            not foreign.any()
+            and not wrapped.any()
+            and volume_error <= VOLUME_TOLERANCE
+            and (missing.size == 0)
+        ):
+            break
+        reason = (
+            f"{int(foreign.sum())} faces with other particles' mirrors, {int(wrapped.sum())} "
+            f"faces through the padding, {missing.size} empty cells, cell volumes add up to "
+            f"{volume_error:.3g} relative off the clipped domain's"
+        )
+        if everything:
+            raise ValueError(f"the tessellation failed with every particle mirrored: {reason}")
+        # grow the layers of the planes whose mirrors bound real cells, else all of them
+        leaking = np.unique(plane_of[nbr[foreign] - n])
+        if leaking.size and not wrapped.any():
+            layers[leaking] *= 4.0
+        else:
+            layers *= 4.0
+    else:  # pragma: no cover - the layer reaches the domain size long before
+        raise ValueError(f"the tessellation failed: {reason}")
+    # particle pairs: one face per pair (both cells report it: the mean of the two areas)
+    sel = real & big
+    a, b = cell[sel], nbr[sel]
+    key_i, key_j = np.minimum(a, b), np.maximum(a, b)
+    order = np.lexsort((key_j, key_i))
+    key_i, key_j, face = key_i[order], key_j[order], area[sel][order]
+    start = np.concatenate([[0], np.nonzero((np.diff(key_i) != 0) | (np.diff(key_j) != 0))[0] + 1])
+    if key_i.size == 0:  # a single cell, or cells that only touch walls
+        start = np.zeros(0, np.int64)
+    counts = np.diff(np.append(start, key_i.size)).astype(np.int64)
+    if np.any(counts > 2):
+        k = int(start[np.argmax(counts > 2)])
+        raise ValueError(
+            f"particles {key_i[k]} and {key_j[k]} share more than one face (a periodic domain "
+            "shorter than three cells along an axis): the pair would conduct twice"
+        )
+    sums = np.add.reduceat(face, start) if face.size else np.zeros(0)
+    pair_area = sums / counts * unit**2
+    # wall faces: a particle and its own mirror
+    w = m & own & big
+    w_cell = cell[w]
+    w_plane = plane_of[nbr[w] - n]
+    order = np.lexsort((w_plane, w_cell))
+    return Faces(
+        pair_i=key_i[start],
+        pair_j=key_j[start],
+        pair_area=pair_area,
+        wall_particle=w_cell[order],
+        wall_index=w_plane[order],
+        wall_area=area[w][order] * unit**2,
+        volume=volume * unit**3,
+        mirrors=int(origin.size),
+        attempts=attempt,
+    )
+
+
+def wall_of_face(sim: Simulation, planes: list[Plane], particle: np.ndarray,
+                 plane: np.ndarray) -> np.ndarray:  # fmt: skip
+    """The wall row each clipped face lies on (-1: a domain face without a wall there)."""
+    out = np.full(particle.size, -1, np.int64)
+    pos = sim.particles.position
+    rows = sim.wall_rows
+    for q, pl in enumerate(planes):
+        sel = np.nonzero(plane == q)[0]
+        for w in pl.walls:
+            free = sel[out[sel] < 0]
+            if not free.size:
+                break
+            if sim.wall_kind[w] == wl.PLANE:
+                out[free] = w
+                continue
+            row = rows[w]
+            u = row[wl.COL_U : wl.COL_U + 3]
+            n = row[wl.COL_NORMAL : wl.COL_NORMAL + 3]
+            v = np.cross(n, u)
+            rel = pos[particle[free]] - row[wl.COL_POINT : wl.COL_POINT + 3]
+            on = (np.abs(rel @ u) <= row[wl.COL_HALF_U] * (1 + 1e-9)) & (
+                np.abs(rel @ v) <= row[wl.COL_HALF_V] * (1 + 1e-9)
+            )
+            out[free[on]] = w
+    return out
+
+
+# ------------------------------------------------------------------------- provider
+@njit(cache=True, parallel=True, error_model="numpy")
+def _largest_move(position, reference, global_id, lower, upper, periodic, part):
+    """Largest displacement since ``reference`` (rows by global id; minimum image), by fixed
+    chunks: the maximum does not depend on the thread count."""
+    length = upper - lower
+    n = position.shape[0]
+    chunk = 4096
+    nchunks = (n + chunk - 1) // chunk
+    for c in prange(nchunks):
+        local = 0.0
+        for i in range(c * chunk, min(n, (c + 1) * chunk)):
+            g = global_id[i]
+            d2 = 0.0
+            for a in range(3):
+                d = position[i, a] - reference[g, a]
+                if periodic[a]:
+                    d -= length[a] * np.round(d / length[a])
+                d2 += d * d
+            local = max(local, d2)
+        part[c] = local
+    best = 0.0
+    for c in range(nchunks):
+        best = max(best, part[c])
+    return math.sqrt(best)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def closure_inputs(pair_i, pair_j, wall_i, radius, fields, porosity_column, inputs,
+                   wall_inputs):  # fmt: skip
+    """A_n of the porosity closure (Zhou et al. 2009) for every pair: the mean of the two
+    particles' 0.985 R² (1 - ε)^(-2/3) (one value per pair, so that what i gains j loses), and
+    the particle's for a wall pair."""
+    for k in prange(pair_i.shape[0]):
+        i = pair_i[k]
+        j = pair_j[k]
+        inputs[k, INPUT_FACE_AREA] = 0.5 * (
+            closure_face_area(radius[i], fields[i, porosity_column])
+            + closure_face_area(radius[j], fields[j, porosity_column])
+        )
+    for k in prange(wall_i.shape[0]):
+        i = wall_i[k]
+        wall_inputs[k, INPUT_FACE_AREA] = closure_face_area(radius[i], fields[i, porosity_column])
+
+
+class VoronoiProvider:
+    """Fills an external pair set with the faces of the tessellation, on its update policy
+    (see the module docstring); with ``closure`` the pairs are the near pairs within the
+    models' cut-off and A_n comes from each particle's porosity (Zhou et al. 2009)."""
+
+    def __init__(self, sim: Simulation, settings: TessellationSettings | None,
+                 external: ExternalPairSet | None,
+                 closure_gap: Callable[[float], float] | None = None) -> None:  # fmt: skip
+        from thermodem.config.thermal import TessellationSettings
+
+        self.sim = sim
+        self.settings = settings or TessellationSettings()
+        self.external = external
+        self.closure = closure_gap is not None
+        self.closure_gap = closure_gap  # largest conducting gap for particles up to a radius
+        frozen = bool(sim.case.thermal.frozen_mechanics)
+        self.every = None if frozen else self.settings.every_steps
+        self.ratio = None if frozen else self.settings.displacement_ratio
+        self.count = 0  # tessellations made
+        self.seconds = 0.0  # their total wall-clock time
+        self.last_seconds = 0.0
+        self.last_step = -1
+        self.particles = -1  # particle count at the last tessellation
+        self.reference = np.zeros((0, 3))  # positions at the last one, rows by global id
+        self.volume = np.zeros(0)  # cell volumes by global id [m³]
+        self.mirrors = 0
+        self._part = np.zeros(1)
+        self._warned = False
+        self.range_set = None
+        if self.closure:
+            from thermodem.engine.range_set import RangePairSet
+
+            self.range_set = RangePairSet(sim.case.thermal.range_skin)
+            self._range_builds = -1
+
+    # ------------------------------------------------------------------ the policy
+    def due(self) -> bool:
+        sim = self.sim
+        p = sim.particles
+        if self.count == 0 or p.count != self.particles:
+            return True
+        if self.every is not None and sim.step_count - self.last_step >= self.every:
+            return True
+        if self.ratio is not None and p.count:
+            rows = p.count // 4096 + 1
+            if self._part.shape[0] < rows:
+                self._part = np.zeros(rows)
+            if int(p.global_id.max()) >= self.reference.shape[0]:
+                return True
+            moved = _largest_move(p.position, self.reference, p.global_id, sim.lower,
+                                  sim.upper, sim.periodic, self._part)  # fmt: skip
+            return moved > self.ratio * float(p.radius.min())
+        return False
+
+    def update(self, fields: np.ndarray | None = None) -> bool:
+        """Tessellate if due (and, with the closure, refresh the near pairs and A_n); returns
+        whether the external set's pairs changed."""
+        if self.sim.particles.count == 0:
+            return False
+        if self.closure:
+            return self._closure(fields)
+        if not self.due():
+            return False
+        self.tessellate()
+        return True
+
+    def tessellate(self) -> None:
+        sim = self.sim
+        p = sim.particles
+        started = wallclock.perf_counter()
+        planes, hot_elsewhere, lower, upper = clipping_planes(sim)
+        if hot_elsewhere and not self._warned:
+            self._warned = True
+            names = ", ".join(f"{w} ({wl.KIND_NAMES[int(sim.wall_kind[w])]})"
+                              for w in hot_elsewhere)  # fmt: skip
+            warnings.warn(
+                f"thermal.tessellation: fixed-temperature walls {names} are not flat walls on a "
+                "clipping plane (a non-periodic domain face or a plane wall): the Voronoi "
+                "models exchange no heat with them",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+        try:
+            faces = tessellate(p.position, p.radius, lower, upper, sim.periodic, planes,
+                               self.settings.method)  # fmt: skip
+        except ValueError as exc:
+            raise SimulationError(
+                f"thermal.tessellation ({self.settings.method}): {exc} (step {sim.step_count}, "
+                f"t = {sim.time:.6g} s, {p.count} particles)",
+                sim.step_count,
+                sim.time,
+            ) from None
+        gid = p.global_id
+        size = int(gid.max()) + 1 if p.count else 0
+        self.volume = np.zeros(size)
+        self.volume[gid] = faces.volume
+        self.reference = np.zeros((size, 3))
+        self.reference[gid] = p.position
+        if self.external is not None:
+            walls = wall_of_face(sim, planes, faces.wall_particle, faces.wall_index)
+            keep = walls >= 0
+            self.external.set_pairs(gid[faces.pair_i], gid[faces.pair_j],
+                                    faces.pair_area[:, None])  # fmt: skip
+            self.external.set_wall_pairs(gid[faces.wall_particle[keep]], walls[keep],
+                                         faces.wall_area[keep][:, None])  # fmt: skip
+        self.count += 1
+        self.last_step = sim.step_count
+        self.particles = p.count
+        self.mirrors = faces.mirrors
+        self.last_seconds = wallclock.perf_counter() - started
+        self.seconds += self.last_seconds
+        if self.count <= 3 or self.count % 10 == 0:
+            pairs = faces.pair_i.size
+            warnings.warn(
+                f"tessellation {self.count} ({self.settings.method}) at step {sim.step_count}: "
+                f"{p.count} cells, {pairs} faces between particles, {faces.wall_area.size} on "
+                "clipping planes, "
+                f"{faces.mirrors} mirror particles ({faces.attempts} attempt"
+                f"{'s' if faces.attempts > 1 else ''}), {self.last_seconds:.3g} s; "
+                f"{self.seconds:.3g} s in {self.count} tessellations so far",
+                RunNotice,
+                stacklevel=2,
+            )
+
+    def _closure(self, fields: np.ndarray) -> bool:
+        sim = self.sim
+        rs = self.range_set
+        changed = False
+        if rs.due(sim):
+            gap = self.closure_gap(float(sim.particles.radius.max()))
+            rs.build(sim, gap, gap)
+        if rs.builds != self._range_builds:
+            self._range_builds = rs.builds
+            gid = sim.particles.global_id
+            wall_i = rs.wall_i[: rs.wall_count]
+            self.external.set_pairs(gid[rs.i[: rs.count]], gid[rs.j[: rs.count]])
+            self.external.set_wall_pairs(gid[wall_i], rs.wall_w[: rs.wall_count])
+            changed = True
+        ext = self.external
+        ext.prepare(sim)
+        from thermodem.kernels.fields import F_POROSITY
+
+        closure_inputs(ext.i, ext.j, ext.wall_i, sim.particles.radius, fields, F_POROSITY,
+                       ext.inputs, ext.wall_inputs)  # fmt: skip
+        return changed
+
+    def porosity(self) -> np.ndarray:
+        """ε_i = 1 - (4/3 π R_i³)/V_cell,i of the current particles (tessellating if due)."""
+        if self.due():
+            self.tessellate()
+        p = self.sim.particles
+        return 1.0 - (4.0 / 3.0) * math.pi * p.radius**3 / self.volume[p.global_id]
+
+    # --------------------------------------------------------------- checkpoints
+    def state_dict(self) -> dict[str, Any]:
+        scalars = {"count": self.count, "seconds": self.seconds, "last_step": self.last_step,
+                   "particles": self.particles, "mirrors": self.mirrors,
+                   "warned": self._warned}  # fmt: skip
+        arrays = {"reference": self.reference, "volume": self.volume}
+        if self.range_set is not None:
+            sub = self.range_set.state_dict()
+            scalars["range_set"] = sub["scalars"]
+            scalars["range_builds"] = self._range_builds
+            arrays.update({f"range__{k}": v for k, v in sub["arrays"].items()})
+        return {"scalars": scalars, "arrays": arrays}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        s, a = state["scalars"], state["arrays"]
+        self.count = int(s["count"])
+        self.seconds = float(s["seconds"])
+        self.last_step = int(s["last_step"])
+        self.particles = int(s["particles"])
+        self.mirrors = int(s["mirrors"])
+        self._warned = bool(s["warned"])
+        self.reference = np.array(a["reference"], np.float64).reshape(-1, 3)
+        self.volume = np.array(a["volume"], np.float64)
+        if self.range_set is not None and "range_set" in s:
+            sub = {k[len("range__") :]: v for k, v in a.items() if k.startswith("range__")}
+            self.range_set.load_state_dict({"scalars": s["range_set"], "arrays": sub})
+            self._range_builds = int(s["range_builds"])
+
+
+class TessellationPorosity:
+    """``thermal.porosity: {kind: voronoi}``: ε_i = 1 - (4/3 π R_i³)/V_cell,i from the
+    tessellation of the Voronoi model when the case has one (the same cells, on its update
+    policy), else from a tessellation of its own (``thermal.tessellation``)."""
+
+    def __init__(self, sim: Simulation, settings: Any) -> None:
+        self.sim = sim
+        self.own: VoronoiProvider | None = None
+
+    def update(self, sim: Simulation, fields: np.ndarray) -> None:
+        from thermodem.kernels.fields import F_POROSITY
+
+        shared = getattr(sim.thermal, "voronoi", None)
+        if shared is None or shared.closure:
+            if self.own is None:
+                self.own = VoronoiProvider(sim, sim.case.thermal.tessellation, None)
+            shared = self.own
+        fields[:, F_POROSITY] = shared.porosity()
+
+
+def _register_porosity() -> None:
+    from thermodem.engine.fields import POROSITY_PROVIDERS
+
+    POROSITY_PROVIDERS["voronoi"] = TessellationPorosity
+
+
+_register_porosity()
+
+__all__ = ["Faces", "Plane", "VoronoiProvider", "clipping_planes", "tessellate", "INPUT_WIDTH"]

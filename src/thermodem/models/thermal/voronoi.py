@@ -1,0 +1,508 @@
+"""Voronoi-based conduction through the interstitial fluid (family ``indirect_conduction``,
+``target="external"``): models A and B of Cheng, Yu & Zulli (1999), with the multi-size
+extensions of Gan et al. (2016) (model A) and Chen et al. (2019) (model B) and the flat-wall
+adaptation of the spec ("Voronoi-Based Models").
+
+Kernel signature (float64 scalars, ``p`` the packed row of the type pair, ``inputs`` the
+pair's row of the external pair set)::
+
+    kernel(p, r_i, r_j, dist, r_c, inputs) -> conductance H [W/K] >= 0
+
+``inputs[INPUT_FACE_AREA]`` is A_n [m²], the area of the Voronoi face the two cells share
+(or of the cell's face on the wall), from the tessellation (``engine/voronoi.py``) or from the
+porosity closure of Zhou et al. (2009). The double pyramid on that face is replaced by the
+double tapered cone of the same base area, radius r_ij = √(A_n/π); with the pyramid's volume
+V_ij = A_n d_ij / 3 this is the spec's r_ij = √(3 V_ij/(π d_ij)). ``dist`` is the centre
+distance (a wall: r_j = inf, dist = d_pw the distance from the centre to the wall plane);
+``r_c`` the contact radius where the bodies overlap (the geometric R_c), else 0.
+
+Every kernel returns 0 when the surface gap is at or beyond ``cutoff_gap_ratio`` × R̃ (the
+spec's remark after Zhou et al. 2009: model A conducts negligibly once d_ij >= 3 R_p, i.e. a
+gap of R_p; "a similar cut-off value should be set" for the others; R̃ = (R_i + R_j)/2, or R_i
+at a wall), when the face is smaller than the contact (nothing left to conduct through the
+fluid), and NaN for a NaN input (the engine's NaN flag).
+
+Swapping i and j (radii, inputs, the row columns in ``swap_pairs``) gives the same H bit for
+bit: each kernel orders the two sides canonically (smaller radius first, then smaller k,
+then smaller core) before it evaluates the asymmetric formulas.
+
+Formulas, choices and their checks: ``docs/models/indirect_conduction-voronoi_a.md`` and
+``-voronoi_b.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+from numba import njit
+from pydantic import Field, field_validator
+
+from thermodem.config.base import StrictModel
+from thermodem.models.registry import packed, register
+from thermodem.models.thermal.contact_radius import require
+from thermodem.state.materials import PairContext
+
+FAMILY = "indirect_conduction"
+
+VORONOI_A = 5
+VORONOI_B = 6
+
+#: Columns of a pair's input row in the external pair set.
+INPUT_FACE_AREA = 0
+INPUT_WIDTH = 1
+
+#: Multi-size rules.
+SIZES_GENERAL = 0  # model A: Gan et al. (2016); model B: Chen et al. (2019)
+SIZES_MEAN_RADIUS = 1  # the mono-size formula with R_p = (R_i + R_j)/2 (Norouzi et al. 2016)
+
+# model A row
+A_K_I = 0
+A_K_J = 1
+A_K_F = 2
+A_SIZES = 3
+A_CUTOFF = 4
+A_COLUMNS = ("k_i", "k_j", "k_f", "multi_size", "cutoff_gap_ratio")
+A_SWAP_PAIRS = ((A_K_I, A_K_J),)
+
+# model B row
+B_K_I = 0
+B_K_J = 1
+B_K_F = 2
+B_CORE_I = 3
+B_CORE_J = 4
+B_SIZES = 5
+B_CUTOFF = 6
+B_COLUMNS = ("k_i", "k_j", "k_f", "core_ratio_i", "core_ratio_j", "multi_size",
+             "cutoff_gap_ratio")  # fmt: skip
+B_SWAP_PAIRS = ((B_K_I, B_K_J), (B_CORE_I, B_CORE_J))
+
+#: Gauss-Legendre rule of model A's quadrature on [0, 1], used on each half interval (see
+#: ``model_a_integral``).
+QUAD_NODES = 20
+_x, _w = np.polynomial.legendre.leggauss(QUAD_NODES)
+GL_U = np.ascontiguousarray(0.5 * (_x + 1.0))
+GL_W = np.ascontiguousarray(0.5 * _w)
+del _x, _w
+
+
+# ------------------------------------------------------------------------ parameters
+class _Common(StrictModel):
+    geometry: Literal["tessellation", "porosity"] = Field(
+        default="tessellation",
+        description="where the face area A_n comes from: the Voronoi tessellation "
+        "(thermal.tessellation), or the porosity closure of Zhou et al. (2009), "
+        "A_n = 0.985 R² (1 - ε)^(-2/3), with ε from thermal.porosity",
+    )
+    cutoff_gap_ratio: float = Field(
+        default=1.0,
+        gt=0,
+        description="no conduction once the surface gap is >= this × (R_i + R_j)/2 (a wall: "
+        "× R_i); 1.0: Zhou et al. (2009), d_ij >= 3 R_p",
+    )
+
+
+class VoronoiAParams(_Common):
+    """Voronoi model A, Cheng, Yu & Zulli (1999) Int. J. Heat Mass Transfer 42, 2847-2856:
+    the double tapered cone's surface is isothermal, the region outside it does not conduct
+    and the heat paths are parallel to the line of centres; H is an integral over the path
+    radius r from R_c to r_sf evaluated by a compiled quadrature.
+
+    Mono-size (R_i = R_j = R_p)::
+
+        H = ∫ 2πr dr / [ (√(R_p² - r²) - d r/(2 r_ij))/k + (d - 2√(R_p² - r²))/k_f ]
+        r_sf = R_p r_ij / √(r_ij² + (d/2)²),    k = k̄ = (1/k_i + 1/k_j)^-1
+
+    Multi-size: ``gan2016`` (Gan et al. 2016), the integral with β_i, D_i, r_ij, r'_ij of the
+    spec, or ``mean_radius`` (Norouzi et al. 2016), the mono formula with R_p = (R_i + R_j)/2
+    (from the larger of R_c and the radius where the two mean spheres part).
+    A flat wall: d_p = √(R_p² - r²) - d_pw r/r_ij in the particle (k_p = k_i), d_f = d_pw -
+    √(R_p² - r²) in the fluid, r_sf = R_p r_ij/√(r_ij² + d_pw²); conduction in the wall is
+    neglected. Row: [k_i, k_j, k_f, multi_size, cutoff_gap_ratio].
+    """
+
+    multi_size: Literal["gan2016", "mean_radius"] = Field(
+        default="gan2016",
+        description="unequal radii: gan2016 (Gan et al. 2016) or mean_radius (Norouzi et al. "
+        "2016: the mono-size formula with R_p = (R_i + R_j)/2)",
+    )
+
+
+#: Isothermal core ratio r_c/R_p of Chen et al. (2019) by k_p/k_f: 0.6 for 1 < k_p/k_f <= 5,
+#: 0.5 above (their range ends at 10^4; above it the core hardly matters and 0.5 is kept).
+def chen2019_core_ratio(k_ratio: float) -> float:
+    return 0.6 if k_ratio <= 5.0 else 0.5
+
+
+class VoronoiBParams(_Common):
+    """Voronoi model B, Cheng, Yu & Zulli (1999): each particle has an isothermal core of
+    radius r_c at its temperature and the heat paths radiate from the centres (closed form).
+
+    Mono-size (Cheng et al. 1999)::
+
+        H = (π/b) ln[(a - b cos θ_0)/(a - b cos θ_c)]
+        a = (1/(2k̄)) (1/r_c - 1/R_p) + 1/(k_f R_p),  b = 2/(k_f d),  k̄ = (1/k_i + 1/k_j)^-1
+        cos θ_0 = d / (2√(r_ij² + (d/2)²)),  cos θ_c = d / (2√(R_c² + (d/2)²))
+
+    Multi-size: ``chen2019`` (Chen et al. 2019, Powder Technol. 353, the Λ, Δγ, A, B, δ, X, Y
+    formulas of the spec, which reduce to the mono form for equal radii) or ``mean_radius``
+    (the mono form with R_p = (R_i + R_j)/2). A flat wall: a = (1/(2k_p))(1/r_c - 1/R_p) +
+    1/(2 k_f R_p), b = 1/(2 k_f d_pw), cos θ_0 = d_pw/√(r_ij² + d_pw²). Not valid for
+    k_p/k_f < 1 (no isothermal core; refused). Row: [k_i, k_j, k_f, r_c,i/R_i, r_c,j/R_j,
+    multi_size, cutoff_gap_ratio].
+    """
+
+    core_radius_ratio: float | Literal["chen2019"] = Field(
+        default="chen2019",
+        description="isothermal core r_c/R_p (0 < . < 1), or chen2019: 0.6 for 1 < k_p/k_f <= "
+        "5, 0.5 above (Chen et al. 2019; 0.5: Cheng et al. 1999 for mono-size)",
+    )
+    multi_size: Literal["chen2019", "mean_radius"] = Field(
+        default="chen2019",
+        description="unequal radii: chen2019 (Chen et al. 2019) or mean_radius (the mono-size "
+        "formula with R_p = (R_i + R_j)/2)",
+    )
+
+    @field_validator("core_radius_ratio")
+    @classmethod
+    def _ratio(cls, v: float | str) -> float | str:
+        if not isinstance(v, str) and not (0.0 < v < 1.0):
+            raise ValueError(f"core_radius_ratio must be in (0, 1) or 'chen2019', got {v!r}")
+        return v
+
+
+def _conductivities(pair: PairContext, model: str) -> tuple[float, float, float]:
+    k_i = require(pair.mat_i, "thermal_conductivity", model)
+    # a wall: conduction in the wall is not considered (the spec's flat-wall adaptation)
+    k_j = k_i if pair.is_wall else require(pair.mat_j, "thermal_conductivity", model)
+    return k_i, k_j, float(pair.gas.thermal_conductivity)
+
+
+def pack_voronoi_a(params: VoronoiAParams, pair: PairContext) -> np.ndarray:
+    k_i, k_j, k_f = _conductivities(pair, f"{FAMILY}.voronoi_a")
+    sizes = SIZES_GENERAL if params.multi_size == "gan2016" else SIZES_MEAN_RADIUS
+    values = {"k_i": k_i, "k_j": k_j, "k_f": k_f, "multi_size": sizes,
+              "cutoff_gap_ratio": params.cutoff_gap_ratio}  # fmt: skip
+    return packed(A_COLUMNS, values)
+
+
+def pack_voronoi_b(params: VoronoiBParams, pair: PairContext) -> np.ndarray:
+    model = f"{FAMILY}.voronoi_b"
+    k_i, k_j, k_f = _conductivities(pair, model)
+    cores = []
+    for side, k in (("i", k_i), ("j", k_j)):
+        if not k / k_f > 1.0:
+            raise ValueError(
+                f"{model} is not valid for k_p/k_f <= 1 (no isothermal core, Chen et al. 2019): "
+                f"the material of side {side} has k_p = {k:g} W/(m K), "
+                f"thermal.gas.thermal_conductivity "
+                f"= {k_f:g} W/(m K), k_p/k_f = {k / k_f:.4g}; use voronoi_a"
+            )
+        ratio = params.core_radius_ratio
+        cores.append(chen2019_core_ratio(k / k_f) if isinstance(ratio, str) else float(ratio))
+    if pair.is_wall:
+        cores[1] = cores[0]
+    sizes = SIZES_GENERAL if params.multi_size == "chen2019" else SIZES_MEAN_RADIUS
+    values = {"k_i": k_i, "k_j": k_j, "k_f": k_f, "core_ratio_i": cores[0],
+              "core_ratio_j": cores[1], "multi_size": sizes,
+              "cutoff_gap_ratio": params.cutoff_gap_ratio}  # fmt: skip
+    return packed(B_COLUMNS, values)
+
+
+def voronoi_range(params: _Common, radius_i: float, radius_j: float) -> float:
+    """Largest surface gap [m] at which H > 0: cutoff × (R_i + R_j)/2 (a wall: × R_i)."""
+    scale = radius_i if math.isinf(radius_j) else 0.5 * (radius_i + radius_j)
+    return params.cutoff_gap_ratio * scale
+
+
+# ------------------------------------------------------------------------- model A
+@njit(cache=True, inline="always", error_model="numpy")
+def _path_denominator(r, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall):
+    """Σ (path length / conductivity) of the path at radius r (model A): in the smaller
+    particle, in the larger one (absent at a wall) and in the fluid."""
+    beta_s = math.sqrt(max(r_s * r_s - r * r, 0.0))
+    den = (beta_s - d_s * r / c_s) * ik_s
+    if wall:
+        return den + (dist - beta_s) * ik_f
+    beta_l = math.sqrt(max(r_l * r_l - r * r, 0.0))
+    return den + (beta_l - d_l * r / c_l) * ik_l + (dist - beta_s - beta_l) * ik_f
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _path_slope(r, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, ik_f, wall):
+    """d/dr of ``_path_denominator``."""
+    beta_s = math.sqrt(max(r_s * r_s - r * r, 0.0))
+    slope = (-r / beta_s - d_s / c_s) * ik_s + r / beta_s * ik_f
+    if wall:
+        return slope
+    beta_l = math.sqrt(max(r_l * r_l - r * r, 0.0))
+    return slope + (-r / beta_l - d_l / c_l) * ik_l + r / beta_l * ik_f
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _graded_half(phi_end, direction, lam, half, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l,
+                 dist, ik_f, wall):  # fmt: skip
+    """∫ over the half interval [phi_end, phi_end + direction × half] of 2πr dr/Σ(path/k),
+    with the nodes graded geometrically away from phi_end on the scale ``lam``."""
+    lam = max(min(lam, half), 1e-14 * half)
+    alpha = math.log1p(half / lam)
+    total = 0.0
+    for q in range(GL_U.shape[0]):
+        e = math.expm1(alpha * GL_U[q])
+        phi = phi_end + direction * lam * e
+        r = r_s * math.sin(phi)
+        jac = alpha * lam * (e + 1.0) * r_s * math.cos(phi)  # |dr/du|
+        den = _path_denominator(r, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall)
+        total += GL_W[q] * r / den * jac
+    return total
+
+
+@njit(cache=True, error_model="numpy")
+def model_a_integral(r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall, r_lo, r_hi):
+    """∫_{r_lo}^{r_hi} 2πr dr / Σ(path/k) of model A (``_path_denominator``; ``r_s`` is the
+    smaller radius, ``ik_*`` reciprocal conductivities).
+
+    The integrand is smooth in φ with r = R_s sin φ (β_s = R_s cos φ has no square-root end
+    point even when r_hi is close to R_s), but it can vary on scales much smaller than the
+    interval at either end: at r_lo where the fluid gap d - β_s - β_l is small (its
+    resistance grows from ~0 to that of the solid path over a length λ_lo, estimated from the
+    gap's Taylor expansion: gap'·s + gap''·s²/2 = k_f × the path resistance at r_lo), and at
+    r_hi when k_p ~ k_f (the resistance falls towards the small fluid path at r_sf, like a
+    pole at λ_hi = Σ/|dΣ/dr| beyond the end). Each half of the φ interval is integrated by
+    Gauss-Legendre with its nodes graded geometrically from its end on that scale,
+    φ - φ_end = λ (exp(α u) - 1), α = ln(1 + (Φ/2)/λ), u in [0, 1].
+    Checked against scipy.integrate.quad to 1e-8 (tests/unit/test_voronoi_models.py).
+    """
+    if not r_hi > r_lo:
+        return 0.0
+    phi_lo = math.asin(min(r_lo / r_s, 1.0))
+    phi_hi = math.asin(min(r_hi / r_s, 1.0))
+    half = 0.5 * (phi_hi - phi_lo)
+    # the lower end: the scale of the fluid gap's growth
+    beta_s = math.sqrt(max(r_s * r_s - r_lo * r_lo, 0.0))
+    c1 = r_lo / beta_s
+    c2 = 0.5 * (1.0 / beta_s + r_lo * r_lo / (beta_s * beta_s * beta_s))
+    if not wall:
+        beta_l = math.sqrt(max(r_l * r_l - r_lo * r_lo, 0.0))
+        c1 += r_lo / beta_l
+        c2 += 0.5 * (1.0 / beta_l + r_lo * r_lo / (beta_l * beta_l * beta_l))
+    delta = (
+        _path_denominator(r_lo, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall) / ik_f
+    )
+    scale = 2.0 * delta / (c1 + math.sqrt(c1 * c1 + 4.0 * c2 * delta))
+    lam_lo = scale / beta_s
+    # the upper end: distance to the pole of 1/Σ when Σ falls towards r_hi
+    den_hi = _path_denominator(r_hi, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall)
+    slope_hi = _path_slope(r_hi, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, ik_f, wall)
+    lam_hi = half
+    if slope_hi < 0.0:
+        lam_hi = den_hi / (-slope_hi) / (r_s * math.cos(phi_hi))
+    total = _graded_half(
+        phi_lo, 1.0, lam_lo, half, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall
+    )
+    total += _graded_half(
+        phi_hi, -1.0, lam_hi, half, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall
+    )
+    return 2.0 * math.pi * total
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _gap_beyond_cutoff(r_i, r_j, dist, ratio):
+    if math.isinf(r_j):
+        return dist - r_i >= ratio * r_i
+    return dist - (r_i + r_j) >= ratio * 0.5 * (r_i + r_j)
+
+
+@njit(cache=True, error_model="numpy")
+def voronoi_a_conductance(p, r_i, r_j, dist, r_c, inputs):
+    """H of Voronoi model A (see VoronoiAParams) for a pair or a flat wall (r_j = inf)."""
+    area = inputs[INPUT_FACE_AREA]
+    if math.isnan(area) or math.isnan(dist):
+        return np.nan
+    if not area > 0.0 or _gap_beyond_cutoff(r_i, r_j, dist, p[A_CUTOFF]):
+        return 0.0
+    r_ij = math.sqrt(area / math.pi)
+    ik_f = 1.0 / p[A_K_F]
+    if math.isinf(r_j):  # a flat wall: one particle, d_pw = dist
+        r_sf = r_i * r_ij / math.sqrt(r_ij * r_ij + dist * dist)
+        return model_a_integral(r_i, dist, r_ij, 1.0 / p[A_K_I], 0.0, 0.0, 1.0, 0.0, dist,
+                                ik_f, True, r_c, r_sf)  # fmt: skip
+    k_i = p[A_K_I]
+    k_j = p[A_K_J]
+    if p[A_SIZES] == SIZES_MEAN_RADIUS or r_i == r_j:
+        # mono-size: k = k̄ = (1/k_i + 1/k_j)^-1, both halves of the path alike
+        r_p = 0.5 * (r_i + r_j)
+        half = 0.5 * dist
+        r_sf = r_p * r_ij / math.sqrt(r_ij * r_ij + half * half)
+        ik = (k_i + k_j) / (k_i * k_j)
+        # the paths start where the two mean spheres part (no negative fluid path)
+        r_lo = max(r_c, math.sqrt(max(r_p * r_p - half * half, 0.0)))
+        return model_a_integral(r_p, half, r_ij, 0.5 * ik, r_p, half, r_ij, 0.5 * ik, dist,
+                                ik_f, False, r_lo, r_sf)  # fmt: skip
+    # Gan et al. (2016), written for R_i <= R_j: s is the smaller particle, l the larger
+    if r_i < r_j:
+        r_s, r_l, k_s, k_l = r_i, r_j, k_i, k_j
+    else:
+        r_s, r_l, k_s, k_l = r_j, r_i, k_j, k_i
+    if r_c > 0.0:
+        d_s = math.sqrt(max(r_s * r_s - r_c * r_c, 0.0))
+    else:
+        d_s = (r_s * r_s - r_l * r_l + dist * dist) / (2.0 * dist)
+    d_l = dist - d_s
+    r_sf = r_s * r_ij / math.sqrt(r_ij * r_ij + d_s * d_s)
+    c_l = d_l * r_sf / math.sqrt(max(r_l * r_l - r_sf * r_sf, 0.0))
+    return model_a_integral(r_s, d_s, r_ij, 1.0 / k_s, r_l, d_l, c_l, 1.0 / k_l, dist, ik_f,
+                            False, r_c, r_sf)  # fmt: skip
+
+
+# ------------------------------------------------------------------------- model B
+@njit(cache=True, inline="always", error_model="numpy")
+def cheng_b(a, b, cos_0, cos_c):
+    """(π/b) ln[(a - b cos θ_0)/(a - b cos θ_c)] of model B (log1p form)."""
+    return math.pi / b * math.log1p(b * (cos_c - cos_0) / (a - b * cos_c))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _quadratic_integral(u1, u2, lam):
+    """∫_{u1}^{u2} du/(u² - Λ), in a form without cancellation near Λ = 0:
+    (u2 - u1)/(u1 u2 - Λ) × f(ζ²), ζ² = Λ (u2 - u1)²/(u1 u2 - Λ)², f = artanh(ζ)/ζ for
+    ζ² > 0, atan(|ζ|)/|ζ| for ζ² < 0, 1 + ζ²/3 + ζ⁴/5 + ... near 0."""
+    den = u1 * u2 - lam
+    ratio = (u2 - u1) / den
+    z2 = lam * ratio * ratio
+    if abs(z2) < 1e-4:
+        f = 1.0 + z2 * (1.0 / 3.0 + z2 * (0.2 + z2 * (1.0 / 7.0 + z2 / 9.0)))
+    elif z2 > 0.0:
+        z = math.sqrt(z2)
+        f = math.atanh(z) / z
+    else:
+        z = math.sqrt(-z2)
+        f = math.atan(z) / z
+    return ratio * f
+
+
+@njit(cache=True, error_model="numpy")
+def chen_b(k_i, k_j, k_f, core_i, core_j, r_i, r_j, dist, r_c, area):
+    """H of Chen et al. (2019)'s multi-size model B (i, j as given; see voronoi_b_conductance
+    for the canonical order). Their closed forms for Λ > 0, Λ = 0, Λ < 0 are one integral,
+    π k_f d (1 - Δγ²) ∫ dδ/P(δ) with P = (A + B) δ² + 2 (B Δγ - 1) δ + Δγ (B Δγ - 1)
+    = (u² - Λ)/(A + B), u = (A + B) δ + B Δγ - 1 = √|Λ| X, evaluated by _quadratic_integral."""
+    g_i = r_i / dist
+    g_j = r_j / dist
+    dg = g_j - g_i
+    big_a = (k_i + k_f * (1.0 / core_i - 1.0)) / (k_i * g_i)
+    big_b = (k_j + k_f * (1.0 / core_j - 1.0)) / (k_j * g_j)
+    lam = (1.0 + dg * big_a) * (1.0 - dg * big_b)
+    one = 1.0 - dg * dg
+    d_max = 0.5 * (math.sqrt(1.0 + 4.0 * area / (math.pi * dist * dist * one)) - dg)
+    d_min = 0.5 * (math.sqrt(1.0 + 4.0 * r_c * r_c / (dist * dist * one)) - dg)
+    if not d_max > d_min:
+        return 0.0
+    u_min = (big_a + big_b) * d_min + dg * big_b - 1.0
+    u_max = (big_a + big_b) * d_max + dg * big_b - 1.0
+    return math.pi * k_f * dist * one * _quadratic_integral(u_min, u_max, lam)
+
+
+@njit(cache=True, error_model="numpy")
+def voronoi_b_conductance(p, r_i, r_j, dist, r_c, inputs):
+    """H of Voronoi model B (see VoronoiBParams) for a pair or a flat wall (r_j = inf)."""
+    area = inputs[INPUT_FACE_AREA]
+    if math.isnan(area) or math.isnan(dist):
+        return np.nan
+    if not area > 0.0 or _gap_beyond_cutoff(r_i, r_j, dist, p[B_CUTOFF]):
+        return 0.0
+    k_f = p[B_K_F]
+    r_ij2 = area / math.pi
+    if r_ij2 <= r_c * r_c:
+        return 0.0
+    if math.isinf(r_j):  # a flat wall at d_pw = dist
+        k_p = p[B_K_I]
+        core = p[B_CORE_I] * r_i
+        a = 0.5 / k_p * (1.0 / core - 1.0 / r_i) + 0.5 / (k_f * r_i)
+        b = 0.5 / (k_f * dist)
+        cos_0 = dist / math.sqrt(r_ij2 + dist * dist)
+        cos_c = dist / math.sqrt(r_c * r_c + dist * dist)
+        return cheng_b(a, b, cos_0, cos_c)
+    k_i = p[B_K_I]
+    k_j = p[B_K_J]
+    c_i = p[B_CORE_I]
+    c_j = p[B_CORE_J]
+    if p[B_SIZES] == SIZES_MEAN_RADIUS:
+        r_p = 0.5 * (r_i + r_j)
+        # 1/(2k̄)(1/r_c - 1/R_p) with each side's own core and conductivity
+        a = 0.5 * ((1.0 / (c_i * r_p) - 1.0 / r_p) / k_i + (1.0 / (c_j * r_p) - 1.0 / r_p) / k_j)
+        a += 1.0 / (k_f * r_p)
+        b = 2.0 / (k_f * dist)
+        half2 = 0.25 * dist * dist
+        cos_0 = 0.5 * dist / math.sqrt(r_ij2 + half2)
+        cos_c = 0.5 * dist / math.sqrt(r_c * r_c + half2)
+        return cheng_b(a, b, cos_0, cos_c)
+    # canonical order: smaller radius first, then smaller k, then smaller core
+    if (r_i, k_i, c_i) <= (r_j, k_j, c_j):
+        return chen_b(k_i, k_j, k_f, c_i, c_j, r_i, r_j, dist, r_c, area)
+    return chen_b(k_j, k_i, k_f, c_j, c_i, r_j, r_i, dist, r_c, area)
+
+
+# ---------------------------------------------------------------------- dispatcher
+@njit(cache=True, inline="always", error_model="numpy")
+def voronoi_dispatch(model_id, p, r_i, r_j, dist, r_c, inputs):
+    """Conductance H [W/K] of the Voronoi model ``model_id`` (NaN for any other id)."""
+    if model_id == VORONOI_A:
+        return voronoi_a_conductance(p, r_i, r_j, dist, r_c, inputs)
+    elif model_id == VORONOI_B:
+        return voronoi_b_conductance(p, r_i, r_j, dist, r_c, inputs)
+    return np.nan
+
+
+# -------------------------------------------------------------- the porosity closure
+@njit(cache=True, inline="always", error_model="numpy")
+def closure_face_area(radius, porosity):
+    """A_n = 0.985 R² (1 - ε)^(-2/3) of Zhou et al. (2009) after Yang et al. (2002):
+    r_ij = √(A_n/π) = 0.560 R (1 - ε)^(-1/3)."""
+    return 0.985 * radius * radius * (1.0 - porosity) ** (-2.0 / 3.0)
+
+
+# -------------------------------------------------------------------- registration
+_CHENG = "Cheng, Yu & Zulli (1999) Int. J. Heat Mass Transfer 42, 2847-2856"
+_ZHOU = "Zhou, Yu & Zulli (2009) AIChE J. 55, 868-884 (cut-off, porosity closure)"
+
+register(
+    family=FAMILY,
+    name="voronoi_a",
+    model_id=VORONOI_A,
+    kernel=voronoi_a_conductance,
+    params=VoronoiAParams,
+    pack=pack_voronoi_a,
+    summary="Voronoi model A: fluid conduction in the double cone of the shared Voronoi face "
+    "(quadrature)",
+    reference=f"{_CHENG}; Gan et al. (2016) (multi-size); Norouzi et al. (2016) (mean radius); "
+    f"{_ZHOU}",
+    requires=("thermal_conductivity",),
+    uses_gas=("thermal_conductivity",),
+    interaction_range=voronoi_range,
+    antisymmetric=False,
+    symmetric=True,
+    columns=A_COLUMNS,
+    swap_pairs=A_SWAP_PAIRS,
+    target="external",
+)
+register(
+    family=FAMILY,
+    name="voronoi_b",
+    model_id=VORONOI_B,
+    kernel=voronoi_b_conductance,
+    params=VoronoiBParams,
+    pack=pack_voronoi_b,
+    summary="Voronoi model B: isothermal cores, radial heat paths to the shared Voronoi face "
+    "(closed form)",
+    reference=f"{_CHENG}; Chen et al. (2019) (multi-size); {_ZHOU}",
+    requires=("thermal_conductivity",),
+    uses_gas=("thermal_conductivity",),
+    interaction_range=voronoi_range,
+    antisymmetric=False,
+    symmetric=True,
+    columns=B_COLUMNS,
+    swap_pairs=B_SWAP_PAIRS,
+    target="external",
+)

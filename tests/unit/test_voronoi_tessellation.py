@@ -1,0 +1,115 @@
+"""The tessellation (engine/voronoi.py) on geometries whose cells are known exactly: simple
+cubic (cubes of side 2R, faces (2R)²), FCC (rhombic dodecahedra, faces √2 R²), BCC (truncated
+octahedra, hexagons 3√3 a²/16 and squares a²/8), periodic and clipped by walls (mirror
+particles), and the radical plane of two unequal spheres."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from thermodem.engine.voronoi import Plane, tessellate
+
+R = 1e-3
+
+
+def box_planes(lower: np.ndarray, upper: np.ndarray, axes=(0, 1, 2)) -> list[Plane]:  # noqa: ANN001
+    planes = []
+    for a in axes:
+        for side, value in ((1.0, lower[a]), (-1.0, upper[a])):
+            point, normal = np.zeros(3), np.zeros(3)
+            point[a], normal[a] = value, side
+            planes.append(Plane(point, normal, (), f"face {a} {side}"))
+    return planes
+
+
+def lattice(kind: str, cells: int) -> tuple[np.ndarray, float]:
+    """Touching spheres of radius R on a lattice; (positions, cubic lattice constant)."""
+    if kind == "sc":
+        a, basis = 2 * R, [[0, 0, 0]]
+    elif kind == "fcc":
+        a, basis = 2 * math.sqrt(2) * R, [[0, 0, 0], [0, 0.5, 0.5], [0.5, 0, 0.5], [0.5, 0.5, 0]]
+    else:
+        a, basis = 4 * R / math.sqrt(3), [[0, 0, 0], [0.5, 0.5, 0.5]]
+    g = np.arange(cells)
+    corners = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
+    pos = (corners[:, None, :] + np.array(basis)[None]).reshape(-1, 3) * a + 0.25 * a
+    return pos, a
+
+
+@pytest.mark.parametrize("method", ["plain", "radical"])
+@pytest.mark.parametrize("kind", ["sc", "fcc", "bcc"])
+def test_periodic_lattice_cells_and_faces(kind: str, method: str) -> None:
+    pos, a = lattice(kind, 3)
+    upper = np.full(3, 3 * a)
+    f = tessellate(pos, np.full(len(pos), R), np.zeros(3), upper, np.ones(3, bool), [], method)
+    n = len(pos)
+    volume = {"sc": 8 * R**3, "fcc": a**3 / 4, "bcc": a**3 / 2}[kind]
+    assert f.volume == pytest.approx(np.full(n, volume), rel=1e-6)
+    faces = np.sort(f.pair_area)
+    if kind == "sc":
+        assert f.pair_i.size == 3 * n and faces == pytest.approx(np.full(3 * n, 4 * R**2), rel=1e-6)
+    elif kind == "fcc":
+        assert f.pair_i.size == 6 * n
+        assert faces == pytest.approx(np.full(6 * n, math.sqrt(2) * R**2), rel=1e-6)
+    else:
+        assert f.pair_i.size == 7 * n  # 8 hexagons and 6 squares per cell
+        want = np.sort([3 * math.sqrt(3) * a**2 / 16] * 4 * n + [a**2 / 8] * 3 * n)
+        assert faces == pytest.approx(want, rel=1e-6)
+    assert f.wall_area.size == 0
+
+
+@pytest.mark.parametrize("method", ["plain", "radical"])
+def test_simple_cubic_in_a_closed_box_is_cubes_with_faces_on_the_walls(method: str) -> None:
+    pos, a = lattice("sc", 4)
+    pos += 0.5 * a - 0.25 * a  # centres at R, 3R, ...: the walls touch the outer spheres
+    upper = np.full(3, 4 * a)
+    planes = box_planes(np.zeros(3), upper)
+    f = tessellate(pos, np.full(len(pos), R), np.zeros(3), upper, np.zeros(3, bool), planes,
+                   method)  # fmt: skip
+    n = len(pos)
+    assert f.volume == pytest.approx(np.full(n, 8 * R**3), rel=1e-6)
+    assert f.pair_i.size == 3 * 4 * 4 * 3
+    assert f.pair_area == pytest.approx(np.full(f.pair_i.size, 4 * R**2), rel=1e-6)
+    # every outer cell face lies on a wall: 6 × 16 faces of (2R)²
+    assert f.wall_area.size == 96
+    assert f.wall_area == pytest.approx(np.full(96, 4 * R**2), rel=1e-6)
+    for q in range(6):  # each wall sees the 16 particles of its side
+        sel = f.wall_particle[f.wall_index == q]
+        a_ = q // 2
+        want = pos[:, a_] < a if q % 2 == 0 else pos[:, a_] > 3 * a
+        assert set(sel.tolist()) == set(np.nonzero(want)[0].tolist())
+
+
+@pytest.mark.parametrize("method", ["plain", "radical"])
+def test_two_spheres_in_a_box_meet_at_the_bisector_or_the_radical_plane(method: str) -> None:
+    side = 4 * R
+    upper = np.array([2 * side, side, side])
+    r = np.array([0.8 * R, 1.6 * R])
+    pos = np.array([[0.7 * side, 0.5 * side, 0.5 * side], [1.35 * side, 0.5 * side, 0.5 * side]])
+    planes = box_planes(np.zeros(3), upper)
+    f = tessellate(pos, r, np.zeros(3), upper, np.zeros(3, bool), planes, method)
+    d = pos[1, 0] - pos[0, 0]
+    # the face: the bisector (plain) or the power plane (|x - c_i|² - R_i² equal on both sides)
+    x = 0.5 * d if method == "plain" else (d * d + r[0] ** 2 - r[1] ** 2) / (2 * d)
+    plane = pos[0, 0] + x
+    assert f.volume == pytest.approx([plane * side**2, (2 * side - plane) * side**2], rel=1e-6)
+    assert f.pair_area == pytest.approx([side**2], rel=1e-6)
+    assert f.wall_area.size == 10  # five walls per cell (the sixth face is the shared one)
+
+
+def test_a_particle_outside_a_plane_is_a_clear_error() -> None:
+    pos = np.array([[1e-3, 1e-3, 1e-3], [3e-3, 1e-3, -1e-4]])
+    planes = box_planes(np.zeros(3), np.full(3, 4e-3))
+    with pytest.raises(ValueError, match="particle index 1.*domain|not on the particles' side"):
+        tessellate(pos, np.full(2, R), np.zeros(3), np.full(3, 4e-3), np.zeros(3, bool), planes,
+                   "plain")  # fmt: skip
+
+
+def test_a_periodic_box_of_two_cells_is_refused() -> None:
+    pos, a = lattice("sc", 2)
+    with pytest.raises(ValueError, match="share more than one face"):
+        tessellate(pos, np.full(len(pos), R), np.zeros(3), np.full(3, 2 * a), np.ones(3, bool),
+                   [], "plain")  # fmt: skip
