@@ -189,7 +189,7 @@ def bob_separated_factor(kpf, lam, r_cyl_ratio, gap_ratio, regime):
     return min(near, far)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def bob_separated_conductance(p, r_i, r_j, dist, r_c, f_n):
     """H = 2π R̄ k_f X(λ) for 0 < d_s < cutoff R̄, else 0 (see the params' docstring)."""
     r_eff = effective_radius(r_i, r_j)

@@ -108,7 +108,7 @@ def gas_parameter(alpha_i: float, alpha_j: float, gas: GasProperties) -> float:
     return accommodation * zeta / (zeta + 1.0) * gas.mean_free_path_value() / gas.prandtl()
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def vargas_mccarthy2002_conductance(p, r_i, r_j, dist, r_c, f_n):
     """H = k_l A_l/l_l + k_g A_g/(l_g + M) of touching pairs (see the module docstring)."""
     if math.isinf(r_j):
