@@ -60,6 +60,8 @@ if TYPE_CHECKING:
 GAS_CONSTANT = 8.314462618
 #: Prefix of the neighbourhood set's arrays in the engine's checkpoint.
 STATE_PREFIX = "fields__"
+#: The correlation validity ranges are checked at every this many-th field update.
+RANGE_CHECK_INTERVAL = 10
 
 
 class PorosityProvider(Protocol):
@@ -212,6 +214,7 @@ class FieldProvider:
             if self.beta_mode == 0:
                 self.ranges = [r for r in self.ranges if r[0] != "Ra"]
         self.warned: list[str] = []
+        self.updates = 0  # field updates so far (the range checks run on every 10th)
         self.numbers_buffer = np.zeros((0, len(conv.NUMBER_NAMES)))
         self.velocity_buffer = np.zeros((1, 3))
         self.part = np.zeros(1)
@@ -331,7 +334,12 @@ class FieldProvider:
                          float(self.walls.wall_range), float(self.walls.wall_view_factor),
                          fields)  # fmt: skip
         if self.ranges and len(self.warned) < len(self.ranges):
-            self._check_ranges(time, fields)
+            # Re, Pr, ε against the correlation's ranges: at the first update and every
+            # RANGE_CHECK_INTERVAL-th one after it (a full pass of its own; an excursion
+            # shorter than that between two checks goes unreported)
+            if self.updates % RANGE_CHECK_INTERVAL == 0:
+                self._check_ranges(time, fields)
+        self.updates += 1
 
     def _chunks(self) -> int:
         return self.sim.particles.count // fk.CHUNK + 1
@@ -456,8 +464,7 @@ class FieldProvider:
                 sim.periodic, self.weights)  # fmt: skip
         if self.radiation_ratio > 0.0:
             fk.neighbour_weights(p.radius, p.temperature, p.type_id, self.emissivity,
-                                 self.weights)  # fmt: skip
-            fk.zero_rows(self.sums)
+                                 self.weights, self.sums)  # fmt: skip
             fk.neighbourhood_pass(*args, self.radiation_mode, self.radiation_ratio, 0.0,
                                   self.sums)  # fmt: skip
             fk.neighbour_columns(self.sums, fields)

@@ -359,8 +359,11 @@ NB_SHELL = 4  # the neighbours' volume in the shell (shell porosity)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def neighbour_weights(radius, temperature, type_id, emissivity, weights):
-    """Per particle: weights[i] = (ε_i A_i / 2, ε_i A_i T_i⁴ / 2, T_i, 0), read by the pairs."""
+def neighbour_weights(radius, temperature, type_id, emissivity, weights, sums):
+    """Per particle: weights[i] = (ε_i A_i / 2, ε_i A_i T_i⁴ / 2, T_i, 0), read by the pairs,
+    and sums[i] = 0 (:func:`neighbourhood_pass` adds to it; a compact (n, 4) array: written
+    at random rows it is faster than the wide fields array: median 5-9 against 17-19 ns per
+    pair on the 50k bed, busy machine)."""
     n = radius.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
@@ -370,6 +373,8 @@ def neighbour_weights(radius, temperature, type_id, emissivity, weights):
             weights[i, 1] = w * (t * t) * (t * t)
             weights[i, 2] = t
             weights[i, 3] = 0.0
+            for q in range(4):
+                sums[i, q] = 0.0
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -403,20 +408,21 @@ def neighbourhood_pass(
                     sums[i, 0] += lens_volume(shell_ratio * ri, rj, d)
                     sums[j, 0] += lens_volume(shell_ratio * rj, ri, d)
                     continue
-                if d2 < q2 * ri * ri:
-                    if zhou:
-                        sums[i, 0] += 1.0
-                        sums[i, 1] += weights[j, 2]
-                    if krause:
-                        sums[i, 2] += weights[j, 1]
-                        sums[i, 3] += weights[j, 0]
-                if d2 < q2 * rj * rj:
-                    if zhou:
-                        sums[j, 0] += 1.0
-                        sums[j, 1] += weights[i, 2]
-                    if krause:
-                        sums[j, 2] += weights[i, 1]
-                        sums[j, 3] += weights[i, 0]
+                # 0/1 weights instead of branches: whether a centre lies inside the other's
+                # sphere is random along the list (mispredicted branches cost ~1/3 of the
+                # pass); adding 0 leaves a sum unchanged, so the sums are the same
+                m_i = 1.0 if d2 < q2 * ri * ri else 0.0
+                m_j = 1.0 if d2 < q2 * rj * rj else 0.0
+                if zhou:
+                    sums[i, 0] += m_i
+                    sums[i, 1] += m_i * weights[j, 2]
+                    sums[j, 0] += m_j
+                    sums[j, 1] += m_j * weights[i, 2]
+                if krause:
+                    sums[i, 2] += m_i * weights[j, 1]
+                    sums[i, 3] += m_i * weights[j, 0]
+                    sums[j, 2] += m_j * weights[i, 1]
+                    sums[j, 3] += m_j * weights[i, 0]
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
