@@ -172,7 +172,7 @@ def _exchange(coefficient, t_i, te4, environment, fields, i):
     return q, 4.0 * coefficient * t2 * t_i * (env + view)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def surroundings_radiation(p, t_i, r_i, fields, i):
     """(Q, G) = (φ ε A σ (T_e⁴ − T⁴), 4 φ ε A σ T³), A = 4π R² (and the walls in view)."""
     coefficient = p[SR_EMISSIVITY] * 4.0 * math.pi * r_i * r_i * STEFAN_BOLTZMANN
@@ -237,7 +237,7 @@ def pack_krause(params: Krause2017Params, pair: PairContext) -> np.ndarray:
     return packed(KRAUSE_COLUMNS, values)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def zhou2009_radiation(p, t_i, r_i, fields, i):
     """T_e = ε T_f + (1 − ε) mean T_j (T_f without neighbours); (Q, G) as surroundings."""
     coefficient = p[SR_EMISSIVITY] * 4.0 * math.pi * r_i * r_i * STEFAN_BOLTZMANN
@@ -251,7 +251,7 @@ def zhou2009_radiation(p, t_i, r_i, fields, i):
     return _exchange(coefficient, t_i, te2 * te2, 1.0, fields, i)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def krause2017_radiation(p, t_i, r_i, fields, i):
     """T_e⁴ = Σ ε_j A_j T_j⁴ / Σ ε_j A_j over the sphere; (Q, G) as surroundings."""
     coefficient = p[SR_EMISSIVITY] * 4.0 * math.pi * r_i * r_i * STEFAN_BOLTZMANN
