@@ -18,14 +18,14 @@ restitution to a damping coefficient depends on the elastic law, so each law own
 
 from __future__ import annotations
 
+import json
 import math
+import os
 from functools import lru_cache
 
 import numpy as np
 from numba import njit
 from pydantic import Field
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from thermodem.config.base import StrictModel
 from thermodem.models.registry import pad_row, register
@@ -54,6 +54,7 @@ class HertzParams(StrictModel):
 @lru_cache(maxsize=256)
 def hertz_restitution_of_alpha(alpha: float) -> float:
     """Restitution of the dimensionless Hertz–Tsuji contact for damping factor α."""
+    from scipy.integrate import solve_ivp  # (imported when needed: ~0.3 s)
 
     def rhs(_t: float, y: np.ndarray) -> list[float]:
         x = max(y[0], 0.0)
@@ -72,9 +73,41 @@ def hertz_restitution_of_alpha(alpha: float) -> float:
     return float(-sol.y_events[0][0][1])
 
 
+#: α(e) found by earlier processes, in ``hertz_alpha.json`` of the cache root: the root
+#: finding integrates the contact equation ~14 times in Python (~1 s at every run start); the
+#: stored value is the one this function computes, to the last bit (JSON keeps doubles).
+_ALPHA_FILE = "hertz_alpha.json"
+
+
 @lru_cache(maxsize=256)
 def hertz_alpha_of_restitution(restitution: float) -> float:
     """Damping factor α of the Hertz–Tsuji law that gives the coefficient of restitution e."""
+    from thermodem._numba_cache import cache_root
+
+    path = cache_root() / _ALPHA_FILE
+    key = repr(float(restitution))
+    try:
+        known = json.loads(path.read_text())
+    except (OSError, ValueError):
+        known = {}
+    value = known.get(key)
+    if isinstance(value, float):
+        return value
+    alpha = _alpha_of_restitution(restitution)
+    known[key] = alpha
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(known))
+        os.replace(tmp, path)
+    except OSError:
+        pass  # a read-only cache: computed again next time
+    return alpha
+
+
+def _alpha_of_restitution(restitution: float) -> float:
+    from scipy.optimize import brentq
+
     if restitution >= 1.0:
         return 0.0
     if restitution <= 0.0:
