@@ -145,6 +145,9 @@ class ImplicitSolver:
         self._hierarchy = None
         self._hierarchy_key: tuple = ()
         self._end: Rates | None = None
+        self._network_cache: tuple | None = None
+        self._system: tuple | None = None  # (matrix, fixed, free block)
+        self._capacity_matrix: tuple | None = None  # (K, C/Δt, θ K + diag(C/Δt))
         self.direct_below = 200
         self.linear = engine.override == 0 and not any(
             t.target == "particles" for t in engine.terms
@@ -190,19 +193,45 @@ class ImplicitSolver:
         fixed = eng.fixed.copy() if eng.fixed.shape[0] == n else np.zeros(n, np.bool_)
         if extra_fixed is not None:
             fixed |= extra_fixed
-        net = Network(laplacian(n, i, j, h, diag), rhs, fixed, p.temperature.copy())
+        cached = self._network_cache
+        if (
+            cached is not None
+            and np.array_equal(cached[0], i)
+            and np.array_equal(cached[1], j)
+            and np.array_equal(cached[2], h)
+            and np.array_equal(cached[3], diag)
+        ):
+            conductance = cached[4]  # the same network (frozen, constant properties)
+        else:
+            conductance = laplacian(n, i, j, h, diag)
+            self._network_cache = (i.copy(), j.copy(), h.copy(), diag.copy(), conductance)
+        net = Network(conductance, rhs, fixed, p.temperature.copy())
         self.timings.assembly += _time.perf_counter() - t0
         return net
 
     # ---------------------------------------------------------------------- linear solve
     def _solve(self, matrix: sp.csr_matrix, residual: np.ndarray, fixed: np.ndarray) -> np.ndarray:
-        """δ with (matrix δ)_free = residual_free, δ = 0 on the fixed rows."""
+        """δ with (matrix δ)_free = residual_free, δ = 0 on the fixed rows.
+
+        BLAS runs on one thread here: the vectors are short (a dot product of 50,000 values
+        takes microseconds), threads of OpenBLAS only contend with the Numba pool (measured:
+        4× slower CG on the 2-core machine), and one thread fixes the order of the
+        reductions, so the results do not depend on the machine's BLAS thread count.
+        """
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=1, user_api="blas"):
+            return self._solve_serial(matrix, residual, fixed)
+
+    def _solve_serial(
+        self, matrix: sp.csr_matrix, residual: np.ndarray, fixed: np.ndarray
+    ) -> np.ndarray:
         n = matrix.shape[0]
         delta = np.zeros(n)
         free = ~fixed
         if not free.any():
             return delta
-        a = matrix[free][:, free] if fixed.any() else matrix
+        a = self._free_block(matrix, fixed)
         r = residual[free]
         norm = float(np.linalg.norm(r))
         if norm == 0.0:
@@ -241,6 +270,25 @@ class ImplicitSolver:
             )
         delta[free] = x
         return delta
+
+    def _free_block(self, matrix: sp.csr_matrix, fixed: np.ndarray) -> sp.csr_matrix:
+        """The rows and columns of the free particles (kept while the matrix is the same
+        object and the fixed set the same)."""
+        sys = self._system
+        if sys is not None and sys[0] is matrix and np.array_equal(sys[1], fixed):
+            return sys[2]
+        a = matrix[~fixed][:, ~fixed] if fixed.any() else matrix
+        self._system = (matrix, fixed.copy(), a)
+        return a
+
+    def _matrix(self, conductance: sp.csr_matrix, cap: np.ndarray) -> sp.csr_matrix:
+        """θ K + diag(C/Δt), kept while K (the same object), θ and C/Δt are the same."""
+        m = self._capacity_matrix
+        if m is not None and m[0] is conductance and np.array_equal(m[1], cap):
+            return m[2]
+        matrix = (self.theta * conductance + sp.diags(cap)).tocsr()
+        self._capacity_matrix = (conductance, cap.copy(), matrix)
+        return matrix
 
     def _preconditioner(self, a: sp.csr_matrix) -> spla.LinearOperator:
         """Smoothed-aggregation AMG, kept while the matrix is the same (within 10 % per
@@ -304,7 +352,7 @@ class ImplicitSolver:
             if theta < 1.0:
                 rhs += (1.0 - theta) * start.heat_rate
             t0 = _time.perf_counter()
-            matrix = (theta * net.conductance + sp.diags(cap)).tocsr()
+            matrix = self._matrix(net.conductance, cap)
             residual = rhs - matrix @ t_k
             self.timings.assembly += _time.perf_counter() - t0
             delta = self._solve(matrix, residual, net.fixed)
