@@ -74,9 +74,10 @@ def main() -> None:
     order = np.argsort(p.global_id)
     out = HERE / "bed.txt"
     with open(out, "w") as f:
-        f.write(f"# Beaulieu heated bed: {len(x)} spheres d = {2 * RADIUS} m, heated wall z = 0; "
-                f"made by prepare_bed.py (settled {args.settle} s, largest speed {speed:.2e} "
-                f"m/s at the end, largest wall overlap {overlap:.3e} m)\nx y z radius\n")  # fmt: skip
+        head = (f"# Beaulieu heated bed: {len(x)} spheres d = {2 * RADIUS} m, heated wall z = 0;"
+                f" made by prepare_bed.py (settled {args.settle} s, largest speed {speed:.2e} "
+                f"m/s at the end, largest wall overlap {overlap:.3e} m)")  # fmt: skip
+        f.write(head + "\nx y z radius\n")
         for i in order:
             f.write(f"{x[i, 0]:.7e} {x[i, 1]:.7e} {x[i, 2]:.7e} {RADIUS!r}\n")
     tmp.unlink()
