@@ -112,7 +112,8 @@ def main() -> None:
     args = ap.parse_args()
     rows = measure(args.kappa)
     for r in rows:
-        print(f"κ = {r['kappa']:8.0f}: k_eff/k_f = {r['ratio']:.4g} ± {r['uncertainty'] / K_GAS:.2g}"
+        du = r["uncertainty"] / K_GAS
+        print(f"κ = {r['kappa']:8.0f}: k_eff/k_f = {r['ratio']:.4g} ± {du:.2g}"
               f"  ZS {r['zs']:.4g} ({r['ratio'] / r['zs'] - 1:+.1%})  ZBS {r['zbs']:.4g} "
               f"({r['ratio'] / r['zbs'] - 1:+.1%})  ε = {r['porosity']:.4f}")  # fmt: skip
     if args.figure:
