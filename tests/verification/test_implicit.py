@@ -215,13 +215,18 @@ def test_implicit_scheme_needs_frozen_mechanics(tmp_path: Path) -> None:
         case_from_dict(case)
 
 
-def test_multigrid_path_matches_direct_solve(tmp_path: Path) -> None:
+def test_multigrid_and_jacobi_paths_match_direct_solve(tmp_path: Path) -> None:
     thermal = {"time_step": 0.3, "scheme": "backward_euler"}
     a = _sim(_column(tmp_path, 10), thermal, walls=HOT_FLOOR)
     b = _sim(_column(tmp_path, 10), thermal, walls=HOT_FLOOR)
-    b.thermal.implicit.direct_below = 0  # CG + smoothed aggregation even for 12 unknowns
-    a.run(steps=5)
-    b.run(steps=5)
+    c = _sim(_column(tmp_path, 10), {**thermal, "implicit": {"preconditioner": "jacobi"}},
+             walls=HOT_FLOOR)  # fmt: skip
+    b.thermal.implicit.direct_below = 0  # CG + smoothed aggregation even for 10 unknowns
+    c.thermal.implicit.direct_below = 0
+    for sim in (a, b, c):
+        sim.run(steps=5)
     np.testing.assert_allclose(_by_gid(b), _by_gid(a), rtol=1e-10)
+    np.testing.assert_allclose(_by_gid(c), _by_gid(a), rtol=1e-10)
+    assert c.thermal.implicit.timings.setups == 0 and c.thermal.implicit.timings.cg_iterations
     assert b.thermal.implicit.timings.setups == 1  # one hierarchy for the constant matrix
     assert isinstance(b.thermal.implicit, ImplicitSolver)

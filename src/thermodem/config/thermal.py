@@ -224,6 +224,11 @@ class ImplicitSettings(StrictModel):
         default=1e-10, gt=0, lt=1, description="relative residual of the conjugate gradients"
     )
     max_iterations: int = Field(default=1000, ge=1, description="conjugate-gradient iterations")
+    preconditioner: Literal["amg", "jacobi"] = Field(
+        default="amg",
+        description="preconditioner of the conjugate gradients: smoothed-aggregation algebraic "
+        "multigrid (pyamg) or the diagonal (Jacobi)",
+    )
     picard_tolerance: float = Field(
         default=1e-8,
         gt=0,

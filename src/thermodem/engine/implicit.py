@@ -242,7 +242,11 @@ class ImplicitSolver:
             self.timings.solve += _time.perf_counter() - t0
             self.timings.solves += 1
             return delta
-        preconditioner = self._preconditioner(a)
+        if self.options.preconditioner == "jacobi":
+            inverse = 1.0 / a.diagonal()
+            preconditioner = spla.LinearOperator(a.shape, matvec=lambda v: inverse * v)
+        else:
+            preconditioner = self._preconditioner(a)
         t1 = _time.perf_counter()
         count = [0]
 
