@@ -115,6 +115,10 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--end", type=float, default=4000.0)
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--schemes", nargs="+",
+                    default=["explicit", "backward_euler", "crank_nicolson"])  # fmt: skip
+    ap.add_argument("--preconditioner", default="amg", choices=["amg", "jacobi"])
+    ap.add_argument("--tolerance", type=float, default=1e-10, help="CG relative residual")
     ap.add_argument(
         "--reference",
         type=float,
