@@ -34,7 +34,7 @@ from bench_shared_bed import HEIGHT, HOT_Z, SIDE, particle_files  # noqa: E402
 TOLERANCE = 1e-3  # K, on the mean temperature
 
 
-SOLVER = {"preconditioner": "amg", "tolerance": 1e-10}
+SOLVER = {"preconditioner": "amg", "tolerance": 1e-10, "startup_steps": 0}
 
 
 def case(scheme: str, dt: float, end: float) -> dict:
@@ -119,6 +119,8 @@ def main() -> None:
                     default=["explicit", "backward_euler", "crank_nicolson"])  # fmt: skip
     ap.add_argument("--preconditioner", default="amg", choices=["amg", "jacobi"])
     ap.add_argument("--tolerance", type=float, default=1e-10, help="CG relative residual")
+    ap.add_argument("--startup", type=int, default=0, help="CN: Rannacher startup steps")
+    ap.add_argument("--cn-dt", type=float, nargs="+", default=[160.0, 80.0, 40.0])
     ap.add_argument(
         "--reference",
         type=float,
@@ -127,7 +129,8 @@ def main() -> None:
     )
     args = ap.parse_args()
     THREADS["n"] = args.threads
-    SOLVER.update(preconditioner=args.preconditioner, tolerance=args.tolerance)
+    SOLVER.update(preconditioner=args.preconditioner, tolerance=args.tolerance,
+                  startup_steps=args.startup)  # fmt: skip
     end = args.end
     rows = []
     # warm the compiled kernels (not timed) and find the explicit limit
@@ -147,7 +150,7 @@ def main() -> None:
     for scheme, dts in (
         ("explicit", [0.9 * limit, 0.45 * limit, 0.225 * limit]),
         ("backward_euler", [40.0, 20.0]),
-        ("crank_nicolson", [160.0, 80.0, 40.0]),
+        ("crank_nicolson", args.cn_dt),
     ):
         if scheme not in args.schemes:
             continue

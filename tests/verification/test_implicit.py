@@ -230,3 +230,27 @@ def test_multigrid_and_jacobi_paths_match_direct_solve(tmp_path: Path) -> None:
     assert c.thermal.implicit.timings.setups == 0 and c.thermal.implicit.timings.cg_iterations
     assert b.thermal.implicit.timings.setups == 1  # one hierarchy for the constant matrix
     assert isinstance(b.thermal.implicit, ImplicitSolver)
+
+
+def test_rannacher_start_keeps_second_order_and_damps_the_stiff_start(tmp_path: Path) -> None:
+    """Crank–Nicolson with startup_steps: 2 (the first two steps as backward-Euler half
+    steps) stays second order on the two spheres; with Δt ≫ τ plain CN flips the sign of
+    ΔT every step (factor (1-x)/(1+x) → -1), the started run decays monotonically."""
+    tau = MASS * C / (2.0 * H)
+    errors = []
+    for dt in (0.4, 0.2, 0.1):
+        sim = _sim(_two(tmp_path), {"time_step": dt, "scheme": "crank_nicolson",
+                                    "implicit": {"startup_steps": 2}})  # fmt: skip
+        sim.run(until=8.0)
+        t = _by_gid(sim)
+        errors.append(abs(t[1] - t[0] - 100.0 * math.exp(-8.0 / tau)))
+    assert math.log2(errors[1] / errors[2]) == pytest.approx(2.0, abs=0.1)
+    stiff = {"time_step": 20.0 * tau, "scheme": "crank_nicolson"}
+    plain = _sim(_two(tmp_path), stiff)
+    started = _sim(_two(tmp_path), {**stiff, "implicit": {"startup_steps": 2}})
+    plain.run(steps=2)
+    started.run(steps=2)
+    # x = H Δt/(m c) = 10: two steps of (1 - x)/(1 + x) = -9/11, two sign flips
+    assert np.diff(_by_gid(plain))[0] == pytest.approx(100.0 * (9.0 / 11.0) ** 2, rel=1e-9)
+    # four backward-Euler half steps of 1/(1 + x): monotone decay
+    assert np.diff(_by_gid(started))[0] == pytest.approx(100.0 / 11.0**4, rel=1e-9)

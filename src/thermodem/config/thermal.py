@@ -236,6 +236,12 @@ class ImplicitSettings(StrictModel):
         "temperature change between iterates [K]",
     )
     picard_iterations: int = Field(default=50, ge=1, description="largest Picard iterations")
+    startup_steps: int = Field(
+        default=0,
+        ge=0,
+        description="crank_nicolson: the first n steps as two backward-Euler half steps each "
+        "(Rannacher start; damps the stiff modes of a non-smooth start)",
+    )
 
 
 class ThermalSettings(StrictModel):

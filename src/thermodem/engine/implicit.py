@@ -288,10 +288,11 @@ class ImplicitSolver:
     def _matrix(self, conductance: sp.csr_matrix, cap: np.ndarray) -> sp.csr_matrix:
         """θ K + diag(C/Δt), kept while K (the same object), θ and C/Δt are the same."""
         m = self._capacity_matrix
-        if m is not None and m[0] is conductance and np.array_equal(m[1], cap):
+        same = m is not None and m[0] is conductance and m[3] == self.theta
+        if same and np.array_equal(m[1], cap):
             return m[2]
         matrix = (self.theta * conductance + sp.diags(cap)).tocsr()
-        self._capacity_matrix = (conductance, cap.copy(), matrix)
+        self._capacity_matrix = (conductance, cap.copy(), matrix, self.theta)
         return matrix
 
     def _preconditioner(self, a: sp.csr_matrix) -> spla.LinearOperator:
@@ -324,7 +325,24 @@ class ImplicitSolver:
 
     # ----------------------------------------------------------------------------- step
     def step(self, dt: float, time: float) -> None:
-        """One implicit step from ``time`` to ``time + dt`` (the engine's state advances)."""
+        """One implicit step from ``time`` to ``time + dt`` (the engine's state advances).
+
+        Crank–Nicolson with ``implicit.startup_steps`` = n: the first n steps of the run are
+        each two backward-Euler half steps (Rannacher 1984), which damp the stiff modes that a
+        non-smooth start (a wall or a layer switched to a new temperature) excites and that
+        Crank–Nicolson alone damps only by (1 - x)/(1 + x) per step.
+        """
+        if self.theta < 1.0 and self.engine.thermal_steps < self.options.startup_steps:
+            self.theta = 1.0
+            try:
+                self._step(0.5 * dt, time)
+                self._step(0.5 * dt, time + 0.5 * dt)
+            finally:
+                self.theta = 0.5
+            return
+        self._step(dt, time)
+
+    def _step(self, dt: float, time: float) -> None:
         eng = self.engine
         p = eng.sim.particles
         theta = self.theta
