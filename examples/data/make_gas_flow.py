@@ -29,8 +29,10 @@ image = vtk.vtkImageData()
 image.SetDimensions(*shape)
 image.SetOrigin(*lower)
 image.SetSpacing(*spacing)
-for name, values in (("T", temperature.transpose(2, 1, 0).ravel()),
-                     ("U", velocity.transpose(2, 1, 0, 3).reshape(-1, 3))):
+for name, values in (
+    ("T", temperature.transpose(2, 1, 0).ravel()),
+    ("U", velocity.transpose(2, 1, 0, 3).reshape(-1, 3)),
+):
     arr = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
     arr.SetName(name)
     image.GetPointData().AddArray(arr)

@@ -222,6 +222,51 @@ def _announce_compile(case: Path) -> None:
 
 
 @app.command()
+def etc(
+    case: Path = typer.Argument(..., help="case file (YAML): the packing and its thermal models"),
+    axes: str = typer.Option("xyz", "--axes", help="axes to measure along, letters of 'xyz'"),
+    layer: list[float] = typer.Option(
+        None, "--layer", help="boundary-layer thickness [m] (repeat; default 1 and 2 diameters)"
+    ),
+    temperature: float = typer.Option(300.0, "--temperature", help="cold-layer temperature [K]"),
+    difference: float = typer.Option(1.0, "--difference", help="hot minus cold [K]"),
+    as_json: bool = typer.Option(False, "--json", help="print the results as JSON"),
+    threads: int | None = _THREADS,
+) -> None:
+    """Effective thermal conductivity of the case's packing along each axis (steady network
+    between two boundary layers of particles; docs/effective-conductivity.md)."""
+    import json
+
+    import numba
+
+    from thermodem.config.load import load_case
+    from thermodem.engine.etc import effective_conductivity_of_case
+
+    t = _threads(threads)
+    if t:
+        numba.set_num_threads(t)
+
+    def go() -> list:
+        return effective_conductivity_of_case(
+            load_case(case), axes, layers=tuple(layer) if layer else None,
+            base_temperature=temperature, difference=difference,
+        )  # fmt: skip
+
+    results = _guarded(go)
+    if as_json:
+        typer.echo(json.dumps([r.as_dict() for r in results], indent=1))
+        return
+    for r in results:
+        layers = ", ".join(f"{s * 1e3:.3g} mm: {k:.6g}" for s, k in r.by_layer.items())
+        typer.echo(
+            f"k_eff along {r.axis} = {r.conductivity:.6g} ± {r.uncertainty:.2g} W/(m K)  "
+            f"(by layer {layers}; Q hot {r.heat_hot:.6g} W, cold {r.heat_cold:.6g} W, "
+            f"A {r.area:.6g} m², dT/dx {r.gradient:.6g} K/m, {r.interior_particles} interior "
+            "particles)"
+        )
+
+
+@app.command()
 def validate(
     case: Path = typer.Argument(..., help="case file (YAML)"),
     threads: int | None = _THREADS,

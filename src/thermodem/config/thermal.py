@@ -217,6 +217,33 @@ class TessellationSettings(StrictModel):
     )
 
 
+class ImplicitSettings(StrictModel):
+    """Solver settings of the implicit schemes (docs/implicit.md)."""
+
+    tolerance: float = Field(
+        default=1e-10, gt=0, lt=1, description="relative residual of the conjugate gradients"
+    )
+    max_iterations: int = Field(default=1000, ge=1, description="conjugate-gradient iterations")
+    preconditioner: Literal["amg", "jacobi"] = Field(
+        default="amg",
+        description="preconditioner of the conjugate gradients: smoothed-aggregation algebraic "
+        "multigrid (pyamg) or the diagonal (Jacobi)",
+    )
+    picard_tolerance: float = Field(
+        default=1e-8,
+        gt=0,
+        description="Picard iteration on k(T), c(T) and the per-particle terms: largest "
+        "temperature change between iterates [K]",
+    )
+    picard_iterations: int = Field(default=50, ge=1, description="largest Picard iterations")
+    startup_steps: int = Field(
+        default=0,
+        ge=0,
+        description="crank_nicolson: the first n steps as two backward-Euler half steps each "
+        "(Rannacher start; damps the stiff modes of a non-smooth start)",
+    )
+
+
 class ThermalSettings(StrictModel):
     """Heat transfer between particles (explicit Euler, spec section 1.2)."""
 
@@ -286,6 +313,15 @@ class ThermalSettings(StrictModel):
     time_step: float | None = Field(
         default=None, gt=0, description="thermal time step with frozen mechanics [s]"
     )
+    scheme: Literal["explicit", "backward_euler", "crank_nicolson"] = Field(
+        default="explicit",
+        description="time scheme of the heat: explicit Euler, or (frozen mechanics only) the "
+        "implicit backward Euler / Crank-Nicolson solve of the conductance network",
+    )
+    implicit: ImplicitSettings = Field(
+        default_factory=lambda: ImplicitSettings(),
+        description="linear solver and Picard iteration of the implicit schemes",
+    )
     initial_temperature: InitialTemperature | None = None
     fixed_temperature: list[FixedTemperature] = Field(default_factory=list)
     heat_flux: list[HeatFlux] = Field(default_factory=list)
@@ -334,6 +370,12 @@ class ThermalSettings(StrictModel):
     def _frozen(self) -> ThermalSettings:
         if self.frozen_mechanics and self.time_step is None:
             raise ValueError("frozen_mechanics needs thermal.time_step [s]")
+        if self.scheme != "explicit" and not self.frozen_mechanics:
+            raise ValueError(
+                f"thermal.scheme = {self.scheme!r} needs thermal.frozen_mechanics: true (the "
+                "implicit schemes solve the conductance network of a bed that does not move); "
+                "allowed with moving mechanics: 'explicit'"
+            )
         return self
 
 

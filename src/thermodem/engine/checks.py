@@ -169,6 +169,8 @@ def check_thermal_time_step(sim) -> list[str]:  # noqa: ANN001 (avoids an import
     if th is None or sim.particles.count == 0:
         return []
     s = th.settings
+    if s.scheme != "explicit":  # backward Euler and Crank-Nicolson are unconditionally stable
+        return []
     dt = s.time_step if s.frozen_mechanics else (1 if s.substeps == "auto" else s.substeps)
     if not s.frozen_mechanics:
         dt = dt * sim.dt

@@ -53,7 +53,7 @@ if TYPE_CHECKING:
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
 SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty",
         "_conditions_key", "field_provider", "fields", "voronoi", "external_wall_conductance",
-        "external_stamp")  # fmt: skip
+        "external_stamp", "implicit", "record_conductances")  # fmt: skip
 #: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
 RANGE_PREFIX = "range_set__"
 EXTERNAL_PREFIX = "external__"
@@ -145,6 +145,14 @@ class ThermalEngine:
         # reuse_conductance = False re-evaluates them at every thermal step (tests)
         self.conductance_ready = False
         self.reuse_conductance = True
+        # the implicit schemes read the per-pair conductances of every term at every state
+        # (engine/implicit.py); the passes then store them also with k(T) tables
+        self.record_conductances = settings.scheme != "explicit"
+        self.implicit = None
+        if settings.scheme != "explicit":
+            from thermodem.engine.implicit import ImplicitSolver
+
+            self.implicit = ImplicitSolver(self)
         self.initial_energy = 0.0
         self.boundary_columns = np.nonzero(heat.BOUNDARY)[0]
         self.in_use = self._mechanisms_in_use()
@@ -509,11 +517,11 @@ class ThermalEngine:
         p = sim.particles
         rs = self.range_set
         by_mech = p.heat_rate_by_mechanism
-        store = frozen
+        store = frozen or self.record_conductances
         pair_h, wall_h = self._stored(
             index, rs.count if store else 0, rs.wall_count if store else 0
         )
-        if store and self.term_ready[index]:
+        if frozen and self.term_ready[index]:
             passes.pair_heat_from_conductance(
                 rs.i, rs.j, rs.group_start, pair_h, p.temperature, term.column, by_mech,
                 self.conductance_sum,
@@ -538,16 +546,16 @@ class ThermalEngine:
             term.table, k_i, k_j, self.k_p, self.k_w, scratch, term.wall_column, by_mech,
             self.conductance_sum, store, wall_h, term.needs_contact_radius,
         )  # fmt: skip
-        self.term_ready[index] = store
+        self.term_ready[index] = frozen
 
     def _contact_term(self, index: int, term: HeatTerm, frozen: bool) -> None:
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
         by_mech = p.heat_rate_by_mechanism
-        store = frozen
+        store = frozen or self.record_conductances
         pair_h, wall_h = self._stored(index, pb.count if store else 0, wb.count if store else 0)
-        if store and self.term_ready[index]:
+        if frozen and self.term_ready[index]:
             passes.pair_heat_from_conductance(
                 pb.i, pb.j, pb.group_start, pair_h, p.temperature, term.column, by_mech,
                 self.conductance_sum,
@@ -573,7 +581,7 @@ class ThermalEngine:
             term.model_id, term.table, k_i, k_j, self.k_p, self.k_w, scratch, term.wall_column,
             by_mech, self.conductance_sum, store, wall_h,
         )  # fmt: skip
-        self.term_ready[index] = store
+        self.term_ready[index] = frozen
 
     # ------------------------------------------------------------------------- the rates
     def compute_rates(self, time: float) -> np.ndarray:
@@ -609,7 +617,12 @@ class ThermalEngine:
         return self.specific_heat_by_type[p.type_id]
 
     def step(self, dt: float, time: float) -> None:
-        """Advance temperatures by dt using the state at ``time`` (explicit Euler)."""
+        """Advance temperatures by dt using the state at ``time`` (explicit Euler, or the
+        implicit scheme of ``thermal.scheme``: engine/implicit.py)."""
+        if self.implicit is not None:
+            self.implicit.step(dt, time)
+            self.thermal_steps += 1
+            return
         sim = self.sim
         p = sim.particles
         if self.fresh:  # the contact pass and after_contact_pass computed every rate

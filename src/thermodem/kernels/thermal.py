@@ -282,3 +282,11 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type
         if bad < 0 and part[c, 3] >= 0:
             bad = int(part[c, 3])
     return limit, where, absorbed, bad
+
+
+@njit(cache=True, error_model="numpy")
+def specific_enthalpies(temperature, type_id, table_t, table_c, table_n, out):
+    """h(T_i) [J/kg] of every particle into ``out`` (the implicit schemes' Picard update)."""
+    for i in range(temperature.shape[0]):
+        m = type_id[i]
+        out[i] = enthalpy(temperature[i], table_t[m], table_c[m], table_n[m])

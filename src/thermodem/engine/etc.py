@@ -1,0 +1,170 @@
+"""Effective thermal conductivity of a packing from its steady conductance network.
+
+For each axis the particles whose centres lie within a boundary layer of thickness ``s`` of
+the bed's two faces normal to the axis are held at T₀ + ΔT (low side) and T₀ (high side);
+the steady temperatures of the others are solved on the case's conductance network (every
+selected term, ``engine/implicit.py``). Then
+
+    k_eff = (Q / A) / |dT/dx|
+
+with Q the heat leaving the hot layer (equal to the heat entering the cold one up to the
+solver's residual; both are reported), A the bed's cross-section normal to the axis (the
+domain's period on a periodic axis, otherwise the extent of the particles, centre ± radius),
+and dT/dx the least-squares slope of the temperatures of the free particles at least one
+mean diameter away from both layers (so the contact resistance between a layer and the bed
+does not enter). The boundary layers disturb the packing's structure near the faces; the
+result is therefore computed for s = one and two mean diameters (default), and the
+**uncertainty** is |k(s₁) - k(s₂)| plus twice the standard error of the fitted slope, plus
+the relative heat imbalance |Q_hot - Q_cold| / Q times k. A choice of this module (docs:
+docs/effective-conductivity.md).
+
+On a lattice of identical conductances H (exact test in tests/verification/test_etc.py) a
+temperature field linear in x is an exact steady solution of the interior (every node is a
+centre of symmetry of its bonds) and the heat flux is q = (H/V) Σ_b (b·e)² ∂T/∂x over the
+bonds b of one cell counted once:
+
+    k = (H / V_cell) Σ_{bonds in a cell} (b·e)²:  SC H/a, BCC 2H/a, FCC 4H/a
+
+with a the cubic cell edge (a = 2R, 4R/√3, 2√2 R for touching spheres).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from thermodem.engine.implicit import ImplicitSolver
+from thermodem.errors import ConfigError
+
+AXES = {"x": 0, "y": 1, "z": 2}
+
+
+@dataclass
+class AxisConductivity:
+    """k_eff along one axis and the figures it is made of."""
+
+    axis: str
+    conductivity: float  # W/(m K), with the thinner layer
+    uncertainty: float  # W/(m K)
+    by_layer: dict  # layer thickness [m] -> k_eff [W/(m K)]
+    heat_hot: float  # W, leaving the hot layer (thinner layer)
+    heat_cold: float  # W, entering the cold layer
+    area: float  # m²
+    gradient: float  # K/m, fitted in the interior
+    interior_particles: int
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def _check_case(sim) -> None:  # noqa: ANN001
+    eng = sim.thermal
+    if eng is None:
+        raise ConfigError("effective conductivity: the case has no thermal section")
+    s = eng.settings
+    given = [name for name in ("fixed_temperature", "heat_flux", "volumetric_source",
+                               "external_source") if getattr(s, name)]  # fmt: skip
+    if given:
+        raise ConfigError(
+            f"effective conductivity: thermal.{given[0]} is given; the measurement imposes its "
+            "own temperatures on two boundary layers and needs a case without fixed "
+            "temperatures or sources (remove them)"
+        )
+    hot = [
+        w.name or f"walls.{k}" for k, w in enumerate(sim.case.walls) if w.thermal.kind == "fixed"
+    ]
+    if hot:
+        raise ConfigError(
+            f"effective conductivity: wall {hot[0]!r} has thermal.kind fixed; the walls must "
+            "be adiabatic (the heat enters and leaves through the boundary layers of particles)"
+        )
+
+
+def effective_conductivity(
+    sim,  # noqa: ANN001
+    axes: str = "xyz",
+    layers: tuple[float, ...] | None = None,
+    base_temperature: float = 300.0,
+    difference: float = 1.0,
+) -> list[AxisConductivity]:
+    """k_eff of the simulation's current packing along each of ``axes`` (module docstring).
+
+    ``layers``: boundary-layer thicknesses [m] (default one and two mean diameters); the
+    first gives the reported value. The particles' temperatures are left at the last solve.
+    """
+    _check_case(sim)
+    bad = [a for a in axes if a not in AXES]
+    if bad or not axes:
+        raise ConfigError(f"effective conductivity: axes = {axes!r}; allowed: letters of 'xyz'")
+    p = sim.particles
+    if p.count == 0:
+        raise ConfigError("effective conductivity: the case has no particles")
+    diameter = 2.0 * float(p.radius.mean())
+    layers = layers or (diameter, 2.0 * diameter)
+    solver = ImplicitSolver(sim.thermal)
+    results = []
+    for name in axes:
+        a = AXES[name]
+        if sim.periodic[a]:
+            raise ConfigError(
+                f"effective conductivity along {name}: the domain is periodic along {name}; "
+                "the two boundary layers would touch through the period (make it non-periodic)"
+            )
+        x = p.position[:, a]
+        low = float(np.min(x - p.radius))
+        high = float(np.max(x + p.radius))
+        area = 1.0
+        for b in range(3):
+            if b == a:
+                continue
+            if sim.periodic[b]:
+                area *= float(sim.upper[b] - sim.lower[b])
+            else:
+                pb = p.position[:, b]
+                area *= float(np.max(pb + p.radius) - np.min(pb - p.radius))
+        by_layer = {}
+        first = None
+        for s in layers:
+            hot = x - low < s
+            cold = high - x < s
+            interior = ~hot & ~cold & (x - low >= s + diameter) & (high - x >= s + diameter)
+            if not hot.any() or not cold.any() or interior.sum() < 3:
+                raise ConfigError(
+                    f"effective conductivity along {name}: the bed ({high - low:.4g} m) is too "
+                    f"thin for boundary layers of {s:.4g} m plus one diameter of margin on each "
+                    "side (need particles in both layers and at least 3 in between)"
+                )
+            p.temperature[:] = base_temperature + 0.5 * difference
+            p.temperature[hot] = base_temperature + difference
+            p.temperature[cold] = base_temperature
+            net = solver.steady(extra_fixed=hot | cold)
+            t = p.temperature
+            q = net.rhs - net.conductance @ t  # heat into each particle [W]
+            q_hot = -float(q[hot].sum())
+            q_cold = float(q[cold].sum())
+            xi, ti = x[interior], t[interior]
+            design = np.vstack([xi - xi.mean(), np.ones_like(xi)]).T
+            coef, res, _, _ = np.linalg.lstsq(design, ti, rcond=None)
+            slope = float(coef[0])
+            dof = max(xi.shape[0] - 2, 1)
+            sigma2 = float(res[0]) / dof if res.shape[0] else 0.0
+            slope_se = float(np.sqrt(sigma2 / np.sum((xi - xi.mean()) ** 2)))
+            k = 0.5 * (q_hot + q_cold) / area / abs(slope)
+            by_layer[float(s)] = k
+            if first is None:
+                first = (k, q_hot, q_cold, slope, slope_se, int(interior.sum()))
+        k, q_hot, q_cold, slope, slope_se, count = first
+        ks = list(by_layer.values())
+        uncertainty = (max(ks) - min(ks)) + 2.0 * k * slope_se / abs(slope)
+        uncertainty += k * abs(q_hot - q_cold) / abs(0.5 * (q_hot + q_cold))
+        results.append(AxisConductivity(name, k, uncertainty, by_layer, q_hot, q_cold, area,
+                                        slope, count))  # fmt: skip
+    return results
+
+
+def effective_conductivity_of_case(case, axes: str = "xyz", **options) -> list[AxisConductivity]:  # noqa: ANN001, ANN003
+    """Build the simulation of a case (its initial packing and contacts) and measure k_eff."""
+    from thermodem.engine.simulation import Simulation
+
+    return effective_conductivity(Simulation(case), axes, **options)

@@ -1,0 +1,488 @@
+"""Implicit heat for frozen mechanics: the conductance network as a sparse matrix.
+
+With the particles at rest every heat term of the engine is, at a given state, a linear
+network: pairs (i, j) with a conductance H_ij (contact conduction, the range set's gap
+conduction, the external set's faces), and per-particle boundary terms b_i - D_i T_i (walls
+at a fixed temperature: b = Σ H T_w, D = Σ H; the per-particle terms: their linearisation
+Q(T*) - G (T - T*), G = -dQ/dT as the kernels return it; sources: b = Q, D = 0). With
+K = L(H) + diag(D), L the graph Laplacian of the pairs, the lumped capacitances C = m c give
+
+    C (T^{n+1} - T^n) / Δt = θ (b - K T^{n+1}) + (1 - θ) Q(T^n)
+
+(θ = 1: backward Euler, first order; θ = ½: Crank–Nicolson, second order; both
+unconditionally stable), and the steady state K T = b. Fixed-temperature particles are
+Dirichlet rows (their temperature at t + Δt, not solved). Temperature-dependent k(T), c(T)
+and the T³-dependent linearisation of radiation are handled by Picard iteration: the network
+is re-evaluated at the last iterate until the largest temperature change is below
+``thermal.implicit.picard_tolerance``; with c(T) the capacity term is written on the enthalpy,
+m (h(T^{n+1}) - h(T^n)), linearised as m [h(T^k) - h(T^n) + c(T^k)(T - T^k)], so that the
+converged step conserves Σ m h exactly like the explicit one.
+
+The network is read from the engine itself (``ThermalEngine.compute_rates`` with
+``record_conductances``): the per-pair conductances that its kernels store, the conductance
+sums ΣH_i + ΣG_i and the boundary mechanism columns; D_i is ΣH_i - Σ_pairs H and
+b_i = Q_boundary,i + D_i T_i. Nothing about a model is repeated here, so every selected term
+enters the matrix (a test compares K T - b with the engine's own heat rates).
+
+The system is assembled as COO arrays by numpy (no loop over pairs) and solved for the
+increment T - T^k with conjugate gradients preconditioned by smoothed-aggregation algebraic
+multigrid (``pyamg``; Ruge & Stüben 1987, Vaněk, Mandel & Brezina 1996), or by a sparse
+direct solve below ``direct_below`` unknowns. The multigrid hierarchy is kept while the
+matrix does not change (constant properties: one setup per run).
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from thermodem.errors import ConfigError, SimulationError
+from thermodem.kernels import thermal as kernels
+from thermodem.state import heat
+
+if TYPE_CHECKING:
+    from thermodem.engine.thermal import ThermalEngine
+
+
+@dataclass
+class Network:
+    """The linearised conductance network of one state."""
+
+    conductance: sp.csr_matrix  # K = L(H) + diag(D) [W/K]
+    rhs: np.ndarray  # b [W]
+    fixed: np.ndarray  # Dirichlet rows (fixed-temperature particles)
+    temperature: np.ndarray  # the state's temperatures (fixed ones at their bath value)
+
+
+@dataclass
+class Rates:
+    """What the ledger needs from the heat rates of one state."""
+
+    boundary: np.ndarray  # Σ_i Q_i,m for every boundary column m [W]
+    absorbed: float  # Σ over fixed particles of Q_i [W]
+    heat_rate: np.ndarray  # Q_i [W]
+    temperature: np.ndarray
+    time: float
+
+
+@dataclass
+class Timings:
+    """Cumulative wall-clock seconds and counts of the implicit solves."""
+
+    assembly: float = 0.0
+    preconditioner: float = 0.0
+    solve: float = 0.0
+    evaluation: float = 0.0
+    setups: int = 0
+    solves: int = 0
+    cg_iterations: int = 0
+    picard_iterations: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+def pair_lists(engine: ThermalEngine) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(i, j, H) of every pair of every term at the engine's last evaluation (the arrays its
+    kernels stored; pairs may repeat across terms: the matrix sums them)."""
+    sim = engine.sim
+    parts_i, parts_j, parts_h = [], [], []
+    pb = sim.pairs
+    if engine.contact.active and pb.count:
+        parts_i.append(pb.i[: pb.count])
+        parts_j.append(pb.j[: pb.count])
+        parts_h.append(engine.pair_conductance[: pb.count])
+    for index, term in enumerate(engine.terms):
+        if term.target == "range":
+            s = engine.range_set
+            n = s.count
+        elif term.target == "contacts":
+            s, n = pb, pb.count
+        elif term.target == "external":
+            s = engine.external
+            n = s.count
+        else:
+            continue
+        if n:
+            parts_i.append(s.i[:n])
+            parts_j.append(s.j[:n])
+            parts_h.append(engine.term_conductance[index][:n])
+    if not parts_i:
+        empty = np.zeros(0, np.int64)
+        return empty, empty, np.zeros(0)
+    i = np.concatenate(parts_i).astype(np.int64)
+    j = np.concatenate(parts_j).astype(np.int64)
+    h = np.concatenate(parts_h)
+    keep = h != 0.0
+    return i[keep], j[keep], h[keep]
+
+
+def laplacian(
+    n: int, i: np.ndarray, j: np.ndarray, h: np.ndarray, diag: np.ndarray
+) -> sp.csr_matrix:
+    """L(H) + diag(diag) as CSR: off-diagonal -H_ij (both triangles), diagonal ΣH + diag."""
+    ar = np.arange(n, dtype=np.int64)
+    pair_sum = np.bincount(i, h, n) + np.bincount(j, h, n)
+    rows = np.concatenate([i, j, ar])
+    cols = np.concatenate([j, i, ar])
+    data = np.concatenate([-h, -h, pair_sum + diag])
+    return sp.coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
+
+
+class ImplicitSolver:
+    """Backward Euler / Crank–Nicolson steps and the steady state of a thermal engine."""
+
+    def __init__(self, engine: ThermalEngine) -> None:
+        self.engine = engine
+        settings = engine.settings
+        self.theta = 0.5 if settings.scheme == "crank_nicolson" else 1.0
+        self.options = settings.implicit
+        self.timings = Timings()
+        self._hierarchy = None
+        self._hierarchy_key: tuple = ()
+        self._end: Rates | None = None
+        self._network_cache: tuple | None = None
+        self._system: tuple | None = None  # (matrix, fixed, free block)
+        self._capacity_matrix: tuple | None = None  # (K, C/Δt, θ K + diag(C/Δt))
+        self.direct_below = 200
+        self.linear = engine.override == 0 and not any(
+            t.target == "particles" for t in engine.terms
+        )
+
+    # ------------------------------------------------------------------ evaluation
+    def _rates(self, time: float) -> Rates:
+        eng = self.engine
+        p = eng.sim.particles
+        t0 = _time.perf_counter()
+        record = eng.record_conductances
+        eng.record_conductances = True
+        try:
+            fixed = eng.compute_rates(time)
+        finally:
+            eng.record_conductances = record
+        by_mech = p.heat_rate_by_mechanism
+        rates = Rates(
+            boundary=by_mech[:, eng.boundary_columns].sum(axis=0),
+            absorbed=float(p.heat_rate[fixed].sum()) if fixed.shape[0] else 0.0,
+            heat_rate=p.heat_rate.copy(),
+            temperature=p.temperature.copy(),
+            time=time,
+        )
+        self.timings.evaluation += _time.perf_counter() - t0
+        return rates
+
+    def network(self, time: float, extra_fixed: np.ndarray | None = None) -> Network:
+        """The conductance network at the current temperatures and ``time``."""
+        eng = self.engine
+        p = eng.sim.particles
+        self._rates(time)
+        t0 = _time.perf_counter()
+        n = p.count
+        i, j, h = pair_lists(eng)
+        pair_sum = np.bincount(i, h, n) + np.bincount(j, h, n)
+        diag = eng.conductance_sum[:n] - pair_sum
+        # what the pairs left is the boundary conductance; round-off of the difference is
+        # not a conductance
+        diag[np.abs(diag) <= 1e-12 * np.abs(eng.conductance_sum[:n])] = 0.0
+        boundary = p.heat_rate_by_mechanism[:, eng.boundary_columns].sum(axis=1)
+        rhs = boundary + diag * p.temperature
+        fixed = eng.fixed.copy() if eng.fixed.shape[0] == n else np.zeros(n, np.bool_)
+        if extra_fixed is not None:
+            fixed |= extra_fixed
+        cached = self._network_cache
+        if (
+            cached is not None
+            and np.array_equal(cached[0], i)
+            and np.array_equal(cached[1], j)
+            and np.array_equal(cached[2], h)
+            and np.array_equal(cached[3], diag)
+        ):
+            conductance = cached[4]  # the same network (frozen, constant properties)
+        else:
+            conductance = laplacian(n, i, j, h, diag)
+            self._network_cache = (i.copy(), j.copy(), h.copy(), diag.copy(), conductance)
+        net = Network(conductance, rhs, fixed, p.temperature.copy())
+        self.timings.assembly += _time.perf_counter() - t0
+        return net
+
+    # ---------------------------------------------------------------------- linear solve
+    def _solve(self, matrix: sp.csr_matrix, residual: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+        """δ with (matrix δ)_free = residual_free, δ = 0 on the fixed rows.
+
+        BLAS runs on one thread here: the vectors are short (a dot product of 50,000 values
+        takes microseconds), threads of OpenBLAS only contend with the Numba pool (measured:
+        4× slower CG on the 2-core machine), and one thread fixes the order of the
+        reductions, so the results do not depend on the machine's BLAS thread count.
+        """
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=1, user_api="blas"):
+            return self._solve_serial(matrix, residual, fixed)
+
+    def _solve_serial(
+        self, matrix: sp.csr_matrix, residual: np.ndarray, fixed: np.ndarray
+    ) -> np.ndarray:
+        n = matrix.shape[0]
+        delta = np.zeros(n)
+        free = ~fixed
+        if not free.any():
+            return delta
+        a = self._free_block(matrix, fixed)
+        r = residual[free]
+        norm = float(np.linalg.norm(r))
+        if norm == 0.0:
+            return delta
+        t0 = _time.perf_counter()
+        if a.shape[0] < self.direct_below:
+            delta[free] = spla.spsolve(a.tocsc(), r)
+            self.timings.solve += _time.perf_counter() - t0
+            self.timings.solves += 1
+            return delta
+        if self.options.preconditioner == "jacobi":
+            inverse = 1.0 / a.diagonal()
+            preconditioner = spla.LinearOperator(a.shape, matvec=lambda v: inverse * v)
+        else:
+            preconditioner = self._preconditioner(a)
+        t1 = _time.perf_counter()
+        count = [0]
+
+        def tick(_x: np.ndarray) -> None:
+            count[0] += 1
+
+        x, info = spla.cg(
+            a, r, rtol=self.options.tolerance, atol=0.0, maxiter=self.options.max_iterations,
+            M=preconditioner, callback=tick,
+        )  # fmt: skip
+        self.timings.solve += _time.perf_counter() - t1
+        self.timings.solves += 1
+        self.timings.cg_iterations += count[0]
+        if info != 0:
+            achieved = float(np.linalg.norm(r - a @ x)) / norm
+            sim = self.engine.sim
+            raise SimulationError(
+                f"implicit heat solve: conjugate gradients did not reach the relative residual "
+                f"thermal.implicit.tolerance = {self.options.tolerance:g} in "
+                f"thermal.implicit.max_iterations = {self.options.max_iterations} iterations "
+                f"(reached {achieved:.3g}) at step {sim.step_count} (t = {sim.time:.6g} s)",
+                sim.step_count,
+                sim.time,
+                -1,
+            )
+        delta[free] = x
+        return delta
+
+    def _free_block(self, matrix: sp.csr_matrix, fixed: np.ndarray) -> sp.csr_matrix:
+        """The rows and columns of the free particles (kept while the matrix is the same
+        object and the fixed set the same)."""
+        sys = self._system
+        if sys is not None and sys[0] is matrix and np.array_equal(sys[1], fixed):
+            return sys[2]
+        a = matrix[~fixed][:, ~fixed] if fixed.any() else matrix
+        self._system = (matrix, fixed.copy(), a)
+        return a
+
+    def _matrix(self, conductance: sp.csr_matrix, cap: np.ndarray) -> sp.csr_matrix:
+        """θ K + diag(C/Δt), kept while K (the same object), θ and C/Δt are the same."""
+        m = self._capacity_matrix
+        same = m is not None and m[0] is conductance and m[3] == self.theta
+        if same and np.array_equal(m[1], cap):
+            return m[2]
+        matrix = (self.theta * conductance + sp.diags(cap)).tocsr()
+        self._capacity_matrix = (conductance, cap.copy(), matrix, self.theta)
+        return matrix
+
+    def _preconditioner(self, a: sp.csr_matrix) -> spla.LinearOperator:
+        """Smoothed-aggregation AMG, kept while the matrix is the same (within 10 % per
+        entry: a slightly stale hierarchy is still a good preconditioner; CG stays exact)."""
+        import pyamg
+
+        key = (a.shape, a.nnz)
+        if self._hierarchy is not None and key == self._hierarchy_key:
+            old_data, old_indices = self._hierarchy[1], self._hierarchy[2]
+            if np.array_equal(old_indices, a.indices) and np.all(
+                np.abs(a.data - old_data) <= 0.1 * np.abs(old_data)
+            ):
+                return self._hierarchy[0].aspreconditioner(cycle="V")
+        t0 = _time.perf_counter()
+        ml = pyamg.smoothed_aggregation_solver(a, symmetry="symmetric", max_coarse=50)
+        self.timings.preconditioner += _time.perf_counter() - t0
+        self.timings.setups += 1
+        self._hierarchy = (ml, a.data.copy(), a.indices.copy())
+        self._hierarchy_key = key
+        return ml.aspreconditioner(cycle="V")
+
+    # ----------------------------------------------------------------------- capacities
+    def _enthalpy(self, temperature: np.ndarray) -> np.ndarray:
+        eng = self.engine
+        p = eng.sim.particles
+        out = np.empty(p.count)
+        kernels.specific_enthalpies(temperature, p.type_id, eng.c_t, eng.c_v, eng.c_n, out)
+        return out
+
+    # ----------------------------------------------------------------------------- step
+    def step(self, dt: float, time: float) -> None:
+        """One implicit step from ``time`` to ``time + dt`` (the engine's state advances).
+
+        Crank–Nicolson with ``implicit.startup_steps`` = n: the first n steps of the run are
+        each two backward-Euler half steps (Rannacher 1984), which damp the stiff modes that a
+        non-smooth start (a wall or a layer switched to a new temperature) excites and that
+        Crank–Nicolson alone damps only by (1 - x)/(1 + x) per step.
+        """
+        if self.theta < 1.0 and self.engine.thermal_steps < self.options.startup_steps:
+            self.theta = 1.0
+            try:
+                self._step(0.5 * dt, time)
+                self._step(0.5 * dt, time + 0.5 * dt)
+            finally:
+                self.theta = 0.5
+            return
+        self._step(dt, time)
+
+    def _step(self, dt: float, time: float) -> None:
+        eng = self.engine
+        p = eng.sim.particles
+        theta = self.theta
+        start = self._end
+        if theta < 1.0 and not (
+            start is not None
+            and start.time == time
+            and start.temperature.shape == p.temperature.shape
+            and np.array_equal(start.temperature, p.temperature)
+        ):
+            start = self._rates(time)
+        t_n = p.temperature.copy()
+        h_n = self._enthalpy(t_n) if eng.has_c_table else None
+        limit = math.inf
+        for iteration in range(1, self.options.picard_iterations + 1):
+            net = self.network(time + dt)
+            t_k = net.temperature
+            if iteration == 1:
+                c_now = eng.specific_heat()
+                limit, where = kernels.stability_limit(
+                    p.mass, c_now, eng.conductance_sum, net.fixed
+                )
+            cap = p.mass * eng.specific_heat() / dt
+            if h_n is not None:
+                inertia = cap * t_k - p.mass * (self._enthalpy(t_k) - h_n) / dt
+            else:
+                inertia = cap * t_n
+            rhs = inertia + theta * net.rhs
+            if theta < 1.0:
+                rhs += (1.0 - theta) * start.heat_rate
+            t0 = _time.perf_counter()
+            matrix = self._matrix(net.conductance, cap)
+            residual = rhs - matrix @ t_k
+            self.timings.assembly += _time.perf_counter() - t0
+            delta = self._solve(matrix, residual, net.fixed)
+            p.temperature[:] = t_k + delta
+            self.timings.picard_iterations += 1
+            change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
+            if self.linear or change <= self.options.picard_tolerance:
+                break
+        else:
+            self._not_converged(change, time)
+        bad = np.nonzero(~(p.temperature > 0.0) | ~np.isfinite(p.temperature))[0]
+        if bad.shape[0]:
+            gid = int(p.global_id[bad[0]])
+            raise SimulationError(
+                f"implicit heat step: temperature of particle {gid} became "
+                f"{p.temperature[bad[0]]:.6g} K at t = {time + dt:.6g} s",
+                eng.sim.step_count,
+                time,
+                gid,
+            )
+        end = self._rates(time + dt)
+        self._end = end
+        for m, q_end, q_start in zip(
+            eng.boundary_columns,
+            end.boundary,
+            start.boundary if start is not None else end.boundary,
+            strict=True,
+        ):
+            q = theta * q_end + (1.0 - theta) * q_start
+            eng.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
+        absorbed = theta * end.absorbed + (1.0 - theta) * (
+            start.absorbed if start is not None else 0.0
+        )
+        eng.cumulative["fixed_absorbed"] += absorbed * dt
+        eng.limit = limit
+        eng.limit_particle = int(p.global_id[where]) if where >= 0 else -1
+
+    def _not_converged(self, change: float, time: float) -> None:
+        sim = self.engine.sim
+        raise SimulationError(
+            f"implicit heat step: the Picard iteration on the temperature-dependent terms did "
+            f"not converge to thermal.implicit.picard_tolerance = "
+            f"{self.options.picard_tolerance:g} K in thermal.implicit.picard_iterations = "
+            f"{self.options.picard_iterations} (last change {change:.3g} K) at t = {time:.6g} s",
+            sim.step_count,
+            time,
+            -1,
+        )
+
+    # ---------------------------------------------------------------------------- steady
+    def steady(
+        self,
+        time: float | None = None,
+        extra_fixed: np.ndarray | None = None,
+    ) -> Network:
+        """Steady temperatures K T = b (Picard on the temperature-dependent terms) into the
+        particles; ``extra_fixed`` marks more Dirichlet particles (at their current T).
+        Returns the network at the solution."""
+        eng = self.engine
+        p = eng.sim.particles
+        time = eng.sim.time if time is None else time
+        change = math.inf
+        for _ in range(self.options.picard_iterations):
+            net = self.network(time, extra_fixed)
+            self._check_anchored(net)
+            residual = net.rhs - net.conductance @ net.temperature
+            delta = self._solve(net.conductance, residual, net.fixed)
+            p.temperature[:] = net.temperature + delta
+            self.timings.picard_iterations += 1
+            change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
+            if self.linear or change <= self.options.picard_tolerance:
+                break
+        else:
+            self._not_converged(change, time)
+        return self.network(time, extra_fixed)
+
+    def _check_anchored(self, net: Network) -> None:
+        """Every cluster of free particles must reach a fixed temperature (a wall, a fixed
+        particle, a per-particle term), or its steady temperature is undefined."""
+        from scipy.sparse.csgraph import connected_components
+
+        free = ~net.fixed
+        if not free.any():
+            return
+        k = net.conductance
+        row_sum = np.asarray(k.sum(axis=1)).ravel()  # D_i: L has zero row sums
+        anchor = row_sum > 1e-12 * np.abs(k.diagonal())
+        anchor |= np.asarray((k[:, net.fixed] != 0).sum(axis=1)).ravel() > 0
+        a = k[free][:, free]
+        count, labels = connected_components(a, directed=False)
+        anchored = np.bincount(labels, anchor[free], count) > 0
+        if not anchored.all():
+            floating = int(np.sum(~anchored[labels]))
+            raise ConfigError(
+                f"steady state: {floating} particles in {int(np.sum(~anchored))} clusters "
+                "exchange heat with no fixed temperature (a thermal.walls kind fixed, "
+                "thermal.fixed_temperature, convection or radiation): their steady "
+                "temperature is undefined"
+            )
+
+
+def steady_state(sim, time: float | None = None) -> Network:  # noqa: ANN001
+    """Solve the steady temperatures of a simulation's current configuration (Python API).
+
+    The temperatures of the particles are replaced by the steady ones; returns the network.
+    """
+    if sim.thermal is None:
+        raise ConfigError("steady_state: the case has no thermal section")
+    eng = sim.thermal
+    solver = eng.implicit if eng.implicit is not None else ImplicitSolver(eng)
+    return solver.steady(time)
