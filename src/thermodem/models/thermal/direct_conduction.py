@@ -609,6 +609,7 @@ _register(
     "Batchelor & O'Brien contact (η regimes) and separated-particle conduction",
     _BOB + "; Dai, Hanaor & Gan (2019); Moscardini et al. (2018)",
     pack_bob_complete, interaction_range=bob_interaction_range, columns=BOB_COLUMNS,
+    range_parameter="cutoff_gap_ratio",
     uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(
@@ -618,6 +619,7 @@ _register(
     "Yun & Evans (2010) Comput. Geotech. 37, 991-998; Dai, Hanaor & Gan (2019) Int. J. Therm. "
     "Sci. 142, 266-279",
     pack_bob_modified, interaction_range=bob_interaction_range, columns=BOB_MODIFIED_COLUMNS,
+    range_parameter="cutoff_gap_ratio",
     uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(

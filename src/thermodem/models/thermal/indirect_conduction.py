@@ -214,6 +214,7 @@ register(
     requires=("thermal_conductivity",),
     uses_gas=("thermal_conductivity",),
     interaction_range=bob_separated_range,
+    range_parameter="cutoff_gap_ratio",
     uses_contact_radius=False,
     antisymmetric=False,
     symmetric=True,
