@@ -458,7 +458,7 @@ def run_case(
             return _drive(sim, run, fresh=True)
         except ConfigError as exc:
             runlog.file_only(f"error: {exc}")
-            status.update(status="failed", message=str(exc))
+            status.update(status="failed", message=str(exc), refused_input=True)
             raise
         finally:
             runlog.close()
