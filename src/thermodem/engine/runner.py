@@ -729,8 +729,13 @@ def _restored(ckpt: Checkpoint, threads: int | None, case: Case) -> Simulation:
     """A simulation continuing from ``ckpt`` (ConfigError for a state that does not load)."""
     try:
         return Simulation.from_checkpoint(ckpt, threads=threads, case=case)
-    except ConfigError:
-        raise
+    except ConfigError as exc:
+        if str(ckpt.path) in str(exc):
+            raise
+        raise ConfigError(
+            f"checkpoint {ckpt.path}: {exc}; nothing was changed (a checkpoint continues "
+            "the case it was written with, or one with the same particles, walls and models)"
+        ) from None
     except (KeyError, IndexError, TypeError, ValueError) as exc:
         raise ConfigError(
             f"checkpoint {ckpt.path} cannot be restored ({type(exc).__name__}: {exc}); the file "

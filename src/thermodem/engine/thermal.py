@@ -796,6 +796,11 @@ class ThermalEngine:
             for k in list(arrays)
             if k.startswith(EXTERNAL_PREFIX)
         }
+        from thermodem.engine.restart import check_thermal_arrays, keep_derived_thermal
+
+        # tables and ids made from the case stay this case's (a restart may change the case)
+        changed = keep_derived_thermal(self, scalars, arrays)
+        check_thermal_arrays(self, arrays)
         for name, value in scalars.items():
             current = getattr(self, name, None)
             if isinstance(current, float) and value is not None:
@@ -805,6 +810,9 @@ class ThermalEngine:
             setattr(self, name, value)
         for name, value in arrays.items():
             setattr(self, name, np.array(value, copy=True))
+        if changed:  # conductances kept from the old case's models are stale
+            self.conductance_ready = False
+            self.term_ready[:] = False
         if self.range_set is not None:
             if range_scalars is None:
                 raise ConfigError(
