@@ -285,7 +285,10 @@ class Simulation:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
             pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
-            reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_rate_by_mechanism,
+            # the heat sums start at zero: zeroed here, or already by this step's Euler update
+            zero = not (th.rates_cleared and th.conductance_sum.shape[0] == p.count)
+            th.rates_cleared = False
+            reset_forces(p.force, p.torque, p.mass, self.gravity, zero, p.heat_rate_by_mechanism,
                          th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
             no_mech, no_sum = self._no_heat[0][-3:-1]
@@ -342,9 +345,10 @@ class Simulation:
             self.time = self.step_count * th.settings.time_step
             return
         if th is not None and self.step_count >= th.next_step:
-            # heat over the next n steps from the positions, contacts and temperatures now
+            # heat over the next n steps from the positions, contacts and temperatures now;
+            # with n = 1 this step's contact pass adds the heat of the next state at once
             n = th.substeps
-            th.step(n * self.dt, self.time)
+            th.step(n * self.dt, self.time, clear=n == 1)
             th.next_step = self.step_count + n
         p = self.particles
         nchunks = p.count // CHECK_CHUNK + 1

@@ -145,6 +145,8 @@ class ThermalEngine:
         # reuse_conductance = False re-evaluates them at every thermal step (tests)
         self.conductance_ready = False
         self.reuse_conductance = True
+        #: the last explicit update zeroed the mechanism rates and conductance sums (step)
+        self.rates_cleared = False
         # the implicit schemes read the per-pair conductances of every term at every state
         # (engine/implicit.py); the passes then store them also with k(T) tables
         self.record_conductances = settings.scheme != "explicit"
@@ -616,9 +618,14 @@ class ThermalEngine:
             return self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
         return self.specific_heat_by_type[p.type_id]
 
-    def step(self, dt: float, time: float) -> None:
+    def step(self, dt: float, time: float, clear: bool = False) -> None:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler, or the
-        implicit scheme of ``thermal.scheme``: engine/implicit.py)."""
+        implicit scheme of ``thermal.scheme``: engine/implicit.py).
+
+        ``clear``: the contact pass of this same step evaluates the heat of the next state
+        (heat every step): the explicit update then zeroes the mechanism rates and conductance
+        sums it has read (``rates_cleared``), so that the force reset need not. Nothing reads
+        them in between (outputs are written after the step)."""
         if self.implicit is not None:
             self.implicit.step(dt, time)
             self.thermal_steps += 1
@@ -650,8 +657,9 @@ class ThermalEngine:
             self.limit, where, absorbed, bad = kernels.euler_step(
                 p.temperature, p.heat_rate, by_mech, self.sum_columns, source, p.mass, p.type_id,
                 self.specific_heat_by_type, self.conductance_sum, fixed, dt,
-                self.euler_partials,
+                self.euler_partials, clear,
             )  # fmt: skip
+            self.rates_cleared = clear
             boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
             boundary = boundary[self.boundary_columns]
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
