@@ -102,6 +102,7 @@ DERIVED: tuple[str, ...] = (
     "rebuild_every_step",
     "callbacks",
     "chunk_check",
+    "_complete",  # the argument of the step in progress
     "_no_heat",
     "mechanisms",
     # the thread count: the new process's request or choice (results do not depend on it)
@@ -151,6 +152,7 @@ def _pair_state(buf: Any) -> dict[str, np.ndarray]:
 
 def capture(sim: Simulation) -> dict[str, Any]:
     """The complete restart state of ``sim`` (copies; the simulation can go on)."""
+    sim.complete_rates()  # the stored heat rates are complete (Simulation.step)
     scalars: dict[str, Any] = {name: _plain(getattr(sim, name)) for name in SCALARS}
     scalars["ledger_cumulative"] = {k: float(v) for k, v in sim.ledger_cumulative.items()}
     scalars["rng"] = sim.rng.bit_generator.state

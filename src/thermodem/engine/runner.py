@@ -262,7 +262,7 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
                 if stop.signum:
                     raise KeyboardInterrupt
                 in_step = True
-                sim.step()
+                sim.step(complete=False)  # the writers below complete the heat rates
                 in_step = False
                 k = sim.step_count
                 if k % run.series_every == 0:
@@ -274,6 +274,7 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
                     run.status.update(**_status_numbers(sim, run))
                 progress.update(sim)
                 if run.callback is not None and k % run.every == 0:
+                    sim.complete_rates()
                     run.callback(sim)
     except SimulationError as exc:
         raise _failed(sim, run, exc) from None

@@ -147,6 +147,8 @@ class ThermalEngine:
         self.reuse_conductance = True
         #: the last explicit update zeroed the mechanism rates and conductance sums (step)
         self.rates_cleared = False
+        #: the source column and total heat rates are not formed yet (after_contact_pass)
+        self.rates_pending = False
         # the implicit schemes read the per-pair conductances of every term at every state
         # (engine/implicit.py); the passes then store them also with k(T) tables
         self.record_conductances = settings.scheme != "explicit"
@@ -598,17 +600,29 @@ class ThermalEngine:
         self.fresh = False
         return self.finish(time)
 
-    def after_contact_pass(self, time: float) -> None:
+    def after_contact_pass(self, time: float, complete: bool = True) -> None:
         """The fused contact pass has added the contact conduction of this state: add every
-        other term and form the total heat rates, for the thermal step that follows."""
+        other term and (``complete``) form the source column and total heat rates, which the
+        thermal step that follows forms anyway: without ``complete`` they are left to it, or
+        to :meth:`complete_rates` when something reads them first (``rates_pending``)."""
         self._fixed_and_sources(time)
         self.evaluate_terms(time)
-        self.finish(time)
+        if complete:
+            self.finish(time)
+        else:
+            self.rates_pending = True
+
+    def complete_rates(self) -> None:
+        """Form the source column and the total heat rates if the last contact pass left
+        them to the next thermal step (outputs, checkpoints and the API call this)."""
+        if self.rates_pending:
+            self.finish(self.sim.time)
 
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
         kernels.finish_heat(self.source, p.heat_rate, p.heat_rate_by_mechanism, self.sum_columns)
+        self.rates_pending = False
         return self.fixed
 
     def specific_heat(self) -> np.ndarray:
@@ -643,6 +657,7 @@ class ThermalEngine:
         by_mech = p.heat_rate_by_mechanism
         if self.has_c_table:
             kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)
+            self.rates_pending = False
             c = self.specific_heat()
             self.limit, where = kernels.stability_limit(p.mass, c, self.conductance_sum, fixed)
             boundary = by_mech[:, self.boundary_columns].sum(axis=0)
@@ -660,6 +675,7 @@ class ThermalEngine:
                 self.euler_partials, clear,
             )  # fmt: skip
             self.rates_cleared = clear
+            self.rates_pending = False  # the update formed them
             boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
             boundary = boundary[self.boundary_columns]
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
@@ -727,6 +743,7 @@ class ThermalEngine:
         ``heat_rate_<mechanism>``: for pairwise mechanisms the heat exchanged, ½ Σ|Q_i| (they
         sum to zero); for boundary mechanisms the net heat into the particles, Σ Q_i.
         """
+        self.complete_rates()
         p = self.sim.particles
         out: dict[str, float] = {}
         if p.count:
