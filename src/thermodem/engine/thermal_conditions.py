@@ -129,11 +129,26 @@ class ThermalConditions:
         rows = n // CHUNK + 1
         if self._part.shape[0] < rows:
             self._part = np.zeros(rows)
-        reset = apply_conditions(
-            p.position, p.radius, p.mass, p.type_id, p.temperature, specific_heat_by_type,
-            self.static_mask, self.kinds, self.values, self.has_region, self.boxes, self.fixed,
-            self.source, self._part,
-        )  # fmt: skip
+        own = self.sim.owned_count
+        if own == n:
+            reset = apply_conditions(
+                p.position, p.radius, p.mass, p.type_id, p.temperature, specific_heat_by_type,
+                self.static_mask, self.kinds, self.values, self.has_region, self.boxes,
+                self.fixed, self.source, self._part,
+            )  # fmt: skip
+        else:
+            # on several MPI ranks: the ghosts (after the owned particles) get the same
+            # conditions as on their owners, but only the owned particles' reset energy
+            # enters this rank's ledger (thermodem.mpi)
+            reset = 0.0
+            for part in (slice(0, own), slice(own, n)):
+                r = apply_conditions(
+                    p.position[part], p.radius[part], p.mass[part], p.type_id[part],
+                    p.temperature[part], specific_heat_by_type, self.static_mask[part],
+                    self.kinds, self.values, self.has_region, self.boxes, self.fixed[part],
+                    self.source[part], self._part,
+                )  # fmt: skip
+                reset = r if part.start == 0 else reset
         for e in self.settings.external_source:
             if not (e.start_time <= time < e.end_time):
                 continue
