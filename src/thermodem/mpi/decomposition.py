@@ -111,14 +111,18 @@ def bisect(
         found = np.zeros(m, np.bool_)
         best = 0.5 * (a + b)
         best_err = np.full(m, np.iinfo(np.int64).max)
-        node_index = {node: q for q, (node, *_rest) in enumerate(level)}
-        local_q = np.array([node_index.get(int(k), -1) for k in member], np.int64)
-        coord = position[np.arange(n_local), ax[local_q]] if n_local else np.zeros(0)
+        lut = np.full(nodes, -1, np.int64)
+        lut[[node for node, *_rest in level]] = np.arange(m)
+        local_q = np.where(member >= 0, lut[member.clip(0)], -1)
+        active = np.nonzero(local_q >= 0)[0]  # (particles of the boxes still being cut)
+        active_q = local_q[active]
+        coord = np.zeros(n_local)
+        coord[active] = position[active, ax[active_q]]
         for _ in range(MAX_ITERATIONS):
             mid = np.where(found, best, 0.5 * (a + b))
             below = np.zeros(m, np.int64)
-            if n_local:
-                np.add.at(below, local_q, coord < mid[local_q])
+            if active.shape[0]:
+                np.add.at(below, active_q, coord[active] < mid[active_q])
             below = allreduce_sum(comm, below)
             err = np.abs(below - target)
             better = (err < best_err) & ~found
@@ -131,7 +135,7 @@ def bisect(
             b = np.where(~found & high, mid, b)
             a = np.where(~found & ~high, mid, a)
         new_level = []
-        side = np.zeros(n_local, np.int64)
+        side = member.copy()  # (particles in a finished box keep its leaf)
         for q, (node, lo, hi, first, ranks, _count) in enumerate(level):
             c = float(best[q])
             axis[node], cut[node] = ax[q], c
@@ -161,10 +165,10 @@ def bisect(
         member = side if n_local else member
         # exact counts of the new open nodes
         if new_level:
-            ids = {k: e for e, (k, *_rest) in enumerate(new_level)}
-            counts = np.zeros(len(new_level), np.int64)
-            for k, e in ids.items():
-                counts[e] = int(np.count_nonzero(member == k))
+            lut = np.full(nodes, -1, np.int64)
+            lut[[k for k, *_rest in new_level]] = np.arange(len(new_level))
+            open_q = np.where(member >= 0, lut[member.clip(0)], -1)
+            counts = np.bincount(open_q[open_q >= 0], minlength=len(new_level)).astype(np.int64)
             counts = allreduce_sum(comm, counts)
             new_level = [
                 (k, lo, hi, r0, nr, int(counts[e]))

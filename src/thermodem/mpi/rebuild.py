@@ -120,6 +120,8 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     if sim.skin is None and r_max > 0:
         sim.skin = 0.2 * r_max  # the serial default (engine/neighbor_list.py: cell_size)
     cell = 2.0 * r_max + sim.extra + (sim.skin or 0.0)
+    if not cell > 0.0:  # no particles (a restart's empty start): one cell
+        cell = float(np.max(sim.upper - sim.lower))
     length = sim.upper - sim.lower
     for a in range(3):
         if sim.periodic[a] and length[a] < 2.0 * cell:
@@ -161,7 +163,7 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
             glo[a] = max(sim.lower[a], box[0, a] - h)
             ghi[a] = min(sim.upper[a], box[1, a] + h)
     sim._grid = (glo, ghi, gper)
-    dims, edge = NB.cell_grid(glo, ghi, max(cell, 1e-300), gper)
+    dims, edge = NB.cell_grid(glo, ghi, cell, gper)
     axis = int(SL.choose_axis(owned.position, glo, edge, dims)) if owned.count else 0
     axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
     order = _cell_order(owned.position, glo, edge, dims, axes)

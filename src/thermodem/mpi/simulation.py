@@ -371,7 +371,7 @@ def halo_width(sim: DistributedSimulation, r_max: float) -> float:
     """2 R_max + skin + max(extra distance, largest conducting gap of the range set)."""
     gap = 0.0
     th = sim.thermal
-    if th is not None:
+    if th is not None and r_max > 0.0:  # (no particles yet: a restart's empty start)
         for term in th.terms:
             if term.target == "range":
                 g, w = term.max_gap(r_max)
