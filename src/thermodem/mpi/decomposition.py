@@ -63,6 +63,21 @@ class Decomposition:
             node[todo[~leaf]] = child[~leaf]
         return rank
 
+    def rotated(self, shift: int) -> Decomposition:
+        """The same boxes handed to other ranks: box r to rank (r + shift) mod P (tests use it
+        to make every particle migrate at every rebuild)."""
+        size = self.size
+
+        def relabel(child: np.ndarray) -> np.ndarray:
+            leaf = child < 0
+            out = child.copy()
+            out[leaf] = -((-child[leaf] - 1 + shift) % size) - 1
+            return out
+
+        boxes = np.empty_like(self.boxes)
+        boxes[(np.arange(size) + shift) % size] = self.boxes
+        return Decomposition(self.axis, self.cut, relabel(self.left), relabel(self.right), boxes)
+
     def state(self) -> dict[str, Any]:
         return {
             "axis": self.axis.tolist(),

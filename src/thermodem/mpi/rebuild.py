@@ -137,6 +137,8 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
         if sim.decomposition is not None:
             sim.rebalances += 1
         sim.decomposition = bisect(comm, owned.position, sim.lower, sim.upper, size)
+    if sim.rotate_owners:  # (tests: every particle migrates, the results must not change)
+        sim.decomposition = sim.decomposition.rotated(1)
     # 4. migration
     dest = sim.decomposition.owner(owned.position)
     sim.migrated += int(np.count_nonzero(dest != sim.rank))

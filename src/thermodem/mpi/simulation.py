@@ -81,6 +81,9 @@ class DistributedSimulation(Simulation):
         self.rank = self.comm.Get_rank()
         self.size = self.comm.Get_size()
         self.rebalance_threshold = float(rebalance_threshold)
+        #: hand each box to the next rank at every rebuild, so that every particle migrates
+        #: with its state and pair histories (a test of the migration; results do not change)
+        self.rotate_owners = False
         self._owned = 0
         self._total = 0
         self._distributed = False  # every rank holds the same full set until the first build
