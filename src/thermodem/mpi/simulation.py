@@ -93,6 +93,8 @@ class DistributedSimulation(Simulation):
         self.rebalances = 0
         self.migrated = 0
         self.rebuild_seconds = 0.0
+        #: seconds in the per-step reductions (they include waiting for the slowest rank)
+        self.reduce_seconds = 0.0
         self._grid: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self.mirror: PairBuffers | None = None
         self.stop_requested = 0  # set by a signal handler of this rank
@@ -143,7 +145,9 @@ class DistributedSimulation(Simulation):
         """Collective: the maximum over the ranks of ``values``; if any rank has an ``error``,
         every rank raises the error of the lowest such rank (the same message everywhere)."""
         code = float(self.size - self.rank) if error is not None else 0.0
+        t0 = wallclock.perf_counter()
         out = X.allreduce_max(self.comm, np.array([code, *values], np.float64))
+        self.reduce_seconds += wallclock.perf_counter() - t0
         if out[0] > 0:
             source = self.size - int(out[0])
             payload = None
@@ -159,9 +163,11 @@ class DistributedSimulation(Simulation):
         """One reduction per thermal step: the smallest limit and the lowest rank with a bad
         temperature; the particle of the limit is asked for only when the limit is exceeded
         (the message names it)."""
+        t0 = wallclock.perf_counter()
         out = X.allreduce_min(
             self.comm, np.array([limit, self.rank if bad_particle >= 0 else self.size], float)
         )
+        self.reduce_seconds += wallclock.perf_counter() - t0
         global_limit, source = float(out[0]), int(out[1])
         th = self.thermal
         particle = -1
@@ -213,7 +219,9 @@ class DistributedSimulation(Simulation):
 
     def _check_overlap(self) -> None:
         limit = self.case.simulation.max_overlap_ratio
+        t0 = wallclock.perf_counter()
         worst = float(X.allreduce_max(self.comm, np.array([self.max_overlap_ratio]))[0])
+        self.reduce_seconds += wallclock.perf_counter() - t0
         if worst <= limit:
             return
         error = None
@@ -326,6 +334,18 @@ class DistributedSimulation(Simulation):
 
         load_distributed(self, state)
 
+    @classmethod
+    def from_checkpoint(
+        cls, path: str, threads: int | None = None, case: Case | None = None
+    ) -> DistributedSimulation:
+        """A distributed simulation continuing from a checkpoint written by any number of
+        ranks (collective: every rank reads the file)."""
+        from thermodem.io.checkpoint import Checkpoint, read_checkpoint
+        from thermodem.mpi.runner import _build
+
+        ckpt = path if isinstance(path, Checkpoint) else read_checkpoint(path)
+        return _build(case or ckpt.case(), threads, REBALANCE_THRESHOLD, ckpt)
+
     def halo_summary(self) -> dict[str, float]:
         """Communication and balance figures of this run so far (collective)."""
         counts = X.allreduce_max(
@@ -333,8 +353,10 @@ class DistributedSimulation(Simulation):
         )
         sums = X.allreduce_sum(
             self.comm,
-            np.array([self.owned_count, self.ghost_count, self.halo.seconds, self.rebuild_seconds]),
-        )
+            np.array([self.owned_count, self.ghost_count, self.halo.seconds, self.rebuild_seconds,
+                      self.reduce_seconds, self.mirror.count if self.mirror else 0,
+                      self.pairs.count]),
+        )  # fmt: skip
         return {
             "ranks": self.size,
             "particles": int(sums[0]),
@@ -344,6 +366,9 @@ class DistributedSimulation(Simulation):
             "imbalance": float(counts[0] * self.size / max(sums[0], 1) - 1.0),
             "halo_seconds_mean": float(sums[2] / self.size),
             "rebuild_seconds_mean": float(sums[3] / self.size),
+            "reduce_seconds_mean": float(sums[4] / self.size),
+            "mirror_pairs": int(sums[5]),
+            "pairs": int(sums[6]),
             "rebalances": self.rebalances,
         }
 
