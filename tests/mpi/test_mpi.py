@@ -286,6 +286,37 @@ def test_periodic_bed_with_range_set_on_2_ranks(tmp_path: Path) -> None:
     _assert_same_ledgers(tmp_path / "p1", tmp_path / "p2")
 
 
+@needs_mpi
+def test_thermal_options_and_a_moving_plate_on_2_ranks(tmp_path: Path) -> None:
+    """A c(T) table, the resistance network with the conductance reuse (its columns in
+    the contact history), substeps 'auto', a heat flux into the
+    top layer and a plate pressing the bed down (the particles move: rebuilds, migration):
+    300 steps on 2 ranks against the serial run."""
+    steps = 300
+    case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=steps * DT)
+    glass = case["materials"]["glass"]
+    glass["specific_heat_table"] = [[300.0, 800.0], [400.0, 900.0]]
+    glass.update(microhardness=3e9, surface_roughness=1e-6, surface_slope=0.1,
+                 thermal_accommodation=0.8, youngs_modulus_real=7e10)  # fmt: skip
+    case["thermal"].update(direct_conduction="resistance_network", substeps="auto",
+                           conductance_force_tolerance=0.01)  # fmt: skip
+    case["thermal"]["heat_flux"] = [{"flux": 2e4, "select": {"region": {
+        "lower": [0, 0, 8e-3], "upper": [SIDE, SIDE, HEIGHT]}}}]  # fmt: skip
+    top = float(np.loadtxt(DATA / "mpi_bed_box.txt", skiprows=1)[:, 2].max()) + 1e-3
+    case["walls"].append({"kind": "plane", "point": [0, 0, top], "normal": [0, 0, -1],
+                          "velocity": [0, 0, -0.2], "material": "glass"})  # fmt: skip
+    case["neighbors"] = {"skin": 5e-5}  # (rebuilds every few steps)
+    case["output"] = {"vtu": False, "timeseries_interval": 50 * DT}
+    path = _write_case(tmp_path / "options.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"o{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    _assert_same_state(_final(tmp_path / "o1", steps), _final(tmp_path / "o2", steps))
+    _assert_same_ledgers(tmp_path / "o1", tmp_path / "o2")
+    log = (tmp_path / "o2" / "run.log").read_text()
+    assert "MPI: 2 ranks" in log
+
+
 MIGRATION_SCRIPT = """
 import sys, numpy as np, yaml
 from thermodem.config.load import case_from_dict

@@ -263,11 +263,13 @@ class ThermalEngine:
         if self.has_c_table and self.conditions.active:
             before = p.temperature.copy()
             fixed, source, _ = self.conditions.apply(time, self.specific_heat_by_type)
-            after = p.temperature[fixed]
+            own = fixed.copy()
+            own[self.sim.owned_count :] = False  # (on several MPI ranks: not the ghosts)
+            after = p.temperature[own]
             self.cumulative["fixed_reset"] += kernels.total_enthalpy(
-                after, p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+                after, p.mass[own], p.type_id[own], self.c_t, self.c_v, self.c_n
             ) - kernels.total_enthalpy(
-                before[fixed], p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+                before[own], p.mass[own], p.type_id[own], self.c_t, self.c_v, self.c_n
             )
             return fixed, source
         fixed, source, reset = self.conditions.apply(time, self.specific_heat_by_type)
