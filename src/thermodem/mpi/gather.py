@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermodem.engine.simulation import LEDGER_DISSIPATION
-from thermodem.kernels import contact as C
 from thermodem.mpi import exchange as X
 from thermodem.state import heat
 from thermodem.state.particles import Particles
@@ -363,4 +362,4 @@ def load_distributed(sim: DistributedSimulation, state: dict) -> None:
     sim.set_threads()
 
 
-__all__ = ["C", "GatheredView", "gathered_state", "gathered_view", "global_report"]
+__all__ = ["GatheredView", "gathered_state", "gathered_view", "global_report"]

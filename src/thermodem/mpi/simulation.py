@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from thermodem.config.schema import Case
-from thermodem.engine.neighbor_list import cell_size, rebuild_due
+from thermodem.engine.neighbor_list import rebuild_due
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
@@ -407,4 +407,4 @@ def halo_width(sim: DistributedSimulation, r_max: float) -> float:
     return 2.0 * r_max + (sim.skin or 0.0) + max(sim.extra, gap)
 
 
-__all__ = ["DistributedSimulation", "cell_size", "halo_members", "halo_width", "neighbour_ranks"]
+__all__ = ["DistributedSimulation", "halo_members", "halo_width", "neighbour_ranks"]
