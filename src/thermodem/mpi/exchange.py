@@ -71,20 +71,20 @@ def row_width(p: Particles, extra_widths: tuple[int, ...] = ()) -> int:
 
 
 def pack_particles(
-    p: Particles, index: np.ndarray, extras: tuple[np.ndarray, ...] = ()
+    p: Particles, index: np.ndarray | slice, extras: tuple[np.ndarray, ...] = ()
 ) -> np.ndarray:
-    """Rows of the particles ``index``: every Particles array, then the ``extras`` (per
-    particle arrays, 1-D or 2-D)."""
+    """Rows of the particles ``index`` (indices, or a slice: no copy before the packing):
+    every Particles array, then the ``extras`` (per particle arrays, 1-D or 2-D)."""
     layout = row_layout(p)
     widths = tuple(1 if e.ndim == 1 else int(e.shape[1]) for e in extras)
-    rows = np.empty((index.shape[0], row_width(p, widths)))
+    m = p.radius[index].shape[0]
+    rows = np.empty((m, row_width(p, widths)))
     c = 0
     for name, w in layout:
-        a = getattr(p, name)[index]
-        rows[:, c : c + w] = a.reshape(index.shape[0], w)
+        rows[:, c : c + w] = getattr(p, name)[index].reshape(m, w)
         c += w
     for e, w in zip(extras, widths, strict=True):
-        rows[:, c : c + w] = e[index].reshape(index.shape[0], w)
+        rows[:, c : c + w] = e[index].reshape(m, w)
         c += w
     return rows
 

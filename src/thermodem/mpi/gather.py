@@ -166,7 +166,7 @@ def _gathered_particles(
     """The owned particles of every rank (with per-particle ``extras``) on rank 0, sorted by
     global id; None on the other ranks."""
     n = sim.owned_count
-    rows = X.pack_particles(sim.particles, np.arange(n), extras)
+    rows = X.pack_particles(sim.particles, slice(0, n), extras)
     widths = tuple(1 if e.ndim == 1 else int(e.shape[1]) for e in extras)
     rows = gather_rows(sim.comm, rows)
     if rows is None:

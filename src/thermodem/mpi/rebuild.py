@@ -142,7 +142,7 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     # 4. migration
     dest = sim.decomposition.owner(owned.position)
     sim.migrated += int(np.count_nonzero(dest != sim.rank))
-    rows = X.pack_particles(owned, np.arange(owned.count), extra_own)
+    rows = X.pack_particles(owned, slice(0, owned.count), extra_own)
     width = rows.shape[1]
     rows, _ = X.alltoallv_rows(comm, _split(dest, rows, size), width)
     rec_width = records.shape[1]
