@@ -40,17 +40,18 @@ if TYPE_CHECKING:
 # ------------------------------------------------------------------------------- records
 def pair_records(
     buf: PairBuffers, global_id: np.ndarray, selected: np.ndarray, wall: bool
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
     """Rows ``[gid_i, gid_j or wall, history...]`` of the pairs with a non-zero history whose
-    particle i is ``selected`` (a mask over the particles)."""
+    particle i is ``selected`` (a mask over the particles), and the index of each one's i."""
     c = buf.count
     history = buf.history[:c]
-    keep = np.any(history != 0.0, axis=1) & selected[buf.i[:c]]
-    rows = np.empty((int(keep.sum()), 2 + history.shape[1]))
-    rows[:, 0] = global_id[buf.i[:c][keep]]
-    rows[:, 1] = buf.j[:c][keep] if wall else global_id[buf.j[:c][keep]]
+    keep = np.nonzero(np.any(history != 0.0, axis=1) & selected[buf.i[:c]])[0]
+    owner = buf.i[keep].astype(np.int64)
+    rows = np.empty((keep.shape[0], 2 + history.shape[1]))
+    rows[:, 0] = global_id[owner]
+    rows[:, 1] = buf.j[keep] if wall else global_id[buf.j[keep]]
     rows[:, 2:] = history[keep]
-    return rows
+    return rows, owner
 
 
 def _positions_of(global_id: np.ndarray, wanted: np.ndarray) -> np.ndarray:
@@ -103,8 +104,10 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     selected = np.zeros(n_all, np.bool_)
     selected[first:last] = True
     # 2. records, the per-particle thermal arrays
-    records = pair_records(sim.pairs, p.global_id, selected, wall=False)
-    wall_records = pair_records(sim.walls, p.global_id, selected, wall=True)
+    records, rec_owner = pair_records(sim.pairs, p.global_id, selected, wall=False)
+    wall_records, wall_owner = pair_records(sim.walls, p.global_id, selected, wall=True)
+    rec_owner -= first  # (index in the share)
+    wall_owner -= first
     extras: tuple[np.ndarray, ...] = ()
     if th is not None:
         cs = th.conductance_sum if th.conductance_sum.shape[0] == n_all else np.zeros(n_all)
@@ -140,19 +143,30 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     if sim.rotate_owners:  # (tests: every particle migrates, the results must not change)
         sim.decomposition = sim.decomposition.rotated(1)
     # 4. migration
+    # (only the particles that leave are packed and sent; the others stay in place)
     dest = sim.decomposition.owner(owned.position)
-    sim.migrated += int(np.count_nonzero(dest != sim.rank))
-    rows = X.pack_particles(owned, slice(0, owned.count), extra_own)
-    width = rows.shape[1]
-    rows, _ = X.alltoallv_rows(comm, _split(dest, rows, size), width)
-    rec_width = records.shape[1]
-    rec_dest = dest[_positions_of(owned.global_id, records[:, 0].astype(np.int64))]
-    records, _ = X.alltoallv_rows(comm, _split(rec_dest, records, size), rec_width)
-    wall_dest = dest[_positions_of(owned.global_id, wall_records[:, 0].astype(np.int64))]
-    wall_records, _ = X.alltoallv_rows(comm, _split(wall_dest, wall_records, size), rec_width)
+    leave = dest != sim.rank
+    sim.migrated += int(np.count_nonzero(leave))
+    leaving = np.nonzero(leave)[0]
     widths = tuple(1 for _ in extras)
-    owned, extra_own = X.unpack_particles(rows, owned, widths)
+    width = X.row_width(owned, widths)
+    rows = X.pack_particles(owned, leaving, extra_own)
+    rows, _ = X.alltoallv_rows(comm, _split(dest[leaving], rows, size), width)
+    arrived, extra_arrived = X.unpack_particles(rows, owned, widths)
     del rows
+    rec_width = records.shape[1]
+    moved_records = []
+    for recs, owner in ((records, rec_owner), (wall_records, wall_owner)):
+        go = leave[owner]
+        sent, _ = X.alltoallv_rows(comm, _split(dest[owner[go]], recs[go], size), rec_width)
+        moved_records.append(np.concatenate([recs[~go], sent]))
+    records, wall_records = moved_records
+    if leaving.shape[0] or arrived.count:  # (else the owned particles stay as they are)
+        staying = np.nonzero(~leave)[0]
+        owned = X.concatenate_particles([X.take_particles(owned, staying), arrived])
+        extra_own = [
+            np.concatenate([e[staying], a]) for e, a in zip(extra_own, extra_arrived, strict=True)
+        ]
     # 5. this rank's grid; the owned particles sorted by its cells
     h = halo_width(sim, r_max)
     sim.halo_width = h
