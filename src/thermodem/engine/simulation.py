@@ -73,6 +73,9 @@ LEDGER_DISSIPATION = (
 class Simulation:
     """A thermal DEM simulation built from a validated :class:`~thermodem.config.schema.Case`."""
 
+    #: the MPI communicator of a run on several ranks (``thermodem.mpi``); None here
+    comm = None
+
     def __init__(
         self, case: Case, threads: int | None = None, *, insert_particles: bool = True
     ) -> None:
@@ -216,6 +219,40 @@ class Simulation:
         )
         numba.set_num_threads(self.threads)
         return self.threads
+
+    # ---------------------------------------------- ranks (thermodem.mpi overrides these)
+    @property
+    def owned_count(self) -> int:
+        """Particles this process owns: all of them (on several MPI ranks, the first
+        ``owned_count`` of ``particles``; the ghosts follow)."""
+        return self.particles.count
+
+    @property
+    def global_count(self) -> int:
+        """Particles of the whole simulation (on every MPI rank together)."""
+        return self.particles.count
+
+    @property
+    def global_contacts(self) -> int:
+        """Touching contacts of the whole simulation at the last report (on several MPI
+        ranks, updated by each time-series row)."""
+        return self.contact_count
+
+    def sum_over_ranks(self, value: float) -> float:
+        """``value`` summed over the MPI ranks (itself here)."""
+        return value
+
+    def grid_box(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lower, upper, periodic) of the region the neighbour grids cover: the domain (on
+        several MPI ranks, this rank's box with its halo)."""
+        return self.lower, self.upper, self.periodic
+
+    def agree_thermal(
+        self, limit: float, limit_particle: int, bad_particle: int, bad_temperature: float
+    ) -> tuple[float, int, int, float]:
+        """The explicit Euler limit, its particle (global id) and the first particle with a
+        bad temperature (global id or -1) of the whole simulation (the arguments here)."""
+        return limit, limit_particle, bad_particle, bad_temperature
 
     # ------------------------------------------------------------------ particles in and out
     def add_particles(self, new: InsertedParticles) -> None:

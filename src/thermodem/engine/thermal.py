@@ -270,11 +270,13 @@ class ThermalEngine:
         if self.has_c_table and self.conditions.active:
             before = p.temperature.copy()
             fixed, source, _ = self.conditions.apply(time, self.specific_heat_by_type)
-            after = p.temperature[fixed]
+            own = fixed.copy()
+            own[self.sim.owned_count :] = False  # (on several MPI ranks: not the ghosts)
+            after = p.temperature[own]
             self.cumulative["fixed_reset"] += kernels.total_enthalpy(
-                after, p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+                after, p.mass[own], p.type_id[own], self.c_t, self.c_v, self.c_n
             ) - kernels.total_enthalpy(
-                before[fixed], p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+                before[own], p.mass[own], p.type_id[own], self.c_t, self.c_v, self.c_n
             )
             return fixed, source
         fixed, source, reset = self.conditions.apply(time, self.specific_heat_by_type)
@@ -698,31 +700,43 @@ class ThermalEngine:
             self.evaluate_terms(time)
             fixed, source = self.fixed, self.source
         self.fresh = False
-        by_mech = p.heat_rate_by_mechanism
+        # the particles this process owns: all of them (on several MPI ranks the first
+        # owned_count, the ghosts after them are updated by their owners, thermodem.mpi)
+        n = sim.owned_count
+        temperature, heat_rate, mass = p.temperature[:n], p.heat_rate[:n], p.mass[:n]
+        by_mech, type_id = p.heat_rate_by_mechanism[:n], p.type_id[:n]
+        fixed, source, conductance = fixed[:n], source[:n], self.conductance_sum[:n]
         if self.has_c_table:
-            kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)
+            kernels.finish_heat(source, heat_rate, by_mech, self.sum_columns)
             self.rates_pending = False
-            c = self.specific_heat()
-            self.limit, where = kernels.stability_limit(p.mass, c, self.conductance_sum, fixed)
+            c = self.specific_heat()[:n]
+            limit, where = kernels.stability_limit(mass, c, conductance, fixed)
             boundary = by_mech[:, self.boundary_columns].sum(axis=0)
-            absorbed, bad = kernels.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
-                                                          p.type_id, self.c_t, self.c_v,
-                                                          self.c_n, fixed, dt)  # fmt: skip
+            absorbed, bad = kernels.euler_update_enthalpy(temperature, heat_rate, mass, type_id,
+                                                          self.c_t, self.c_v, self.c_n, fixed,
+                                                          dt)  # fmt: skip
         else:
             # one fused pass: heat rate, Euler limit, update and the ledger sums
-            rows = p.count // kernels.EULER_CHUNK + 1
+            rows = n // kernels.EULER_CHUNK + 1
             if self.euler_partials.shape[0] < rows:
                 self.euler_partials = np.zeros((rows, self.euler_partials.shape[1]))
-            self.limit, where, absorbed, bad = kernels.euler_step(
-                p.temperature, p.heat_rate, by_mech, self.sum_columns, source, p.mass, p.type_id,
-                self.specific_heat_by_type, self.conductance_sum, fixed, dt,
-                self.euler_partials, clear,
+            limit, where, absorbed, bad = kernels.euler_step(
+                temperature, heat_rate, by_mech, self.sum_columns, source, mass, type_id,
+                self.specific_heat_by_type, conductance, fixed, dt, self.euler_partials, clear,
             )  # fmt: skip
-            self.rates_cleared = clear
+            # (with MPI ghosts after the owned particles the force reset zeroes them all)
+            self.rates_cleared = clear and n == p.count
             self.rates_pending = False  # the update formed them
             boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
             boundary = boundary[self.boundary_columns]
-        self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
+        gid = p.global_id
+        # the whole simulation's limit and failure (the same on every MPI rank)
+        self.limit, self.limit_particle, bad_gid, bad_temperature = sim.agree_thermal(
+            float(limit),
+            int(gid[where]) if where >= 0 else -1,
+            int(gid[bad]) if bad >= 0 else -1,
+            float(temperature[bad]) if bad >= 0 else math.nan,
+        )
         if dt > self.limit and not self.settings.stability.allow_unstable:
             raise SimulationError(
                 f"thermal time step {dt:.4g} s exceeds the explicit Euler limit m c / ΣH = "
@@ -737,15 +751,14 @@ class ThermalEngine:
             self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
-        if bad >= 0:
-            gid = int(p.global_id[bad])
+        if bad_gid >= 0:
             raise SimulationError(
-                f"temperature of particle {gid} became {p.temperature[bad]:.6g} K at step "
+                f"temperature of particle {bad_gid} became {bad_temperature:.6g} K at step "
                 f"{sim.step_count} (t = {time:.6g} s); likely cause: thermal time step "
                 f"{dt:.4g} s against the limit {self.limit:.4g} s",
                 sim.step_count,
                 time,
-                gid,
+                bad_gid,
             )
         if self.settings.substeps == "auto" and math.isfinite(self.limit):
             n = int(0.5 * self.limit / sim.dt)
@@ -755,12 +768,15 @@ class ThermalEngine:
     def thermal_energy(self, mask: np.ndarray | None = None) -> float:
         """Σ m c T over all particles (or ``mask``) [J] (Σ m h(T) with a tabulated c)."""
         p = self.sim.particles
-        t, m, ty = p.temperature, p.mass, p.type_id
+        n = self.sim.owned_count  # (all particles; on several MPI ranks the owned ones)
+        t, m, ty = p.temperature[:n], p.mass[:n], p.type_id[:n]
         if mask is not None:
-            t, m, ty = t[mask], m[mask], ty[mask]
+            t, m, ty = t[mask[:n]], m[mask[:n]], ty[mask[:n]]
         if self.has_c_table:
-            return kernels.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
-        return float(np.sum(m * self.specific_heat_by_type[ty] * t))
+            return self.sim.sum_over_ranks(
+                kernels.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
+            )
+        return self.sim.sum_over_ranks(float(np.sum(m * self.specific_heat_by_type[ty] * t)))
 
     def inserted(self, temperature: np.ndarray, mass: np.ndarray, type_id: np.ndarray) -> None:
         """Ledger the thermal energy that inserted particles bring in."""

@@ -190,11 +190,23 @@ class ThermalConditions:
         rows = self.listed.shape[0] // CHUNK + 1
         if self._part.shape[0] < rows:
             self._part = np.zeros(rows)
-        reset = apply_listed(
-            self.listed, self.code, p.position, p.radius, p.mass, p.type_id, p.temperature,
-            specific_heat_by_type, self.static_mask, self.kinds, self.values, self.has_region,
-            self.boxes, self.fixed, self.base_source, self.bath, self._part,
-        )  # fmt: skip
+        own = self.sim.owned_count
+        if own == n:
+            parts = (self.listed,)
+        else:
+            # on several MPI ranks the ghosts (after the owned particles) get the same
+            # conditions as on their owners, but only the owned particles' reset energy enters
+            # this rank's ledger (thermodem.mpi); `listed` is sorted
+            split = int(np.searchsorted(self.listed, own))
+            parts = (self.listed[:split], self.listed[split:])
+        reset = 0.0
+        for k, listed in enumerate(parts):
+            r = apply_listed(
+                listed, self.code, p.position, p.radius, p.mass, p.type_id, p.temperature,
+                specific_heat_by_type, self.static_mask, self.kinds, self.values,
+                self.has_region, self.boxes, self.fixed, self.base_source, self.bath, self._part,
+            )  # fmt: skip
+            reset = r if k == 0 else reset
         active = [e for e in self.settings.external_source if e.start_time <= time < e.end_time]
         if not active:
             self.source = self.base_source
