@@ -297,6 +297,12 @@ THERMAL_FROM_CASE: tuple[str, ...] = (
     "specific_heat_by_type",
 )  # fmt: skip
 THERMAL_LAYOUT: tuple[str, ...] = ("boundary_columns", "scratch", "term_scratch", "euler_partials")
+#: Thermal arrays computed again before they are read: a state may hold them empty (a
+#: checkpoint gathered from MPI ranks, thermodem.mpi.gather) with ``conductance_ready`` False.
+THERMAL_RECOMPUTED: tuple[str, ...] = (
+    "k_p", "rhoc_p", "k_w", "rhoc_w", "fields", "pair_conductance", "wall_conductance",
+    "external_wall_conductance",
+)  # fmt: skip
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -328,12 +334,15 @@ def keep_derived_thermal(engine: Any, scalars: dict[str, Any], arrays: dict[str,
 def check_thermal_arrays(engine: Any, arrays: dict[str, Any]) -> None:
     """ConfigError for a thermal state array that cannot be this engine's: another dtype kind
     or number of dimensions, other trailing dimensions, or fewer rows than the engine built
-    from the case allocates (the arrays grow with the pair lists; a short one is damaged)."""
+    from the case allocates (the arrays grow with the pair lists; a short one is damaged).
+    An empty :data:`THERMAL_RECOMPUTED` array is no damage: it is computed again."""
     for name, value in arrays.items():
         current = getattr(engine, name, None)
         if not isinstance(current, np.ndarray):
             continue
         saved = np.asarray(value)
+        if name in THERMAL_RECOMPUTED and saved.ndim and saved.shape[0] == 0:
+            continue
         if (
             saved.dtype.kind != current.dtype.kind
             or saved.ndim != current.ndim

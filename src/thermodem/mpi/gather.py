@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from thermodem.engine.restart import THERMAL_RECOMPUTED  # stored empty in a gathered checkpoint
 from thermodem.engine.simulation import LEDGER_DISSIPATION
 from thermodem.mpi import exchange as X
 from thermodem.state import heat
@@ -32,9 +33,6 @@ ENERGY_KEYS = ("kinetic_translational", "kinetic_rotational", "gravitational",
 LEDGER_KEYS = ("stiffness_work", "wall_work", "external_work", "inserted_energy")
 #: Per-particle arrays of the thermal engine: gathered with the particles in checkpoints.
 THERMAL_PARTICLE_ARRAYS = ("conductance_sum",)
-#: Thermal arrays recomputed before they are read (stored empty in a gathered checkpoint).
-THERMAL_RECOMPUTED = ("k_p", "rhoc_p", "k_w", "rhoc_w", "fields", "pair_conductance",
-                      "wall_conductance", "external_wall_conductance")  # fmt: skip
 
 
 # ---------------------------------------------------------------------------------- reports
@@ -196,9 +194,13 @@ class GatheredView:
     def coordination_number(self) -> np.ndarray:
         return self._coordination
 
+    def complete_rates(self) -> None:
+        """The ranks formed their heat rates before the gather (:func:`gathered_view`)."""
+
 
 def gathered_view(sim: DistributedSimulation) -> GatheredView | None:
     """The frame data gathered to rank 0 (None on the other ranks); collective."""
+    sim.complete_rates()  # heat rates left to the next thermal step (Simulation.step)
     z = sim.coordination_number()[: sim.owned_count].astype(np.float64)
     out = _gathered_particles(sim, (np.concatenate([z, np.zeros(sim.ghost_count)]),))
     if out is None:
@@ -241,6 +243,7 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
     """The restart state of the whole simulation on rank 0 (serial layout), None elsewhere."""
     from thermodem.engine.restart import SCALARS, _plain, step_length
 
+    sim.complete_rates()  # heat rates left to the next thermal step (Simulation.step)
     th = sim.thermal
     n_all = sim.particles.count
     extras = [sim.reference]

@@ -181,12 +181,14 @@ class DistributedSimulation(Simulation):
         return global_limit, particle, -1, float("nan")
 
     # ------------------------------------------------------------------------------ step
-    def step(self) -> None:
-        """One step on every rank (collective); see the module docstring."""
+    def step(self, complete: bool = True) -> None:
+        """One step on every rank (collective); see the module docstring. ``complete`` as in
+        :meth:`Simulation.step` (the total heat rates may be left to the next update)."""
+        self._complete = complete
         th = self.thermal
         if th is not None and self.step_count >= th.next_step:
             n = th.substeps
-            th.step(n * self.dt, self.time)
+            th.step(n * self.dt, self.time, clear=n == 1)
             th.next_step = self.step_count + n
         p = self.particles
         own = self.owned_count
@@ -308,6 +310,7 @@ class DistributedSimulation(Simulation):
     def report(self) -> dict[str, float]:
         from thermodem.mpi.gather import global_report
 
+        self.complete_rates()  # heat rates left to the next thermal step (Simulation.step)
         return global_report(self)
 
     def coordination_number(self) -> np.ndarray:
