@@ -178,6 +178,16 @@ def implicit_thermal_case() -> dict:
     return case
 
 
+def exponential_thermal_case() -> dict:
+    """The range-set bed frozen, the Krylov exponential (engine/exponential.py) with steps of
+    1 s: the basis started at t = 0 has 10 vectors after the first step and 15 from the
+    third; the run restarted after step 1 rebuilds the 10 from the saved origin and extends
+    them as the uninterrupted run did."""
+    case = implicit_thermal_case()
+    case["thermal"].update(time_step=1.0, scheme="exponential")
+    return case
+
+
 def _assert_same(a: Simulation, b: Simulation) -> None:
     for name, arr in a.particles.arrays().items():
         assert np.array_equal(arr, getattr(b.particles, name)), name
@@ -203,6 +213,7 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         (reuse_thermal_case, 101, 400),
         (range_thermal_case, 101, 400),
         (implicit_thermal_case, 7, 15),
+        (exponential_thermal_case, 1, 15),
     ],
     ids=[
         "drum-pour-epsd-moving-wall",
@@ -210,6 +221,7 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         "periodic-conductance-reuse",
         "periodic-range-set",
         "frozen-crank-nicolson",
+        "frozen-exponential",
     ],
 )
 def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -> None:

@@ -152,9 +152,16 @@ class ImplicitSolver:
         self.linear = engine.override == 0 and not any(
             t.target == "particles" for t in engine.terms
         )
+        self.exponential = None
+        if settings.scheme == "exponential":
+            from thermodem.engine.exponential import KrylovExponential
+
+            self.exponential = KrylovExponential(self)
 
     # ------------------------------------------------------------------ evaluation
-    def _rates(self, time: float) -> Rates:
+    def _rates(self, time: float, copies: bool = True) -> Rates:
+        """The engine's heat rates at the current temperatures and ``time``; ``copies``:
+        keep copies of the per-particle rates and temperatures (else empty arrays)."""
         eng = self.engine
         p = eng.sim.particles
         t0 = _time.perf_counter()
@@ -165,11 +172,12 @@ class ImplicitSolver:
         finally:
             eng.record_conductances = record
         by_mech = p.heat_rate_by_mechanism
+        empty = np.zeros(0)
         rates = Rates(
             boundary=by_mech[:, eng.boundary_columns].sum(axis=0),
             absorbed=float(p.heat_rate[fixed].sum()) if fixed.shape[0] else 0.0,
-            heat_rate=p.heat_rate.copy(),
-            temperature=p.temperature.copy(),
+            heat_rate=p.heat_rate.copy() if copies else empty,
+            temperature=p.temperature.copy() if copies else empty,
             time=time,
         )
         self.timings.evaluation += _time.perf_counter() - t0
@@ -315,6 +323,17 @@ class ImplicitSolver:
         self._hierarchy_key = key
         return ml.aspreconditioner(cycle="V")
 
+    # ------------------------------------------------------------------------ restart
+    def state(self) -> tuple[dict, dict]:
+        """What a checkpoint keeps of the solver (the exponential scheme's origin)."""
+        if self.exponential is not None:
+            return self.exponential.state()
+        return {}, {}
+
+    def load_state(self, scalars: dict, arrays: dict) -> None:
+        if self.exponential is not None:
+            self.exponential.load(scalars, arrays)
+
     # ----------------------------------------------------------------------- capacities
     def _enthalpy(self, temperature: np.ndarray) -> np.ndarray:
         eng = self.engine
@@ -332,6 +351,9 @@ class ImplicitSolver:
         non-smooth start (a wall or a layer switched to a new temperature) excites and that
         Crank–Nicolson alone damps only by (1 - x)/(1 + x) per step.
         """
+        if self.exponential is not None:
+            self.exponential.step(dt, time)
+            return
         if self.theta < 1.0 and self.engine.thermal_steps < self.options.startup_steps:
             self.theta = 1.0
             try:
