@@ -188,6 +188,14 @@ def exponential_thermal_case() -> dict:
     return case
 
 
+def trbdf2_thermal_case() -> dict:
+    """The range-set bed frozen, adaptive TR-BDF2 (engine/adaptive.py): the proposed internal
+    step and the last step's change (the predictor) are part of the checkpoint."""
+    case = implicit_thermal_case()
+    case["thermal"].update(time_step=0.5, scheme="tr_bdf2", implicit={"error_tolerance": 1e-4})
+    return case
+
+
 def _assert_same(a: Simulation, b: Simulation) -> None:
     for name, arr in a.particles.arrays().items():
         assert np.array_equal(arr, getattr(b.particles, name)), name
@@ -214,6 +222,7 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         (range_thermal_case, 101, 400),
         (implicit_thermal_case, 7, 15),
         (exponential_thermal_case, 1, 15),
+        (trbdf2_thermal_case, 3, 8),
     ],
     ids=[
         "drum-pour-epsd-moving-wall",
@@ -222,6 +231,7 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         "periodic-range-set",
         "frozen-crank-nicolson",
         "frozen-exponential",
+        "frozen-tr-bdf2",
     ],
 )
 def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -> None:

@@ -102,6 +102,7 @@ class KrylovExponential:
         self.origin_temperature = np.zeros(0)
         self.origin_vectors = 0
         self.origin_key = ""
+        self._buffer = np.zeros((0, 0))
         self._pending = False  # restored: rebuild the basis from the origin on the next step
 
     def _clear(self) -> None:
@@ -167,9 +168,11 @@ class KrylovExponential:
         self.norm = float(np.linalg.norm(r0))
         n = int(free.sum())
         rows = min(self.dimension, 32) + 1
-        self.basis = np.zeros((rows, n))
-        self.alpha = np.zeros(rows)
-        self.beta = np.zeros(rows)
+        if self._buffer.shape[1] != n:  # kept across bases (its pages are touched once)
+            self._buffer = np.zeros((rows, n))
+        self.basis = self._buffer
+        self.alpha = np.zeros(self.basis.shape[0])
+        self.beta = np.zeros(self.basis.shape[0])
         if self.norm > 0.0:
             self.basis[0] = r0 / self.norm
         else:
@@ -190,22 +193,27 @@ class KrylovExponential:
         t0 = _time.perf_counter()
         _, _, k_ff, scale, _, _, _ = self._data
         v_all = self.basis
+        work = np.empty(v_all.shape[1])
         while self.vectors < target and not self.exact:
             k = self.vectors
             if k + 1 >= v_all.shape[0]:
                 grow = min(2 * v_all.shape[0], self.dimension + 1)
                 new = np.zeros((grow, v_all.shape[1]))
                 new[: v_all.shape[0]] = v_all
-                self.basis = v_all = new
+                self.basis = self._buffer = v_all = new
                 self.alpha = np.resize(self.alpha, grow)
                 self.beta = np.resize(self.beta, grow)
             v = v_all[k]
-            w = scale * (k_ff @ (scale * v))
+            np.multiply(scale, v, out=work)
+            w = k_ff @ work
+            w *= scale
             self.solver.timings.cg_iterations += 1  # matrix products
             if k:
-                w -= self.beta[k - 1] * v_all[k - 1]
+                np.multiply(v_all[k - 1], self.beta[k - 1], out=work)
+                w -= work
             a = float(v @ w)
-            w -= a * v
+            np.multiply(v, a, out=work)
+            w -= work
             b = float(np.linalg.norm(w))
             self.alpha[k] = a
             self.beta[k] = b
@@ -214,7 +222,7 @@ class KrylovExponential:
             if b <= 1e-13 * max(abs(a), float(np.max(np.abs(self.alpha[: k + 1])))):
                 self.exact = True
                 break
-            v_all[k + 1] = w / b
+            np.divide(w, b, out=v_all[k + 1])
         self.solver.timings.solve += _time.perf_counter() - t0
 
     def _eigen(self, k: int) -> tuple[np.ndarray, np.ndarray]:
