@@ -67,6 +67,7 @@ class AdaptiveTRBDF2:
         self.accepted = 0
         self.rejected = 0
         self._previous: tuple[float, np.ndarray] | None = None  # (h, T_n - T_{n-1})
+        self.predict = True  # start the stages from the predictors (False: from T_n, T_γ)
 
     # --------------------------------------------------------------------------- step
     def step(self, dt: float, time: float) -> None:
@@ -131,7 +132,7 @@ class AdaptiveTRBDF2:
         h_n = solver._enthalpy(t_n) if eng.has_c_table else None
         # stage 1: Crank–Nicolson over γh
         guess = None
-        if self._previous is not None:
+        if self._previous is not None and self.predict:
             h_prev, slope = self._previous
             guess = t_n + (GAMMA * h / h_prev) * slope
         limit, where = solver.solve_stage(GAMMA * h, time + GAMMA * h, 0.5, t_n, h_n,
@@ -145,7 +146,7 @@ class AdaptiveTRBDF2:
         else:
             h_virtual = None
             t_virtual = A * t_g - B * t_n
-        guess = t_n + (t_g - t_n) / GAMMA
+        guess = t_n + (t_g - t_n) / GAMMA if self.predict else None
         solver.solve_stage(D * h, time + h, 1.0, t_virtual, h_virtual, None, guess)
         end = solver._rates(time + h)
         err = self._error(h, start, mid, end)
