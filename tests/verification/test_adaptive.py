@@ -153,3 +153,49 @@ def test_temperature_dependent_properties_conserve_enthalpy(tmp_path: Path) -> N
     adaptive = sim.thermal.implicit.adaptive
     stages = 2 * (adaptive.accepted + adaptive.rejected)
     assert sim.thermal.implicit.timings.picard_iterations > stages  # more than one per stage
+
+
+def _radiating_sphere_temperature(t: float, t0: float, t_env: float, a: float) -> float:
+    """dT/dt = a (T_e⁴ - T⁴): t(T) = [ln((T_e + T)/(T_e - T)) + 2 atan(T/T_e)]/(4 a T_e³)
+    from T₀ (closed form), inverted by bisection."""
+    from scipy.optimize import brentq
+
+    def elapsed(temp: float) -> float:
+        return (math.log((t_env + temp) / (t_env - temp)) + 2.0 * math.atan(temp / t_env)) / (
+            4.0 * a * t_env**3
+        )
+
+    return brentq(lambda temp: elapsed(temp) - elapsed(t0) - t, t0, t_env * (1 - 1e-15),
+                  xtol=1e-13, rtol=1e-15)  # fmt: skip
+
+
+ORDERS = [("backward_euler", 1.0), ("crank_nicolson", 2.0), ("tr_bdf2", 2.0)]
+
+
+@pytest.mark.parametrize(("scheme", "order"), ORDERS)
+def test_t4_radiation_converges_at_the_schemes_order(
+    tmp_path: Path, scheme: str, order: float
+) -> None:
+    """One sphere radiating with surroundings at 1000 K from 300 K (T⁴: the Picard iteration
+    on the linearised term, Newton's method since G = dQ/dT): the temperature at 4 s against
+    the closed form of dT/dt = εσA(T_e⁴ - T⁴)/(mc) converges at the scheme's order (TR-BDF2
+    at fixed internal steps), and the ledger's heat_in_radiation is the energy gained."""
+    mats = {"glass": dict(MATERIAL, emissivity=0.9)}
+    path = _write(tmp_path / "one.txt", [300.0])
+    a = 0.9 * 5.670374419e-8 * 4.0 * math.pi * R**2 / (MASS * C)
+    exact = _radiating_sphere_temperature(4.0, 300.0, 1000.0, a)
+    errors = []
+    for dt in (0.4, 0.2, 0.1):
+        implicit = {**FIXED_STEP, "initial_step": dt} if scheme == "tr_bdf2" else {}
+        radiation = {"model": "surroundings", "environment_temperature": 1000.0}
+        thermal = {"time_step": dt, "scheme": scheme, "implicit": implicit, "radiation": radiation}
+        sim = _sim(path, thermal, materials=mats)
+        u0 = sim.thermal.thermal_energy()
+        sim.run(until=4.0)
+        errors.append(abs(float(sim.particles.temperature[0]) - exact))
+        gained = sim.thermal.thermal_energy() - u0
+        assert sim.thermal.cumulative["heat_in_radiation"] == pytest.approx(gained, rel=1e-9)
+        assert sim.thermal.implicit.timings.picard_iterations > sim.step_count
+    assert 450.0 < exact < 900.0  # a real non-linear transient
+    observed = math.log2(errors[0] / errors[1]), math.log2(errors[1] / errors[2])
+    assert observed == pytest.approx((order, order), abs=0.1)
