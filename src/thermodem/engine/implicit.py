@@ -195,25 +195,32 @@ class ImplicitSolver:
         self._rates(time)
         t0 = _time.perf_counter()
         n = p.count
-        i, j, h = pair_lists(eng)
-        pair_sum = np.bincount(i, h, n) + np.bincount(j, h, n)
-        diag = eng.conductance_sum[:n] - pair_sum
-        # what the pairs left is the boundary conductance; round-off of the difference is
-        # not a conductance
-        diag[np.abs(diag) <= 1e-12 * np.abs(eng.conductance_sum[:n])] = 0.0
+        cached = self._network_cache
+        if self.linear and cached is not None and cached[3].shape[0] == n:
+            # frozen with constant properties: the conductances cannot have changed
+            i, j, h, diag = cached[:4]
+        else:
+            i, j, h = pair_lists(eng)
+            pair_sum = np.bincount(i, h, n) + np.bincount(j, h, n)
+            diag = eng.conductance_sum[:n] - pair_sum
+            # what the pairs left is the boundary conductance; round-off of the difference
+            # is not a conductance
+            diag[np.abs(diag) <= 1e-12 * np.abs(eng.conductance_sum[:n])] = 0.0
         boundary = p.heat_rate_by_mechanism[:, eng.boundary_columns].sum(axis=1)
         rhs = boundary + diag * p.temperature
         fixed = eng.fixed.copy() if eng.fixed.shape[0] == n else np.zeros(n, np.bool_)
         if extra_fixed is not None:
             fixed |= extra_fixed
-        cached = self._network_cache
-        if (
-            cached is not None
-            and np.array_equal(cached[0], i)
-            and np.array_equal(cached[1], j)
-            and np.array_equal(cached[2], h)
-            and np.array_equal(cached[3], diag)
-        ):
+        same = cached is not None and (
+            cached[0] is i
+            or (
+                np.array_equal(cached[0], i)
+                and np.array_equal(cached[1], j)
+                and np.array_equal(cached[2], h)
+                and np.array_equal(cached[3], diag)
+            )
+        )
+        if same:
             conductance = cached[4]  # the same network (frozen, constant properties)
         else:
             conductance = laplacian(n, i, j, h, diag)
