@@ -194,6 +194,24 @@ def implicit_thermal_case() -> dict:
     return case
 
 
+def exponential_thermal_case() -> dict:
+    """The range-set bed frozen, the Krylov exponential (engine/exponential.py) with steps of
+    1 s: the basis started at t = 0 has 10 vectors after the first step and 15 from the
+    third; the run restarted after step 1 rebuilds the 10 from the saved origin and extends
+    them as the uninterrupted run did."""
+    case = implicit_thermal_case()
+    case["thermal"].update(time_step=1.0, scheme="exponential")
+    return case
+
+
+def trbdf2_thermal_case() -> dict:
+    """The range-set bed frozen, adaptive TR-BDF2 (engine/adaptive.py): the proposed internal
+    step and the last step's change (the predictor) are part of the checkpoint."""
+    case = implicit_thermal_case()
+    case["thermal"].update(time_step=0.5, scheme="tr_bdf2", implicit={"error_tolerance": 1e-4})
+    return case
+
+
 def _assert_same(a: Simulation, b: Simulation) -> None:
     for name, arr in a.particles.arrays().items():
         assert np.array_equal(arr, getattr(b.particles, name)), name
@@ -229,6 +247,8 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
             300,
         ),  # fmt: skip
         (implicit_thermal_case, 7, 15),
+        (exponential_thermal_case, 1, 15),
+        (trbdf2_thermal_case, 3, 8),
     ],
     ids=[
         "drum-pour-epsd-moving-wall",
@@ -240,6 +260,8 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         "periodic-musser",
         "periodic-vargas-mccarthy",
         "frozen-crank-nicolson",
+        "frozen-exponential",
+        "frozen-tr-bdf2",
     ],
 )
 def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -> None:

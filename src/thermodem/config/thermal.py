@@ -243,6 +243,30 @@ class ImplicitSettings(StrictModel):
         description="crank_nicolson: the first n steps as two backward-Euler half steps each "
         "(Rannacher start; damps the stiff modes of a non-smooth start)",
     )
+    error_tolerance: float = Field(
+        default=1e-3,
+        gt=0,
+        description="tr_bdf2: RMS over the free particles of the estimated local error of an "
+        "internal step [K]",
+    )
+    initial_step: float | None = Field(
+        default=None,
+        gt=0,
+        description="tr_bdf2: first internal step [s]; null: the explicit limit m c/ΣH",
+    )
+    krylov_tolerance: float = Field(
+        default=1e-6,
+        gt=0,
+        description="exponential: estimated RMS temperature error of the Krylov approximation "
+        "over the free particles [K]",
+    )
+    krylov_dimension: int = Field(
+        default=200,
+        ge=10,
+        le=5000,
+        description="exponential: largest number of Lanczos vectors kept (memory: 8 bytes x "
+        "particles x (this + 1)); beyond it a new basis starts, or the step is divided",
+    )
 
 
 class ThermalSettings(StrictModel):
@@ -314,10 +338,14 @@ class ThermalSettings(StrictModel):
     time_step: float | None = Field(
         default=None, gt=0, description="thermal time step with frozen mechanics [s]"
     )
-    scheme: Literal["explicit", "backward_euler", "crank_nicolson"] = Field(
-        default="explicit",
-        description="time scheme of the heat: explicit Euler, or (frozen mechanics only) the "
-        "implicit backward Euler / Crank-Nicolson solve of the conductance network",
+    scheme: Literal["explicit", "backward_euler", "crank_nicolson", "tr_bdf2", "exponential"] = (
+        Field(
+            default="explicit",
+            description="time scheme of the heat: explicit Euler, or (frozen mechanics only) the "
+            "implicit backward Euler / Crank-Nicolson solve of the conductance network, adaptive "
+            "TR-BDF2 with error control, or the Krylov exponential of a linear network (exact in "
+            "time, constant properties)",
+        )
     )
     implicit: ImplicitSettings = Field(
         default_factory=lambda: ImplicitSettings(),

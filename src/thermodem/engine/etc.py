@@ -18,6 +18,20 @@ result is therefore computed for s = one and two mean diameters (default), and t
 the relative heat imbalance |Q_hot - Q_cold| / Q times k. A choice of this module (docs:
 docs/effective-conductivity.md).
 
+**Periodic gradient** (``periodic_gradient``, ``thermodem etc --periodic``) along an axis on
+which the domain is periodic: no boundary layers; the temperature is T = θ + G x with a mean
+gradient G imposed across the period and a periodic fluctuation θ. Each pair (i, j) of the
+network (every term) with the minimum-image separation Δx_ij carries H_ij (θ_j - θ_i + G Δx_ij),
+so the steady state is the graph-Laplacian system
+
+    Σ_j H_ij (θ_i - θ_j) = G Σ_j H_ij Δx_ij      (one θ fixed per connected cluster)
+
+and the heat flux is the network's: q = (1/V) Σ_pairs H_ij (T_i - T_j) Δx_ij, k_eff = -q/G,
+V the period's volume (on non-periodic transverse axes, the particles' extent as above).
+The dissipation gives it again, k' = (1/(V G²)) Σ_pairs H_ij (T_i - T_j)² (equal at the exact
+steady state); the reported uncertainty is |k - k'|, i.e. the solver's — not the statistical
+scatter of the sample. On a lattice the fluctuation is zero and k is the lattice sum below.
+
 On a lattice of identical conductances H (exact test in tests/verification/test_etc.py) a
 temperature field linear in x is an exact steady solution of the interior (every node is a
 centre of symmetry of its bonds) and the heat flux is q = (H/V) Σ_b (b·e)² ∂T/∂x over the
@@ -109,7 +123,8 @@ def effective_conductivity(
         if sim.periodic[a]:
             raise ConfigError(
                 f"effective conductivity along {name}: the domain is periodic along {name}; "
-                "the two boundary layers would touch through the period (make it non-periodic)"
+                "the two boundary layers would touch through the period (make it non-periodic, "
+                "or use the periodic gradient: thermodem etc --periodic)"
             )
         x = p.position[:, a]
         low = float(np.min(x - p.radius))
@@ -163,8 +178,85 @@ def effective_conductivity(
     return results
 
 
+def periodic_gradient(
+    sim,  # noqa: ANN001
+    axes: str = "xyz",
+    gradient: float = 1000.0,
+) -> list[AxisConductivity]:
+    """k_eff along each of ``axes`` (periodic axes only) by an imposed mean gradient
+    [K/m] across the period (module docstring). The particles' temperatures are left as
+    T = 300 K + θ + G (x - x_min)."""
+    import scipy.sparse.linalg as spla
+    from scipy.sparse.csgraph import connected_components
+
+    from thermodem.engine.implicit import laplacian, pair_lists
+
+    _check_case(sim)
+    bad = [a for a in axes if a not in AXES]
+    if bad or not axes:
+        raise ConfigError(f"effective conductivity: axes = {axes!r}; allowed: letters of 'xyz'")
+    p = sim.particles
+    if p.count == 0:
+        raise ConfigError("effective conductivity: the case has no particles")
+    eng = sim.thermal
+    solver = ImplicitSolver(eng)
+    solver._rates(sim.time)  # the engine's passes store every term's conductances
+    i, j, h = pair_lists(eng)
+    n = p.count
+    period = np.asarray(sim.upper - sim.lower, float)
+    results = []
+    for name in axes:
+        a = AXES[name]
+        if not sim.periodic[a]:
+            raise ConfigError(
+                f"effective conductivity, periodic gradient along {name}: the domain is not "
+                f"periodic along {name} (domain.periodic); use the boundary layers instead"
+            )
+        dx = p.position[j, a] - p.position[i, a]
+        dx -= period[a] * np.round(dx / period[a])  # minimum image
+        volume = 1.0
+        for b in range(3):
+            if sim.periodic[b]:
+                volume *= float(period[b])
+            else:
+                pb = p.position[:, b]
+                volume *= float(np.max(pb + p.radius) - np.min(pb - p.radius))
+        lap = laplacian(n, i, j, h, np.zeros(n))
+        source = gradient * (np.bincount(i, h * dx, n) - np.bincount(j, h * dx, n))
+        count, labels = connected_components(lap, directed=False)
+        pinned = np.zeros(n, np.bool_)
+        pinned[np.unique(labels, return_index=True)[1]] = True
+        free = ~pinned
+        theta = np.zeros(n)
+        block = lap[free][:, free].tocsr()
+        if free.sum() < 5000:
+            theta[free] = spla.spsolve(block.tocsc(), source[free])
+        elif free.any():
+            inverse = 1.0 / block.diagonal()
+            jacobi = spla.LinearOperator(block.shape, matvec=lambda v, d=inverse: d * v)
+            theta[free], info = spla.cg(block, source[free], rtol=1e-12, maxiter=20 * n,
+                                        M=jacobi)  # fmt: skip
+            if info != 0:
+                raise ConfigError(
+                    "effective conductivity, periodic gradient: conjugate gradients did not "
+                    f"converge in {20 * n} iterations"
+                )
+        drop = theta[i] - theta[j] - gradient * dx  # T_i - T_j
+        flux = float(np.sum(h * drop * dx)) / volume
+        k = -flux / gradient
+        k_dissipation = float(np.sum(h * drop * drop)) / (volume * gradient**2)
+        p.temperature[:] = 300.0 + theta + gradient * (p.position[:, a] - p.position[:, a].min())
+        area = volume / float(period[a])
+        results.append(AxisConductivity(name, k, abs(k - k_dissipation), {0.0: k}, -flux * area,
+                                        -flux * area, area, gradient, int(n - count)))  # fmt: skip
+    return results
+
+
 def effective_conductivity_of_case(case, axes: str = "xyz", **options) -> list[AxisConductivity]:  # noqa: ANN001, ANN003
-    """Build the simulation of a case (its initial packing and contacts) and measure k_eff."""
+    """Build the simulation of a case (its initial packing and contacts) and measure k_eff
+    (``periodic=True``: by the periodic gradient, the other options then do not apply)."""
     from thermodem.engine.simulation import Simulation
 
+    if options.pop("periodic", False):
+        return periodic_gradient(Simulation(case), axes)
     return effective_conductivity(Simulation(case), axes, **options)

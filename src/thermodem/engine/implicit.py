@@ -152,9 +152,21 @@ class ImplicitSolver:
         self.linear = engine.override == 0 and not any(
             t.target == "particles" for t in engine.terms
         )
+        self.exponential = None
+        self.adaptive = None
+        if settings.scheme == "exponential":
+            from thermodem.engine.exponential import KrylovExponential
+
+            self.exponential = KrylovExponential(self)
+        elif settings.scheme == "tr_bdf2":
+            from thermodem.engine.adaptive import AdaptiveTRBDF2
+
+            self.adaptive = AdaptiveTRBDF2(self)
 
     # ------------------------------------------------------------------ evaluation
-    def _rates(self, time: float) -> Rates:
+    def _rates(self, time: float, copies: bool = True) -> Rates:
+        """The engine's heat rates at the current temperatures and ``time``; ``copies``:
+        keep copies of the per-particle rates and temperatures (else empty arrays)."""
         eng = self.engine
         p = eng.sim.particles
         t0 = _time.perf_counter()
@@ -165,11 +177,12 @@ class ImplicitSolver:
         finally:
             eng.record_conductances = record
         by_mech = p.heat_rate_by_mechanism
+        empty = np.zeros(0)
         rates = Rates(
             boundary=by_mech[:, eng.boundary_columns].sum(axis=0),
             absorbed=float(p.heat_rate[fixed].sum()) if fixed.shape[0] else 0.0,
-            heat_rate=p.heat_rate.copy(),
-            temperature=p.temperature.copy(),
+            heat_rate=p.heat_rate.copy() if copies else empty,
+            temperature=p.temperature.copy() if copies else empty,
             time=time,
         )
         self.timings.evaluation += _time.perf_counter() - t0
@@ -182,25 +195,32 @@ class ImplicitSolver:
         self._rates(time)
         t0 = _time.perf_counter()
         n = p.count
-        i, j, h = pair_lists(eng)
-        pair_sum = np.bincount(i, h, n) + np.bincount(j, h, n)
-        diag = eng.conductance_sum[:n] - pair_sum
-        # what the pairs left is the boundary conductance; round-off of the difference is
-        # not a conductance
-        diag[np.abs(diag) <= 1e-12 * np.abs(eng.conductance_sum[:n])] = 0.0
+        cached = self._network_cache
+        if self.linear and cached is not None and cached[3].shape[0] == n:
+            # frozen with constant properties: the conductances cannot have changed
+            i, j, h, diag = cached[:4]
+        else:
+            i, j, h = pair_lists(eng)
+            pair_sum = np.bincount(i, h, n) + np.bincount(j, h, n)
+            diag = eng.conductance_sum[:n] - pair_sum
+            # what the pairs left is the boundary conductance; round-off of the difference
+            # is not a conductance
+            diag[np.abs(diag) <= 1e-12 * np.abs(eng.conductance_sum[:n])] = 0.0
         boundary = p.heat_rate_by_mechanism[:, eng.boundary_columns].sum(axis=1)
         rhs = boundary + diag * p.temperature
         fixed = eng.fixed.copy() if eng.fixed.shape[0] == n else np.zeros(n, np.bool_)
         if extra_fixed is not None:
             fixed |= extra_fixed
-        cached = self._network_cache
-        if (
-            cached is not None
-            and np.array_equal(cached[0], i)
-            and np.array_equal(cached[1], j)
-            and np.array_equal(cached[2], h)
-            and np.array_equal(cached[3], diag)
-        ):
+        same = cached is not None and (
+            cached[0] is i
+            or (
+                np.array_equal(cached[0], i)
+                and np.array_equal(cached[1], j)
+                and np.array_equal(cached[2], h)
+                and np.array_equal(cached[3], diag)
+            )
+        )
+        if same:
             conductance = cached[4]  # the same network (frozen, constant properties)
         else:
             conductance = laplacian(n, i, j, h, diag)
@@ -210,7 +230,13 @@ class ImplicitSolver:
         return net
 
     # ---------------------------------------------------------------------- linear solve
-    def _solve(self, matrix: sp.csr_matrix, residual: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+    def _solve(
+        self,
+        matrix: sp.csr_matrix,
+        residual: np.ndarray,
+        fixed: np.ndarray,
+        reference: float | None = None,
+    ) -> np.ndarray:
         """δ with (matrix δ)_free = residual_free, δ = 0 on the fixed rows.
 
         BLAS runs on one thread here: the vectors are short (a dot product of 50,000 values
@@ -221,10 +247,14 @@ class ImplicitSolver:
         from threadpoolctl import threadpool_limits
 
         with threadpool_limits(limits=1, user_api="blas"):
-            return self._solve_serial(matrix, residual, fixed)
+            return self._solve_serial(matrix, residual, fixed, reference)
 
     def _solve_serial(
-        self, matrix: sp.csr_matrix, residual: np.ndarray, fixed: np.ndarray
+        self,
+        matrix: sp.csr_matrix,
+        residual: np.ndarray,
+        fixed: np.ndarray,
+        reference: float | None = None,
     ) -> np.ndarray:
         n = matrix.shape[0]
         delta = np.zeros(n)
@@ -253,8 +283,12 @@ class ImplicitSolver:
         def tick(_x: np.ndarray) -> None:
             count[0] += 1
 
+        # relative to the residual of the stage's start (a warm start keeps that scale)
+        rtol, atol = self.options.tolerance, 0.0
+        if reference is not None:
+            rtol, atol = 0.0, self.options.tolerance * reference
         x, info = spla.cg(
-            a, r, rtol=self.options.tolerance, atol=0.0, maxiter=self.options.max_iterations,
+            a, r, rtol=rtol, atol=atol, maxiter=self.options.max_iterations,
             M=preconditioner, callback=tick,
         )  # fmt: skip
         self.timings.solve += _time.perf_counter() - t1
@@ -286,13 +320,13 @@ class ImplicitSolver:
         return a
 
     def _matrix(self, conductance: sp.csr_matrix, cap: np.ndarray) -> sp.csr_matrix:
-        """θ K + diag(C/Δt), kept while K (the same object), θ and C/Δt are the same."""
+        """K + diag(cap) (cap = C/(θΔt)), kept while K (the same object) and cap are the
+        same."""
         m = self._capacity_matrix
-        same = m is not None and m[0] is conductance and m[3] == self.theta
-        if same and np.array_equal(m[1], cap):
+        if m is not None and m[0] is conductance and np.array_equal(m[1], cap):
             return m[2]
-        matrix = (self.theta * conductance + sp.diags(cap)).tocsr()
-        self._capacity_matrix = (conductance, cap.copy(), matrix, self.theta)
+        matrix = (conductance + sp.diags(cap)).tocsr()
+        self._capacity_matrix = (conductance, cap.copy(), matrix)
         return matrix
 
     def _preconditioner(self, a: sp.csr_matrix) -> spla.LinearOperator:
@@ -315,6 +349,19 @@ class ImplicitSolver:
         self._hierarchy_key = key
         return ml.aspreconditioner(cycle="V")
 
+    # ------------------------------------------------------------------------ restart
+    def state(self) -> tuple[dict, dict]:
+        """What a checkpoint keeps of the solver (the exponential scheme's origin)."""
+        for scheme in (self.exponential, self.adaptive):
+            if scheme is not None:
+                return scheme.state()
+        return {}, {}
+
+    def load_state(self, scalars: dict, arrays: dict) -> None:
+        for scheme in (self.exponential, self.adaptive):
+            if scheme is not None:
+                scheme.load(scalars, arrays)
+
     # ----------------------------------------------------------------------- capacities
     def _enthalpy(self, temperature: np.ndarray) -> np.ndarray:
         eng = self.engine
@@ -332,6 +379,12 @@ class ImplicitSolver:
         non-smooth start (a wall or a layer switched to a new temperature) excites and that
         Crank–Nicolson alone damps only by (1 - x)/(1 + x) per step.
         """
+        if self.exponential is not None:
+            self.exponential.step(dt, time)
+            return
+        if self.adaptive is not None:
+            self.adaptive.step(dt, time)
+            return
         if self.theta < 1.0 and self.engine.thermal_steps < self.options.startup_steps:
             self.theta = 1.0
             try:
@@ -342,59 +395,29 @@ class ImplicitSolver:
             return
         self._step(dt, time)
 
-    def _step(self, dt: float, time: float) -> None:
-        eng = self.engine
-        p = eng.sim.particles
-        theta = self.theta
+    def start_rates(self, time: float) -> Rates:
+        """The rates of the current state at ``time`` (those the last step left, if they are
+        of this state)."""
+        p = self.engine.sim.particles
         start = self._end
-        if theta < 1.0 and not (
+        if (
             start is not None
             and start.time == time
             and start.temperature.shape == p.temperature.shape
             and np.array_equal(start.temperature, p.temperature)
         ):
-            start = self._rates(time)
+            return start
+        return self._rates(time)
+
+    def _step(self, dt: float, time: float) -> None:
+        eng = self.engine
+        p = eng.sim.particles
+        theta = self.theta
+        start = self.start_rates(time) if theta < 1.0 else None
         t_n = p.temperature.copy()
         h_n = self._enthalpy(t_n) if eng.has_c_table else None
-        limit = math.inf
-        for iteration in range(1, self.options.picard_iterations + 1):
-            net = self.network(time + dt)
-            t_k = net.temperature
-            if iteration == 1:
-                c_now = eng.specific_heat()
-                limit, where = kernels.stability_limit(
-                    p.mass, c_now, eng.conductance_sum, net.fixed
-                )
-            cap = p.mass * eng.specific_heat() / dt
-            if h_n is not None:
-                inertia = cap * t_k - p.mass * (self._enthalpy(t_k) - h_n) / dt
-            else:
-                inertia = cap * t_n
-            rhs = inertia + theta * net.rhs
-            if theta < 1.0:
-                rhs += (1.0 - theta) * start.heat_rate
-            t0 = _time.perf_counter()
-            matrix = self._matrix(net.conductance, cap)
-            residual = rhs - matrix @ t_k
-            self.timings.assembly += _time.perf_counter() - t0
-            delta = self._solve(matrix, residual, net.fixed)
-            p.temperature[:] = t_k + delta
-            self.timings.picard_iterations += 1
-            change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
-            if self.linear or change <= self.options.picard_tolerance:
-                break
-        else:
-            self._not_converged(change, time)
-        bad = np.nonzero(~(p.temperature > 0.0) | ~np.isfinite(p.temperature))[0]
-        if bad.shape[0]:
-            gid = int(p.global_id[bad[0]])
-            raise SimulationError(
-                f"implicit heat step: temperature of particle {gid} became "
-                f"{p.temperature[bad[0]]:.6g} K at t = {time + dt:.6g} s",
-                eng.sim.step_count,
-                time,
-                gid,
-            )
+        explicit = (1.0 - theta) * start.heat_rate if start is not None else None
+        limit, where = self.solve_stage(dt, time + dt, theta, t_n, h_n, explicit)
         end = self._rates(time + dt)
         self._end = end
         for m, q_end, q_start in zip(
@@ -411,6 +434,87 @@ class ImplicitSolver:
         eng.cumulative["fixed_absorbed"] += absorbed * dt
         eng.limit = limit
         eng.limit_particle = int(p.global_id[where]) if where >= 0 else -1
+
+    def solve_stage(
+        self,
+        dt: float,
+        time: float,
+        theta: float,
+        t_old: np.ndarray,
+        h_old: np.ndarray | None,
+        explicit: np.ndarray | None,
+        guess: np.ndarray | None = None,
+    ) -> tuple[float, int]:
+        """Solve  C (T - T_old)/dt = θ Q(T) + explicit  for the temperatures at ``time``
+        (with c(T): m (h(T) - h_old)/dt on the left), Picard on the temperature-dependent
+        terms; the solution is left in the particles. ``guess``: the first iterate of the free
+        particles (default: their current temperatures); the conjugate-gradient tolerance
+        stays relative to the residual at the current temperatures. Returns the explicit
+        limit and its particle at the first iterate."""
+        eng = self.engine
+        p = eng.sim.particles
+        limit, where = math.inf, -1
+        start = None
+        if guess is not None:
+            start = p.temperature.copy()
+            free = ~eng.fixed if eng.fixed.shape[0] == p.count else slice(None)
+            p.temperature[free] = guess[free]
+        change = math.inf
+        for iteration in range(1, self.options.picard_iterations + 1):
+            net = self.network(time)
+            t_k = net.temperature
+            if iteration == 1:
+                limit, where = kernels.stability_limit(
+                    p.mass, eng.specific_heat(), eng.conductance_sum, net.fixed
+                )
+            matrix, residual = self._system_of(net, dt, theta, t_old, h_old, explicit, t_k)
+            reference = None
+            if start is not None and iteration == 1:
+                # the tolerance's scale: the residual of the unpredicted start (the same
+                # network; fixed particles at their new temperature)
+                start[net.fixed] = t_k[net.fixed]
+                _, r0 = self._system_of(net, dt, theta, t_old, h_old, explicit, start)
+                reference = float(np.linalg.norm(r0[~net.fixed]))
+            delta = self._solve(matrix, residual, net.fixed, reference)
+            p.temperature[:] = t_k + delta
+            self.timings.picard_iterations += 1
+            change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
+            if self.linear or change <= self.options.picard_tolerance:
+                break
+        else:
+            self._not_converged(change, time - dt)
+        bad = np.nonzero(~(p.temperature > 0.0) | ~np.isfinite(p.temperature))[0]
+        if bad.shape[0]:
+            gid = int(p.global_id[bad[0]])
+            raise SimulationError(
+                f"implicit heat step: temperature of particle {gid} became "
+                f"{p.temperature[bad[0]]:.6g} K at t = {time:.6g} s",
+                eng.sim.step_count,
+                time - dt,
+                gid,
+            )
+        return limit, where
+
+    def _system_of(self, net: Network, dt: float, theta: float, t_old: np.ndarray,
+                   h_old: np.ndarray | None, explicit: np.ndarray | None, t_k: np.ndarray
+                   ) -> tuple[sp.csr_matrix, np.ndarray]:  # fmt: skip
+        """(K + C/(θΔt), residual/θ at the temperatures t_k) of the stage: the system scaled
+        by 1/θ, so that the stages of one step size share one matrix."""
+        eng = self.engine
+        p = eng.sim.particles
+        cap = p.mass * eng.specific_heat() / dt
+        if h_old is not None:
+            inertia = cap * t_k - p.mass * (self._enthalpy(t_k) - h_old) / dt
+        else:
+            inertia = cap * t_old
+        rhs = inertia + theta * net.rhs
+        if explicit is not None:
+            rhs += explicit
+        t0 = _time.perf_counter()
+        matrix = self._matrix(net.conductance, cap / theta)
+        residual = rhs / theta - matrix @ t_k
+        self.timings.assembly += _time.perf_counter() - t0
+        return matrix, residual
 
     def _not_converged(self, change: float, time: float) -> None:
         sim = self.engine.sim

@@ -58,6 +58,7 @@ SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "exter
 RANGE_PREFIX = "range_set__"
 EXTERNAL_PREFIX = "external__"
 VORONOI_PREFIX = "voronoi__"
+IMPLICIT_PREFIX = "implicit__"
 
 
 class ThermalEngine:
@@ -852,6 +853,11 @@ class ThermalEngine:
             sub = self.field_provider.state_dict()
             state["scalars"]["field_provider"] = sub["scalars"]
             state["arrays"].update({f"{FIELDS_PREFIX}{k}": v for k, v in sub["arrays"].items()})
+        if self.implicit is not None:
+            sub_scalars, sub_arrays = self.implicit.state()
+            if sub_scalars:
+                state["scalars"]["implicit"] = sub_scalars
+                state["arrays"].update({f"{IMPLICIT_PREFIX}{k}": v for k, v in sub_arrays.items()})
         return state
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -868,6 +874,12 @@ class ThermalEngine:
             k[len(FIELDS_PREFIX) :]: arrays.pop(k)
             for k in list(arrays)
             if k.startswith(FIELDS_PREFIX)
+        }
+        implicit_scalars = scalars.pop("implicit", None)
+        implicit_arrays = {
+            k[len(IMPLICIT_PREFIX) :]: arrays.pop(k)
+            for k in list(arrays)
+            if k.startswith(IMPLICIT_PREFIX)
         }
         voronoi_scalars = scalars.pop("voronoi", None)
         voronoi_arrays = {
@@ -918,6 +930,8 @@ class ThermalEngine:
             self.voronoi.load_state_dict({"scalars": voronoi_scalars, "arrays": voronoi_arrays})
         if field_scalars is not None and self.field_provider.active:
             self.field_provider.load_state_dict({"scalars": field_scalars, "arrays": field_arrays})
+        if implicit_scalars is not None and self.implicit is not None:
+            self.implicit.load_state(implicit_scalars, implicit_arrays)
         self.conditions.invalidate()
 
 
