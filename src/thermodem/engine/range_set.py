@@ -119,6 +119,9 @@ class RangePairSet:
                     sim.time,
                 )
         dims, edge = nbr.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
+        if getattr(sim, "planar", False):  # 2D: one cell layer along z (as the contact list)
+            dims[2] = 1
+            edge[2] = sim.upper[2] - sim.lower[2]
         # the slab axis of the contact list: the particles lie in memory by layers along it,
         # so each group of this set touches a compact block of memory (see below)
         axis = getattr(sim, "slab_axis", None)

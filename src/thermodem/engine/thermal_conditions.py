@@ -132,7 +132,7 @@ class ThermalConditions:
         reset = apply_conditions(
             p.position, p.radius, p.mass, p.type_id, p.temperature, specific_heat_by_type,
             self.static_mask, self.kinds, self.values, self.has_region, self.boxes, self.fixed,
-            self.source, self._part,
+            self.source, self._part, float(getattr(self.sim, "disc_thickness", 0.0)),
         )  # fmt: skip
         for e in self.settings.external_source:
             if not (e.start_time <= time < e.end_time):

@@ -20,9 +20,13 @@ VOLUMETRIC = 2
 @njit(cache=True, parallel=True, error_model="numpy")
 def apply_conditions(
     position, radius, mass, type_id, temperature, c_by_type, static_mask, kinds, values,
-    has_region, boxes, fixed, source, part,
+    has_region, boxes, fixed, source, part, disc_thickness,
 ):  # fmt: skip
     """Fixed temperatures and flux/volumetric sources of every entry, in entry order.
+
+    A flux q heats a particle's surface, a power density s its volume: Q = q 4π R² and
+    s 4/3 π R³ for spheres; for the discs of a 2D case (``disc_thickness`` b > 0) Q = q 2π R b
+    (the disc's rim: a 2D model has no faces) and s π R² b.
 
     Entry e (``kinds[e]``: FIXED, FLUX or VOLUMETRIC, ``values[e]``: its temperature, flux or
     power density) holds for particle i when ``static_mask[i, e]`` and, if ``has_region[e]``,
@@ -56,10 +60,16 @@ def apply_conditions(
                     bath = values[e]
                 elif kind == FLUX:
                     r = radius[i]
-                    q += values[e] * 4.0 * math.pi * r * r
+                    if disc_thickness > 0.0:
+                        q += values[e] * 2.0 * math.pi * r * disc_thickness
+                    else:
+                        q += values[e] * 4.0 * math.pi * r * r
                 else:
                     r = radius[i]
-                    q += values[e] * 4.0 / 3.0 * math.pi * r * r * r
+                    if disc_thickness > 0.0:
+                        q += values[e] * math.pi * r * r * disc_thickness
+                    else:
+                        q += values[e] * 4.0 / 3.0 * math.pi * r * r * r
             fixed[i] = is_fixed
             source[i] = q
             if is_fixed:

@@ -53,6 +53,23 @@ PARAM_WIDTH = 16
 #: given from outside with per-pair inputs (Voronoi faces), ``particles`` single particles.
 TARGETS: tuple[str, ...] = ("contacts", "range", "external", "particles")
 
+#: Particle shapes of a two-dimensional case (``simulation.particle_shape``): discs of the
+#: case's thickness, or spheres kept in the plane z = 0.
+PLANAR_SHAPES: tuple[str, ...] = ("disc", "sphere")
+
+
+def planar_support(spec: ModelSpec) -> str:
+    """What ``thermodem models`` says of a model in 2D."""
+    if spec.only_2d:
+        return "discs only (a 2D law: refused in 3D)"
+    if set(spec.planar) == set(PLANAR_SHAPES):
+        return "discs and spheres in a plane"
+    if spec.planar == ("disc",):
+        return "discs only"
+    if spec.planar == ("sphere",):
+        return "spheres in a plane only (3D form)"
+    return "no (3D only)"
+
 
 @dataclass(frozen=True)
 class ModelSpec:
@@ -80,6 +97,8 @@ class ModelSpec:
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
     uses_contact_radius: bool = True
     example_params: dict[str, Any] = field(default_factory=dict)
+    planar: tuple[str, ...] = ()
+    only_2d: bool = False
 
     @property
     def width(self) -> int:
@@ -121,6 +140,8 @@ def register(
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
     uses_contact_radius: bool = True,
     example_params: dict[str, Any] | None = None,
+    planar: tuple[str, ...] = (),
+    only_2d: bool = False,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
 
@@ -133,7 +154,11 @@ def register(
     ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
     None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
     argument (the range pass then does not compute it); ``example_params`` parameters the
-    conformance tests use for a model without defaults.
+    conformance tests use for a model without defaults; ``planar`` the particle shapes of a
+    two-dimensional case (``simulation.dimension: 2``) the model supports: ``"disc"`` (discs
+    of ``simulation.thickness``: the model has a 2D form, or needs none) and/or ``"sphere"``
+    (spheres kept in the plane: the 3D form is right for them); empty: 3D only, refused in 2D
+    before the run (:data:`PLANAR_SHAPES`); ``only_2d`` a 2D law (refused in 3D cases).
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -147,6 +172,9 @@ def register(
             )
     if len(history_flip) != history_width:
         raise ValueError(f"{family}.{name}: history_flip must have history_width entries")
+    for shape in planar:
+        if shape not in PLANAR_SHAPES:
+            raise ValueError(f"{family}.{name}: planar shape {shape!r} not in {PLANAR_SHAPES}")
     if target not in TARGETS:
         raise ValueError(f"{family}.{name}: target {target!r} is not one of {TARGETS}")
     for a, b in swap_pairs:
@@ -175,6 +203,8 @@ def register(
         conductance_reuse_refusal=conductance_reuse_refusal,
         uses_contact_radius=uses_contact_radius,
         example_params=dict(example_params or {}),
+        planar=tuple(planar),
+        only_2d=only_2d,
     )
     models[name] = spec
     return spec

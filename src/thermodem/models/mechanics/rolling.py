@@ -138,6 +138,7 @@ register(
     pack=pack_none,
     summary="no rolling resistance",
     reference="-",
+    planar=("disc", "sphere"),
 )
 register(
     family="rolling",
@@ -149,6 +150,7 @@ register(
     summary="constant directional torque μ_r R* F_n opposing relative rolling",
     reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model A); Zhou et al. (1999)",
     requires=("rolling_friction",),
+    planar=("disc", "sphere"),
 )
 register(
     family="rolling",
@@ -162,4 +164,5 @@ register(
     requires=("rolling_friction",),
     history_width=3,
     history_flip=(True, True, True),
+    planar=("disc", "sphere"),
 )

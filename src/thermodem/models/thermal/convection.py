@@ -339,6 +339,7 @@ register(
     reference="-",
     columns=(),
     target="particles",
+    planar=("disc", "sphere"),
 )
 register(
     **_COMMON,

@@ -379,6 +379,7 @@ register(
     columns=RH_COLUMNS,
     uses_contact_radius=False,
     **_COMMON,
+    planar=("sphere",),
 )
 register(
     name="musser2011",
@@ -391,4 +392,5 @@ register(
     interaction_range=musser2011_range,
     columns=MUSSER_COLUMNS,
     **_COMMON,
+    planar=("sphere",),
 )
