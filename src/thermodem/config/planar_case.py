@@ -145,8 +145,11 @@ def _check_models(case: Case) -> None:
             if other
             else " (it has no 2D form: 3D only)"
         )
+        section, _, field = key.partition(".")
+        given = getattr(case, section).model_fields_set
+        default = "" if field in given else " (the default: name a model of 2D)"
         raise ValueError(
-            f"{key}: model {choice.model!r} is not available in a 2D case of "
+            f"{key}: model {choice.model!r}{default} is not available in a 2D case of "
             f"{words[shape]}{hint}; allowed with simulation.dimension: 2 and particle_shape: "
             f"{shape}: {', '.join(allowed)} (docs/two-dimensional.md)"
         )

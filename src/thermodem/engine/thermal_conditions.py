@@ -21,6 +21,7 @@ import numpy as np
 from thermodem.config.thermal import Selection
 from thermodem.engine.expressions import compile_expression
 from thermodem.geometry import wall_layout as wall_cols
+from thermodem.geometry.walls import row_count
 from thermodem.kernels.conditions import (
     CHUNK,
     FIXED,
@@ -66,7 +67,7 @@ class ThermalConditions:
         constant = True
         for w in sim.case.walls:
             fn = wall_temperature_function(w.thermal) if w.thermal.kind == "fixed" else None
-            count = 6 - int(w.open_top) if w.kind == "box" else 1
+            count = row_count(w, bool(getattr(sim, "planar", False)))
             self.wall_functions.extend([fn] * count)
             constant &= not isinstance(getattr(w.thermal, "temperature", None), list | str)
         #: no wall temperature depends on time: the rows are written once

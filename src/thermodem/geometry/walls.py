@@ -106,6 +106,14 @@ class CylinderWall(_WallBase):
 Wall = Annotated[PlaneWall | RectangleWall | BoxWall | CylinderWall, Field(discriminator="kind")]
 
 
+def row_count(wall: _WallBase, planar: bool = False) -> int:
+    """Rows :func:`wall_rows` makes of one wall: a box gives its faces (6, or 4 sides in 2D;
+    one less with ``open_top``), every other wall one row."""
+    if isinstance(wall, BoxWall):
+        return (4 if planar else 6) - int(wall.open_top)
+    return 1
+
+
 def wall_rows(
     walls: list, material_index: dict[str, int], planar: bool = False
 ) -> tuple[np.ndarray, np.ndarray, list]:

@@ -18,8 +18,10 @@ from thermodem.models.mechanics import normal, rolling, tangential
 def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass):
     if model_id == normal.HERTZ:
         return normal.hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass)
-    if model_id == normal.LINEAR or model_id == normal.HERTZ_2D:  # (the same kernel, own rows)
+    if model_id == normal.LINEAR:
         return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+    if model_id == normal.HERTZ_2D:
+        return normal.hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass)
     nan = np.nan  # unknown id: NaN forces stop the run at the next check
     return nan, nan, nan, nan, nan
 

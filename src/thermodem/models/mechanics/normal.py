@@ -202,11 +202,18 @@ class Hertz2DParams(StrictModel):
 
 
 def pack_hertz_2d(params: Hertz2DParams, pair: PairContext) -> np.ndarray:
-    """[k = (π/4) E* b, ζ(e)]; b = ``pair.thickness`` (1 m, per unit thickness, when a pair is
-    packed outside a 2D case of discs, e.g. by the conformance tests)."""
+    """[E*, b, ζ(e)]; b = ``pair.thickness`` (1 m, per unit thickness, when a pair is packed
+    outside a 2D case of discs, e.g. by the conformance tests)."""
     thickness = pair.thickness if pair.thickness > 0.0 else 1.0
-    stiffness = 0.25 * math.pi * pair.effective_youngs_modulus * thickness
-    return pad_row([stiffness, linear_damping_ratio(pair.restitution)])
+    zeta = linear_damping_ratio(pair.restitution)
+    return pad_row([pair.effective_youngs_modulus, thickness, zeta])
+
+
+@njit(cache=True, error_model="numpy")
+def hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+    k = 0.25 * math.pi * p[0] * p[1]
+    gamma = 2.0 * p[2] * math.sqrt(eff_mass * k)
+    return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
 
 
 register(
@@ -237,7 +244,7 @@ register(
     family="normal",
     name="hertz_2d",
     model_id=HERTZ_2D,
-    kernel=linear_force,
+    kernel=hertz_2d_force,
     params=Hertz2DParams,
     pack=pack_hertz_2d,
     summary="2D line contact of discs F = (π/4) E* b δ, damping exact for the restitution",
