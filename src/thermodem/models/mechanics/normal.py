@@ -40,6 +40,8 @@ HERTZ_COLUMNS = ("effective_youngs_modulus", "damping_factor")
 HERTZ_E_STAR, HERTZ_ALPHA = 0, 1
 LINEAR_COLUMNS = ("stiffness", "damping_ratio")
 LINEAR_STIFFNESS, LINEAR_DAMPING_RATIO = 0, 1
+HERTZ_2D_COLUMNS = ("effective_youngs_modulus", "thickness", "damping_ratio")
+HERTZ_2D_E_STAR, HERTZ_2D_THICKNESS, HERTZ_2D_DAMPING_RATIO = 0, 1, 2
 
 
 # ----------------------------------------------------------------------------------- Hertz
@@ -221,13 +223,15 @@ def pack_hertz_2d(params: Hertz2DParams, pair: PairContext) -> np.ndarray:
     outside a 2D case of discs, e.g. by the conformance tests)."""
     thickness = pair.thickness if pair.thickness > 0.0 else 1.0
     zeta = linear_damping_ratio(pair.restitution)
-    return pad_row([pair.effective_youngs_modulus, thickness, zeta])
+    values = {"effective_youngs_modulus": pair.effective_youngs_modulus, "thickness": thickness,
+              "damping_ratio": zeta}  # fmt: skip
+    return packed(HERTZ_2D_COLUMNS, values)
 
 
 @njit(cache=True, error_model="numpy")
 def hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass):
-    k = 0.25 * math.pi * p[0] * p[1]
-    gamma = 2.0 * p[2] * math.sqrt(eff_mass * k)
+    k = 0.25 * math.pi * p[HERTZ_2D_E_STAR] * p[HERTZ_2D_THICKNESS]
+    gamma = 2.0 * p[HERTZ_2D_DAMPING_RATIO] * math.sqrt(eff_mass * k)
     return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
 
 
@@ -264,6 +268,7 @@ register(
     kernel=hertz_2d_force,
     params=Hertz2DParams,
     pack=pack_hertz_2d,
+    columns=HERTZ_2D_COLUMNS,
     summary="2D line contact of discs F = (π/4) E* b δ, damping exact for the restitution",
     reference="Johnson (1985) Contact Mechanics ch. 4-5 (parallel cylinders); Kratos DEM 2D "
     "Hertz law (Celigueta & Latorre, CIMNE)",
