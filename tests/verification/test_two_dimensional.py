@@ -301,3 +301,60 @@ def test_3d_laws_are_refused_for_discs_and_hertz_2d_in_3d() -> None:
     case["contact"] = {"normal": "hertz_2d"}
     with pytest.raises(ConfigError, match=r"contact\.normal: model 'hertz_2d' is a law of 2D"):
         case_from_dict(case)
+
+
+def test_a_disc_rests_in_a_drum_circle_with_the_overlap_of_its_weight() -> None:
+    """A disc at rest at the bottom of a circle (a cylinder wall along z, the drum): the line
+    contact holds its weight, k δ = m g with k = (π/4) E* b (disc-wall E* as disc-disc)."""
+    b, drum = 0.004, 0.05
+    case = disc_case(b, 0.1, 2e-6, [[0.0, -(drum - RADIUS) + 1e-5]], [[0.0, 0.0]])
+    case["simulation"]["gravity"] = [0.0, -9.81]
+    case["walls"] = [{"kind": "cylinder", "center": [0, 0], "axis": [0, 0, 1], "radius": drum,
+                      "material": "glass"}]  # fmt: skip
+    sim = Simulation(case_from_dict(case))
+    sim.run(until=0.05)
+    p = sim.particles
+    overlap = RADIUS - (drum - math.hypot(p.position[0, 0], p.position[0, 1]))
+    k = 0.25 * math.pi * E_STAR * b
+    assert overlap == pytest.approx(p.mass[0] * 9.81 / k, rel=1e-6)
+    assert abs(p.position[0, 0]) < 1e-12 and p.position[0, 2] == 0.0
+
+
+def test_periodic_x_strip_of_discs_lists_minimum_image_pairs_and_conserves_momentum(
+    tmp_path,
+) -> None:
+    rng = np.random.default_rng(8)
+    n_side = 12
+    spacing = 0.0051
+    xy = np.stack(np.meshgrid(np.arange(n_side), np.arange(n_side)), -1).reshape(-1, 2)
+    xy = (xy + 0.5) * spacing
+    v = rng.uniform(-0.3, 0.3, xy.shape)
+    v -= v.mean(axis=0)
+    path = tmp_path / "strip.txt"
+    np.savetxt(path, np.column_stack([xy, np.full(len(xy), 0.0024), v]),
+               header="x y r vx vy", comments="")  # fmt: skip
+    width = n_side * spacing
+    case = disc_case(0.002, 0.5, 4e-6, [[0, 0]], [[0, 0]])
+    case["domain"] = {"lower": [0.0, -0.01], "upper": [width, width + 0.01],
+                      "periodic": [True, False]}  # fmt: skip
+    case["materials"]["glass"] = material(0.5, 0.4)
+    case["contact"]["tangential"] = "linear"
+    case["insertion"] = [{"kind": "file", "material": "glass", "path": str(path)}]
+    sim = Simulation(case_from_dict(case))
+    p0 = (sim.particles.mass[:, None] * sim.particles.velocity).sum(axis=0)
+    sim.run(steps=600)
+    p = sim.particles
+    assert sim.contact_count > 10
+    assert np.any(p.position[:, 0] < 0.5 * spacing)  # someone crossed the periodic boundary
+    momentum = (p.mass[:, None] * p.velocity).sum(axis=0)
+    scale = float(np.sum(p.mass * np.abs(p.velocity).sum(axis=1)))
+    assert np.all(np.abs(momentum - p0) <= 1e-13 * scale)  # no walls: pairwise forces only
+    built = sim.reference
+    d = built[:, None, :2] - built[None, :, :2]
+    d[..., 0] -= width * np.floor(d[..., 0] / width + 0.5)  # minimum image along x
+    dist = np.sqrt((d**2).sum(axis=2))
+    cut = p.radius[:, None] + p.radius[None, :] + sim.skin
+    brute = {(i, j) for i, j in zip(*np.nonzero(dist < cut), strict=True) if i < j}
+    pb = sim.pairs
+    pairs = zip(pb.i[: pb.count], pb.j[: pb.count], strict=True)
+    assert {(min(int(i), int(j)), max(int(i), int(j))) for i, j in pairs} == brute
