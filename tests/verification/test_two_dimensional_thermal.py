@@ -304,3 +304,34 @@ def test_every_model_says_whether_it_supports_2d() -> None:
     assert ("direct_conduction", "thermal_pipe") in names
     assert ("contact_radius", "geometric") in names
     assert ("direct_conduction", "batchelor_obrien_simple") not in names
+
+
+@pytest.mark.parametrize("model", ["rojek2014", "thermal_pipe"])
+def test_square_lattice_of_discs_has_the_lattice_sum_conductivity(
+    tmp_path: Path, model: str
+) -> None:
+    """A square lattice (spacing a) of touching discs, periodic along y: in steady state the
+    temperature is linear along x and each disc passes H ΔT to its x neighbour, so
+    k_eff = H a / (a b) = H / b (engine/etc.py; its cross-section in 2D is width × b). For
+    Rojek's bars H = k b: k_eff = k, the bars tile the plane; for the pipe H = k 2 a_c b / a."""
+    from thermodem.engine.etc import effective_conductivity
+
+    b, a = 0.003, 2.0 * R - 2e-5
+    nx, ny = 14, 4
+    rows = [f"{(i + 0.5) * a!r} {(j + 0.5) * a!r} {R!r}" for i in range(nx) for j in range(ny)]
+    path = tmp_path / "square.txt"
+    path.write_text("x y r\n" + "\n".join(rows) + "\n")
+    case = disc_case([[0, 0]], [300.0], {}, thickness=b)
+    case["domain"] = {"lower": [-0.01, 0.0], "upper": [nx * a + 0.01, ny * a],
+                      "periodic": [False, True]}  # fmt: skip
+    case["insertion"] = [{"kind": "file", "material": "glass", "path": str(path)}]
+    case["thermal"] = {"frozen_mechanics": True, "time_step": 1.0,
+                       "contact_radius": "geometric", "direct_conduction": model}  # fmt: skip
+    sim = Simulation(case_from_dict(case))
+    assert sim.contact_count == 2 * nx * ny - ny  # x bonds (nx - 1) ny, y bonds nx ny
+    (res,) = effective_conductivity(sim, "x")
+    h = K * b if model == "rojek2014" else K * 2.0 * chord_half_length(a) * b / a
+    assert res.area == pytest.approx(ny * a * b, rel=1e-12)
+    assert res.conductivity == pytest.approx(h / b, rel=1e-9)
+    with pytest.raises(ConfigError, match="allowed: letters of 'xy'"):
+        effective_conductivity(sim, "z")
