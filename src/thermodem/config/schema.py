@@ -187,6 +187,11 @@ class SimulationSettings(StrictModel):
                         f"{key}: {getattr(self, key)!r} is a key of 2D cases only; set "
                         "dimension: 2 or remove it"
                     )
+        elif self.particle_shape == "sphere" and "thickness" in self.model_fields_set:
+            raise ValueError(
+                f"thickness: {self.thickness!r} is the length of discs; with particle_shape: "
+                "sphere the particles are spheres (no thickness): remove it"
+            )
         elif self.gravity[2] != 0.0:
             raise ValueError(
                 f"gravity: {list(self.gravity)} has a z component in a 2D case (the particles "
