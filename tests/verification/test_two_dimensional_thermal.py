@@ -335,3 +335,29 @@ def test_square_lattice_of_discs_has_the_lattice_sum_conductivity(
     assert res.conductivity == pytest.approx(h / b, rel=1e-9)
     with pytest.raises(ConfigError, match="allowed: letters of 'xy'"):
         effective_conductivity(sim, "z")
+
+
+def test_region_selections_of_a_2d_case_take_x_y_boxes() -> None:
+    """A fixed temperature and a flux selected by [x, y] boxes (read with z = 0, faces
+    included) hold exactly for the discs inside, in a moving bed (the selections are
+    classified at neighbour-list builds on the x-y axes)."""
+    thermal = {
+        "contact_radius": "geometric",
+        "direct_conduction": "rojek2014",
+        "fixed_temperature": [
+            {"select": {"region": {"lower": [-0.01, -0.01], "upper": [0.001, 0.01]}},
+             "temperature": 500.0}
+        ],
+        "heat_flux": [{"select": {"region": {"lower": [0.02, -0.01], "upper": [0.03, 0.01]}},
+                       "flux": 1000.0}],
+    }  # fmt: skip
+    case = disc_case([[0, 0], [0.025, 0], [0.04, 0]], [300.0] * 3, thermal, thickness=0.002)
+    case["insertion"][0]["velocities"] = [[0.0, 0.0], [0.0, 0.0], [-0.5, 0.0]]
+    sim = Simulation(case_from_dict(case))
+    sim.run(steps=200)  # disc 2 moves 1 mm: still outside both boxes
+    t = by_gid(sim)
+    assert t[0] == 500.0
+    q = 1000.0 * 2.0 * math.pi * R * 0.002
+    cap = RHO * math.pi * R**2 * 0.002 * C
+    assert t[1] == pytest.approx(300.0 + q * sim.time / cap, rel=1e-9)
+    assert t[2] == 300.0

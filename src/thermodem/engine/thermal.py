@@ -118,6 +118,9 @@ class ThermalEngine:
             if any(t.target == "range" for t in self.terms)
             else None
         )
+        if self.range_set is not None and self._radius_bound() > 0.0:
+            # before the run: the largest particles the insertions can bring (pours too)
+            self.check_ranges(self._radius_bound())
         # per-pair conductances of the contact conduction (heat-only passes, frozen reuse)
         self.pair_conductance = np.zeros(0)
         self.wall_conductance = np.zeros(0)
@@ -145,6 +148,10 @@ class ThermalEngine:
         # reuse_conductance = False re-evaluates them at every thermal step (tests)
         self.conductance_ready = False
         self.reuse_conductance = True
+        #: the last explicit update zeroed the mechanism rates and conductance sums (step)
+        self.rates_cleared = False
+        #: the source column and total heat rates are not formed yet (after_contact_pass)
+        self.rates_pending = False
         # the implicit schemes read the per-pair conductances of every term at every state
         # (engine/implicit.py); the passes then store them also with k(T) tables
         self.record_conductances = settings.scheme != "explicit"
@@ -388,21 +395,62 @@ class ThermalEngine:
         p = self.sim.particles
         if p.count == 0:
             return 0.0, 0.0
-        r_max = float(p.radius.max())
-        extent = float(np.min(self.sim.upper - self.sim.lower))
+        return self.check_ranges(float(p.radius.max()))
+
+    def _radius_bound(self) -> float:
+        """Largest radius the case's insertion distributions can produce [m] (0 if none
+        is bounded; particle files and lists are checked once inserted)."""
+        bounds = [
+            getattr(getattr(e, "distribution", None), "max_radius_bound", None)
+            for e in self.sim.case.insertion
+        ]
+        return max([float(b) for b in bounds if b is not None] + [0.0])
+
+    def check_ranges(self, r_max: float) -> tuple[float, float]:
+        """The range set's largest conducting gaps of particle pairs and particle-wall pairs
+        for particles up to ``r_max`` [m]; a ConfigError naming the model's key and its range
+        parameter when a gap exceeds the domain, or when a periodic axis is too short for the
+        range set's cells (two cells of 2 r_max + gap + skin)."""
+        sim = self.sim
+        extent = float(np.min(sim.upper - sim.lower))
         gap = wall_gap = 0.0
+        widest = None
         for term in self.terms:
             if term.target != "range":
                 continue
             g, w = term.max_gap(r_max)
             if max(g, w) > extent:
                 raise ConfigError(
-                    f"{term.key} = {term.choice.model!r}: its largest conducting gap "
-                    f"{max(g, w):.6g} m (for particles of radius {r_max:.6g} m) exceeds the "
-                    f"domain's smallest extent {extent:.6g} m; check its range parameters "
-                    f"({term.params.model_dump()})"
+                    f"{_range_key(term)}: {term.choice.model!r} conducts across surface gaps up "
+                    f"to {max(g, w):.6g} m for particles of radius {r_max:.6g} m, more than the "
+                    f"domain's smallest extent {extent:.6g} m; allowed: "
+                    f"{_range_allowed(term, extent / max(g, w))}"
                 )
+            if widest is None or g > gap:
+                widest = term
             gap, wall_gap = max(gap, g), max(wall_gap, w)
+        if widest is None:
+            return gap, wall_gap
+        skin = self.settings.range_skin
+        if skin is None:  # the contact list's skin (its default: 0.2 R_max)
+            skin = getattr(sim, "skin", None) or sim.case.neighbors.skin or 0.2 * r_max
+        cell = 2.0 * r_max + gap + float(skin)
+        length = sim.upper - sim.lower
+        for a in range(3):
+            if sim.periodic[a] and length[a] < 2.0 * cell:
+                # the part of the cell the model's range can still take
+                room = 0.5 * float(length[a]) - 2.0 * r_max - float(skin)
+                raise ConfigError(
+                    f"{_range_key(widest)}: periodic axis {'xyz'[a]} of length "
+                    f"{length[a]:.6g} m is shorter than two cells of the range pair set "
+                    f"(2 R_max {2.0 * r_max:.6g} m + largest conducting gap {gap:.6g} m + "
+                    f"thermal.range_skin {float(skin):.6g} m each); allowed: "
+                    + (
+                        _range_allowed(widest, room / gap)
+                        if room > 0.0
+                        else "a longer periodic axis or a smaller thermal.range_skin"
+                    )
+                )
         return gap, wall_gap
 
     def evaluate_terms(self, time: float) -> None:
@@ -596,17 +644,29 @@ class ThermalEngine:
         self.fresh = False
         return self.finish(time)
 
-    def after_contact_pass(self, time: float) -> None:
+    def after_contact_pass(self, time: float, complete: bool = True) -> None:
         """The fused contact pass has added the contact conduction of this state: add every
-        other term and form the total heat rates, for the thermal step that follows."""
+        other term and (``complete``) form the source column and total heat rates, which the
+        thermal step that follows forms anyway: without ``complete`` they are left to it, or
+        to :meth:`complete_rates` when something reads them first (``rates_pending``)."""
         self._fixed_and_sources(time)
         self.evaluate_terms(time)
-        self.finish(time)
+        if complete:
+            self.finish(time)
+        else:
+            self.rates_pending = True
+
+    def complete_rates(self) -> None:
+        """Form the source column and the total heat rates if the last contact pass left
+        them to the next thermal step (outputs, checkpoints and the API call this)."""
+        if self.rates_pending:
+            self.finish(self.sim.time)
 
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
         kernels.finish_heat(self.source, p.heat_rate, p.heat_rate_by_mechanism, self.sum_columns)
+        self.rates_pending = False
         return self.fixed
 
     def specific_heat(self) -> np.ndarray:
@@ -616,9 +676,14 @@ class ThermalEngine:
             return self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
         return self.specific_heat_by_type[p.type_id]
 
-    def step(self, dt: float, time: float) -> None:
+    def step(self, dt: float, time: float, clear: bool = False) -> None:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler, or the
-        implicit scheme of ``thermal.scheme``: engine/implicit.py)."""
+        implicit scheme of ``thermal.scheme``: engine/implicit.py).
+
+        ``clear``: the contact pass of this same step evaluates the heat of the next state
+        (heat every step): the explicit update then zeroes the mechanism rates and conductance
+        sums it has read (``rates_cleared``), so that the force reset need not. Nothing reads
+        them in between (outputs are written after the step)."""
         if self.implicit is not None:
             self.implicit.step(dt, time)
             self.thermal_steps += 1
@@ -636,6 +701,7 @@ class ThermalEngine:
         by_mech = p.heat_rate_by_mechanism
         if self.has_c_table:
             kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)
+            self.rates_pending = False
             c = self.specific_heat()
             self.limit, where = kernels.stability_limit(p.mass, c, self.conductance_sum, fixed)
             boundary = by_mech[:, self.boundary_columns].sum(axis=0)
@@ -650,8 +716,10 @@ class ThermalEngine:
             self.limit, where, absorbed, bad = kernels.euler_step(
                 p.temperature, p.heat_rate, by_mech, self.sum_columns, source, p.mass, p.type_id,
                 self.specific_heat_by_type, self.conductance_sum, fixed, dt,
-                self.euler_partials,
+                self.euler_partials, clear,
             )  # fmt: skip
+            self.rates_cleared = clear
+            self.rates_pending = False  # the update formed them
             boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
             boundary = boundary[self.boundary_columns]
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
@@ -719,6 +787,7 @@ class ThermalEngine:
         ``heat_rate_<mechanism>``: for pairwise mechanisms the heat exchanged, ½ Σ|Q_i| (they
         sum to zero); for boundary mechanisms the net heat into the particles, Σ Q_i.
         """
+        self.complete_rates()
         p = self.sim.particles
         out: dict[str, float] = {}
         if p.count:
@@ -796,6 +865,11 @@ class ThermalEngine:
             for k in list(arrays)
             if k.startswith(EXTERNAL_PREFIX)
         }
+        from thermodem.engine.restart import check_thermal_arrays, keep_derived_thermal
+
+        # tables and ids made from the case stay this case's (a restart may change the case)
+        changed = keep_derived_thermal(self, scalars, arrays)
+        check_thermal_arrays(self, arrays)
         for name, value in scalars.items():
             current = getattr(self, name, None)
             if isinstance(current, float) and value is not None:
@@ -805,6 +879,9 @@ class ThermalEngine:
             setattr(self, name, value)
         for name, value in arrays.items():
             setattr(self, name, np.array(value, copy=True))
+        if changed:  # conductances kept from the old case's models are stale
+            self.conductance_ready = False
+            self.term_ready[:] = False
         if self.range_set is not None:
             if range_scalars is None:
                 raise ConfigError(
@@ -826,3 +903,20 @@ class ThermalEngine:
         if field_scalars is not None and self.field_provider.active:
             self.field_provider.load_state_dict({"scalars": field_scalars, "arrays": field_arrays})
         self.conditions.invalidate()
+
+
+def _range_key(term: HeatTerm) -> str:
+    """'thermal.indirect_conduction.cutoff_gap_ratio = 100.0' (the key that sets the range)."""
+    name = term.spec.range_parameter
+    if name is None:
+        return f"{term.key} = {term.choice.model!r}"
+    return f"{term.key}.{name} = {getattr(term.params, name)!r}"
+
+
+def _range_allowed(term: HeatTerm, factor: float) -> str:
+    """What the range parameter may be: its value scaled by ``factor`` (ranges are
+    proportional to it)."""
+    name = term.spec.range_parameter
+    if name is None:
+        return "smaller range parameters or a larger domain"
+    return f"{name} below {getattr(term.params, name) * factor:.6g} (or a larger domain)"

@@ -95,6 +95,7 @@ class ModelSpec:
     example_params: dict[str, Any] = field(default_factory=dict)
     planar: tuple[str, ...] = ()
     only_2d: bool = False
+    range_parameter: str | None = None
 
     @property
     def width(self) -> int:
@@ -138,6 +139,7 @@ def register(
     example_params: dict[str, Any] | None = None,
     planar: tuple[str, ...] = (),
     only_2d: bool = False,
+    range_parameter: str | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
 
@@ -150,11 +152,13 @@ def register(
     ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
     None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
     argument (the range pass then does not compute it); ``example_params`` parameters the
-    conformance tests use for a model without defaults; ``planar`` the particle shapes of a
-    two-dimensional case (``simulation.dimension: 2``) the model supports: ``"disc"`` (discs
-    of ``simulation.thickness``: the model has a 2D form, or needs none) and/or ``"sphere"``
-    (spheres kept in the plane: the 3D form is right for them); empty: 3D only, refused in 2D
-    before the run (:data:`PLANAR_SHAPES`); ``only_2d`` a 2D law (refused in 3D cases).
+    conformance tests use for a model without defaults; ``range_parameter`` the parameter
+    that sets ``interaction_range`` (in proportion), named by the range errors; ``planar`` the
+    particle shapes of a two-dimensional case (``simulation.dimension: 2``) the model
+    supports: ``"disc"`` (discs of ``simulation.thickness``: the model has a 2D form, or
+    needs none) and/or ``"sphere"`` (spheres kept in the plane: the 3D form is right for
+    them); empty: 3D only, refused in 2D before the run (:data:`PLANAR_SHAPES`); ``only_2d``
+    a 2D law (refused in 3D cases).
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -201,7 +205,10 @@ def register(
         example_params=dict(example_params or {}),
         planar=tuple(planar),
         only_2d=only_2d,
+        range_parameter=range_parameter,
     )
+    if range_parameter is not None and range_parameter not in params.model_fields:
+        raise ValueError(f"{family}.{name}: range_parameter {range_parameter!r} is no parameter")
     models[name] = spec
     return spec
 
