@@ -448,7 +448,7 @@ def models(
     family: str | None = typer.Argument(None, help="only this family (e.g. normal)"),
 ) -> None:
     """List every model: parameters (unit, default, bounds), requirements, reference."""
-    from thermodem.models.registry import FAMILIES, all_models
+    from thermodem.models.registry import FAMILIES, all_models, planar_support
 
     if family is not None and family not in FAMILIES:
         _fail(f"unknown family {family!r}; families: {', '.join(FAMILIES)}", EXIT_INPUT)
@@ -473,6 +473,7 @@ def models(
                 if spec.range_parameter:
                     where += f"; its range is set by {spec.range_parameter}"
                 typer.echo(f"    runs on: {where}")
+            typer.echo(f"    2D (simulation.dimension: 2): {planar_support(spec)}")
             if spec.conductance_from_force:
                 typer.echo(
                     "    allows thermal.conductance_force_tolerance (conductance reuse, "

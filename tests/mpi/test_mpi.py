@@ -203,6 +203,18 @@ def test_refused_under_mpi(change, key: str) -> None:  # noqa: ANN001
     assert key in str(info.value)
 
 
+def test_two_dimensional_case_refused_under_mpi() -> None:
+    """A disc simulation (simulation.dimension: 2) is refused under MPI, naming the key."""
+    from thermodem.config.load import load_case
+    from thermodem.errors import ConfigError
+    from thermodem.mpi.support import check_case
+
+    case = load_case(Path(__file__).parents[2] / "examples" / "drum_2d.yaml")
+    with pytest.raises(ConfigError, match="MPI does not support it yet") as info:
+        check_case(case)
+    assert "simulation.dimension" in str(info.value)
+
+
 def test_bisection_balances_and_tiles() -> None:
     """Recursive bisection of 1000 points among P boxes: counts within one of N/P, boxes
     tiling the domain, each point inside its box (comm None: one process)."""

@@ -59,7 +59,8 @@ def test_models_lists_the_gas_conduction_models_with_every_parameter_and_its_uni
                 break
             block.append(x)
         if spec.name == "none":
-            assert block == ["    parameters: none", "    reference: -"]
+            two_d = "    2D (simulation.dimension: 2): discs and spheres in a plane"
+            assert block == [two_d, "    parameters: none", "    reference: -"]
             continue
         for name, field in spec.params.model_fields.items():
             line = next(x for x in block if x.startswith(f"    {name}:"))

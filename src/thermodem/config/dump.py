@@ -22,7 +22,8 @@ def case_to_dict(value: Any) -> Any:
     if isinstance(value, ModelChoice):
         return {"model": value.model, **case_to_dict(value.params)}
     if isinstance(value, BaseModel):
-        return {name: case_to_dict(getattr(value, name)) for name in type(value).model_fields}
+        names = [n for n in type(value).model_fields if n not in _omitted(value)]
+        return {name: case_to_dict(getattr(value, name)) for name in names}
     if isinstance(value, dict):
         return {str(k): case_to_dict(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
@@ -32,6 +33,19 @@ def case_to_dict(value: Any) -> Any:
     if value is None or isinstance(value, bool | int | float | str):
         return value
     return str(value)
+
+
+#: Keys of 2D cases only (``simulation.dimension: 2``): left out of a 3D case, which refuses
+#: them.
+_PLANAR_ONLY = ("thickness", "particle_shape")
+
+
+def _omitted(value: BaseModel) -> tuple[str, ...]:
+    from thermodem.config.schema import SimulationSettings
+
+    if isinstance(value, SimulationSettings) and not value.planar:
+        return _PLANAR_ONLY
+    return ()
 
 
 def resolved_case_yaml(case: BaseModel) -> str:

@@ -33,18 +33,18 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import (
     Field,
-    FiniteFloat,
     PositiveInt,
     TypeAdapter,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
 from scipy.special import ndtr
 
 from thermodem.config.base import StrictModel
+from thermodem.config.planar import Vec3, box_axes, is_planar
 
-Vec3 = tuple[FiniteFloat, FiniteFloat, FiniteFloat]
-"""Three finite floats (a point or a vector) [m] or [m/s]."""
+# Vec3: three finite floats (a point or a vector) [m] or [m/s]; [x, y] in a 2D case
 
 PositiveLength = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 """A strictly positive, finite length [m]."""
@@ -55,10 +55,10 @@ FRACTION_SUM_TOLERANCE = 1e-9
 """Allowed deviation of the sum of discrete fractions from 1."""
 
 
-def _check_box(lower: Vec3, upper: Vec3, what: str = "region") -> None:
-    """Raise ValueError unless ``lower < upper`` on every axis."""
+def _check_box(lower: Vec3, upper: Vec3, what: str = "region", axes: str = "xyz") -> None:
+    """Raise ValueError unless ``lower < upper`` on every axis of ``axes`` (2D: "xy")."""
     for axis, lo, hi in zip(_AXES, lower, upper, strict=True):
-        if not lo < hi:
+        if axis in axes and not lo < hi:
             raise ValueError(
                 f"{what}: lower corner must be < upper corner on every axis, but on the "
                 f"{axis} axis lower={lo!r} and upper={hi!r}"
@@ -278,8 +278,8 @@ class BoxRegion(StrictModel):
     upper: Vec3 = Field(description="upper corner (x, y, z) [m]")
 
     @model_validator(mode="after")
-    def _check(self) -> BoxRegion:
-        _check_box(self.lower, self.upper, "box region")
+    def _check(self, info: ValidationInfo) -> BoxRegion:
+        _check_box(self.lower, self.upper, "box region", box_axes(info))
         return self
 
 
@@ -343,15 +343,24 @@ class LatticeInsertion(_EntryBase):
         default=None, description="site spacing, one value or one per axis [m]"
     )
     count: tuple[PositiveInt, PositiveInt, PositiveInt] | None = Field(
-        default=None, description="number of sites along x, y and z"
+        default=None, description="number of sites along x, y and z (2D: [nx, ny])"
     )
     jitter: float = Field(
         default=0.0, ge=0, allow_inf_nan=False, description="maximum random displacement [m]"
     )
 
+    @field_validator("count", "spacing", mode="before")
+    @classmethod
+    def _per_axis_2d(cls, value: Any, info: ValidationInfo) -> Any:
+        """2D: ``[nx, ny]`` is one layer (z count 1); ``[sx, sy]`` gets an unused z spacing."""
+        if is_planar(info) and isinstance(value, list | tuple) and len(value) == 2:
+            return (value[0], value[1], 1 if info.field_name == "count" else value[0])
+        return value
+
     @model_validator(mode="after")
-    def _check(self) -> LatticeInsertion:
-        _check_box(self.lower, self.upper, "lattice insertion")
+    def _check(self, info: ValidationInfo) -> LatticeInsertion:
+        axes = box_axes(info)  # 2D: one layer of sites at z = 0, the z extent is not used
+        _check_box(self.lower, self.upper, "lattice insertion", axes)
         if (self.spacing is None) == (self.count is None):
             raise ValueError(
                 "lattice insertion: give exactly one of 'spacing' or 'count', got "
@@ -365,6 +374,8 @@ class LatticeInsertion(_EntryBase):
             )
         margin = r_max + self.jitter
         for a, axis in enumerate(_AXES):
+            if axis not in axes:
+                continue
             extent = self.upper[a] - self.lower[a]
             if extent < 2.0 * margin:
                 raise ValueError(
@@ -383,8 +394,8 @@ class LatticeInsertion(_EntryBase):
 
     @property
     def region(self) -> BoxRegion:
-        """The lattice box as a :class:`BoxRegion`."""
-        return BoxRegion(lower=self.lower, upper=self.upper)
+        """The lattice box as a :class:`BoxRegion` (validated with the entry)."""
+        return BoxRegion.model_construct(lower=self.lower, upper=self.upper)
 
     def axis_spacing(self, axis: int) -> float | None:
         """Site spacing along ``axis`` (0, 1, 2) [m]; None if there is a single site on it."""
@@ -423,8 +434,8 @@ class RandomBoxInsertion(_EntryBase):
     )
 
     @model_validator(mode="after")
-    def _check(self) -> RandomBoxInsertion:
-        _check_box(self.lower, self.upper, "random_box insertion")
+    def _check(self, info: ValidationInfo) -> RandomBoxInsertion:
+        _check_box(self.lower, self.upper, "random_box insertion", box_axes(info))
         if (self.count is None) == (self.volume_fraction is None):
             raise ValueError(
                 "random_box insertion: give exactly one of 'count' or 'volume_fraction', got "
@@ -434,8 +445,8 @@ class RandomBoxInsertion(_EntryBase):
 
     @property
     def region(self) -> BoxRegion:
-        """The box as a :class:`BoxRegion`."""
-        return BoxRegion(lower=self.lower, upper=self.upper)
+        """The box as a :class:`BoxRegion` (validated with the entry)."""
+        return BoxRegion.model_construct(lower=self.lower, upper=self.upper)
 
 
 class RandomCylinderInsertion(_EntryBase):
@@ -464,7 +475,7 @@ class RandomCylinderInsertion(_EntryBase):
     @property
     def region(self) -> CylinderRegion:
         """The cylinder as a :class:`CylinderRegion`."""
-        return CylinderRegion(
+        return CylinderRegion.model_construct(
             base_centre=self.base_centre, axis=self.axis, radius=self.radius, length=self.length
         )
 

@@ -9,6 +9,7 @@ import yaml
 from pydantic import ValidationError
 
 from thermodem.config.messages import format_validation_error
+from thermodem.config.planar import validation_context
 from thermodem.config.schema import Case
 from thermodem.errors import ConfigError
 
@@ -94,8 +95,8 @@ def case_from_dict(data: Any, source: str = "<case>") -> Case:
         raise ConfigError(
             f"{source}: the case must be a mapping of sections, got {type(data).__name__}"
         )
-    try:
-        return Case.model_validate(data)
+    try:  # a 2D case is validated in the context {"dimension": 2} (config/planar.py)
+        return Case.model_validate(data, context=validation_context(data))
     except ValidationError as exc:
         raise ConfigError(
             f"{source}: invalid case\n{_format_validation_error(exc, data)}"

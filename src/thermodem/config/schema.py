@@ -8,18 +8,21 @@ registry (with a "did you mean") and the remaining keys against that model's own
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, field_validator, model_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.config.insertion import InsertionEntry
+from thermodem.config.planar import Vec3, box_axes, is_planar
 from thermodem.config.thermal import Selection, ThermalSettings
 from thermodem.geometry.walls import Wall
 from thermodem.models import registry
 from thermodem.state.materials import InteractionOverride, Material
 
-Vec3 = tuple[float, float, float]
+#: Gravity when the case gives none: along -z in 3D, along -y in 2D (the plane is x-y).
+DEFAULT_GRAVITY_3D = (0.0, 0.0, -9.81)
+DEFAULT_GRAVITY_2D = (0.0, -9.81, 0.0)
 
 
 class ModelChoice(StrictModel):
@@ -88,10 +91,18 @@ class Domain(StrictModel):
     upper: Vec3
     periodic: tuple[bool, bool, bool] = (False, False, False)
 
+    @field_validator("periodic", mode="before")
+    @classmethod
+    def _periodic_2d(cls, v: Any, info: ValidationInfo) -> Any:
+        if is_planar(info) and isinstance(v, list | tuple) and len(v) == 2:
+            return (v[0], v[1], False)
+        return v
+
     @model_validator(mode="after")
-    def _check(self) -> Domain:
+    def _check(self, info: ValidationInfo) -> Domain:
+        axes = box_axes(info)  # 2D: the z extent is not used (the plane z = 0)
         for axis, lo, hi in zip("xyz", self.lower, self.upper, strict=True):
-            if not lo < hi:
+            if axis in axes and not lo < hi:
                 raise ValueError(
                     f"lower must be < upper on every axis; on {axis}: lower={lo}, upper={hi}"
                 )
@@ -136,7 +147,19 @@ class TimeStepCheck(StrictModel):
 class SimulationSettings(StrictModel):
     time_step: float = Field(gt=0, description="[s]")
     end_time: float = Field(gt=0, description="[s]")
-    gravity: Vec3 = (0.0, 0.0, -9.81)
+    dimension: Literal[2, 3] = Field(
+        default=3, description="3: spheres in space; 2: discs (or spheres) in the x-y plane"
+    )
+    thickness: float = Field(
+        default=1.0,
+        gt=0,
+        description="2D: thickness b of the discs [m] (mass ρ π R² b, heat rates of a disc of "
+        "that thickness; 1 m: per unit thickness)",
+    )
+    particle_shape: Literal["disc", "sphere"] = Field(
+        default="disc", description="2D: discs of the thickness, or spheres kept in the plane"
+    )
+    gravity: Vec3 = DEFAULT_GRAVITY_3D
     seed: int = Field(default=12345, ge=0)
     initial_temperature: float = Field(default=293.15, gt=0, description="[K]")
     time_step_check: TimeStepCheck = Field(default_factory=TimeStepCheck)
@@ -146,6 +169,46 @@ class SimulationSettings(StrictModel):
         le=1,
         description="stop when an overlap exceeds this fraction of the smaller radius",
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _gravity_2d(cls, data: Any) -> Any:
+        """Default gravity of a 2D case: -9.81 m/s² along y."""
+        if isinstance(data, dict) and data.get("dimension") == 2 and "gravity" not in data:
+            data = {**data, "gravity": DEFAULT_GRAVITY_2D}
+        return data
+
+    @model_validator(mode="after")
+    def _only_2d(self) -> SimulationSettings:
+        if self.dimension == 3:
+            for key in ("thickness", "particle_shape"):
+                if key in self.model_fields_set:
+                    raise ValueError(
+                        f"{key}: {getattr(self, key)!r} is a key of 2D cases only; set "
+                        "dimension: 2 or remove it"
+                    )
+        elif self.particle_shape == "sphere" and "thickness" in self.model_fields_set:
+            raise ValueError(
+                f"thickness: {self.thickness!r} is the length of discs; with particle_shape: "
+                "sphere the particles are spheres (no thickness): remove it"
+            )
+        elif self.gravity[2] != 0.0:
+            raise ValueError(
+                f"gravity: {list(self.gravity)} has a z component in a 2D case (the particles "
+                "move in the x-y plane): give [gx, gy] or [gx, gy, 0]"
+            )
+        return self
+
+    @property
+    def planar(self) -> bool:
+        """A two-dimensional case (``dimension: 2``)."""
+        return self.dimension == 2
+
+    @property
+    def disc_thickness(self) -> float:
+        """The disc thickness b [m] of a 2D case of discs, else 0 (3D, spheres in a plane):
+        what the models with a 2D form read (``PairContext.thickness``)."""
+        return float(self.thickness) if self.planar and self.particle_shape == "disc" else 0.0
 
 
 class Output(StrictModel):
@@ -238,6 +301,14 @@ class Case(StrictModel):
     def _names(self) -> Case:
         if not self.materials:
             raise ValueError("materials: at least one material is needed")
+        if self.simulation.planar:
+            from thermodem.config.planar_case import check_planar_case
+
+            check_planar_case(self)  # 2D: in-plane vectors, walls as lines, models with a 2D form
+        else:
+            from thermodem.config.planar_case import check_not_planar
+
+            check_not_planar(self)  # 3D: no 2D-only law
         known = set(self.materials)
         allowed = ", ".join(sorted(known))
         for k, w in enumerate(self.walls):
@@ -308,7 +379,7 @@ class Case(StrictModel):
         else:
             return
         dom = self.domain
-        for a, axis in enumerate("xyz"):
+        for a, axis in enumerate("xy" if self.simulation.planar else "xyz"):
             tol = 1e-9 * (dom.upper[a] - dom.lower[a])
             if lower[a] < dom.lower[a] - tol or upper[a] > dom.upper[a] + tol:
                 raise ValueError(

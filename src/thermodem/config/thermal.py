@@ -27,13 +27,12 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.config.fluid import FluidSettings, PorositySettings, parse_porosity
+from thermodem.config.planar import Vec3, box_axes
 from thermodem.state.gas import GasProperties
-
-Vec3 = tuple[float, float, float]
 
 
 def parse_thermal_choice(family: str, value: Any, default: str):  # noqa: ANN201
@@ -49,9 +48,10 @@ class Box(StrictModel):
     upper: Vec3
 
     @model_validator(mode="after")
-    def _check(self) -> Box:
+    def _check(self, info: ValidationInfo) -> Box:
+        axes = box_axes(info)  # 2D: [x, y] corners are read with z = 0 (faces included)
         for axis, lo, hi in zip("xyz", self.lower, self.upper, strict=True):
-            if not lo < hi:
+            if axis in axes and not lo < hi:
                 raise ValueError(
                     f"lower must be < upper on every axis; on {axis}: lower={lo}, upper={hi}"
                 )

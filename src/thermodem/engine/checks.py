@@ -7,7 +7,8 @@
   smallest particles of each material pair (and particle–wall, m* = m, R* = R) at the
   characteristic impact speed v. Warn when a collision would last fewer than
   ``collision_warn_steps`` steps, refuse below ``collision_min_steps``.
-  For the linear spring the collision time is π sqrt(m*/k) / sqrt(1 - ζ²) instead.
+  For the linear spring the collision time is π sqrt(m*/k) / sqrt(1 - ζ²) instead, and the
+  same with k = (π/4) E* b for the 2D line contact ``hertz_2d`` (masses of discs, ρ π R² b).
 
 ``allow_unstable: true`` turns refusals into warnings.
 """
@@ -20,8 +21,13 @@ import numpy as np
 
 from thermodem.config.schema import Case
 from thermodem.errors import ConfigError
-from thermodem.models.mechanics.normal import hertz_collision_time, linear_damping_ratio
+from thermodem.models.mechanics.normal import (
+    hertz_2d_stiffness,
+    hertz_collision_time,
+    linear_collision_time,
+)
 from thermodem.state.materials import effective_youngs_modulus, resolve_pair
+from thermodem.state.particles import particle_mass
 
 
 def rayleigh_time(radius: float, density: float, shear_modulus: float, poisson: float) -> float:
@@ -62,6 +68,11 @@ def critical_times(
     out = {"rayleigh": math.inf, "collision": math.inf, "impact_speed": v}
     normal = case.contact.normal
     wall_mats = {w.material for w in case.walls}
+    thickness = case.simulation.disc_thickness  # 2D discs: their masses, hertz_2d's stiffness
+
+    def mass(density: float, r: float) -> float:
+        return float(particle_mass(np.float64(density), np.float64(r), thickness))
+
     for a, ra in r_min.items():
         ma = case.materials[a]
         out["rayleigh"] = min(
@@ -70,16 +81,19 @@ def critical_times(
         partners = [(b, r_min[b], False) for b in r_min] + [(b, math.inf, True) for b in wall_mats]
         for b, rb, is_wall in partners:
             mb = case.materials[b]
-            m_a = ma.density * 4.0 / 3.0 * math.pi * ra**3
+            m_a = mass(ma.density, ra)
             if is_wall:
                 m_eff, r_eff = m_a, ra
             else:
-                m_b = mb.density * 4.0 / 3.0 * math.pi * rb**3
+                m_b = mass(mb.density, rb)
                 m_eff, r_eff = m_a * m_b / (m_a + m_b), ra * rb / (ra + rb)
-            if normal.model == "linear":
-                k = normal.params.stiffness
-                zeta = linear_damping_ratio(resolve_pair(ma, mb).restitution)
-                tc = math.pi * math.sqrt(m_eff / k) / math.sqrt(max(1.0 - zeta**2, 1e-12))
+            if normal.model in ("linear", "hertz_2d"):
+                if normal.model == "linear":
+                    k = normal.params.stiffness
+                else:
+                    k = hertz_2d_stiffness(effective_youngs_modulus(ma, mb), thickness or 1.0)
+                e = resolve_pair(ma, mb).restitution
+                tc = linear_collision_time(m_eff, k, max(e, 1e-6))  # (e = 0: critical damping)
             else:
                 tc = hertz_collision_time(m_eff, r_eff, effective_youngs_modulus(ma, mb), v)
             out["collision"] = min(out["collision"], tc)

@@ -40,6 +40,9 @@ bonds b of one cell counted once:
     k = (H / V_cell) Σ_{bonds in a cell} (b·e)²:  SC H/a, BCC 2H/a, FCC 4H/a
 
 with a the cubic cell edge (a = 2R, 4R/√3, 2√2 R for touching spheres).
+
+2D cases of discs: the axes are x and y, and the cross-section is the in-plane extent times
+the disc thickness b (docs/two-dimensional.md).
 """
 
 from __future__ import annotations
@@ -108,9 +111,12 @@ def effective_conductivity(
     first gives the reported value. The particles' temperatures are left at the last solve.
     """
     _check_case(sim)
-    bad = [a for a in axes if a not in AXES]
+    allowed = "xy" if getattr(sim, "planar", False) else "xyz"  # 2D: in the plane
+    bad = [a for a in axes if a not in allowed]
     if bad or not axes:
-        raise ConfigError(f"effective conductivity: axes = {axes!r}; allowed: letters of 'xyz'")
+        raise ConfigError(
+            f"effective conductivity: axes = {axes!r}; allowed: letters of {allowed!r}"
+        )
     p = sim.particles
     if p.count == 0:
         raise ConfigError("effective conductivity: the case has no particles")
@@ -133,7 +139,9 @@ def effective_conductivity(
         for b in range(3):
             if b == a:
                 continue
-            if sim.periodic[b]:
+            if b == 2 and getattr(sim, "disc_thickness", 0.0) > 0.0:
+                area *= float(sim.disc_thickness)  # 2D discs: a section of the thickness
+            elif sim.periodic[b]:
                 area *= float(sim.upper[b] - sim.lower[b])
             else:
                 pb = p.position[:, b]

@@ -35,6 +35,16 @@ def cell_size(sim: Simulation) -> float:
     return 2.0 * r_max + sim.extra + (sim.skin or 0.0)
 
 
+def cell_grid(sim: Simulation, cell: float) -> tuple[np.ndarray, np.ndarray]:
+    """Cells per axis and their edges for a cut-off ``cell``; a 2D case has one layer along z
+    (its particles lie in the plane z = 0), so a particle's stencil holds 9 cells, not 27."""
+    dims, edge = NB.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
+    if sim.planar:
+        dims[2] = 1
+        edge[2] = sim.upper[2] - sim.lower[2]
+    return dims, edge
+
+
 def rebuild_lists(sim: Simulation) -> None:
     """Sort particles by cell, list pairs and wall pairs, carry the history by identity."""
     p = sim.particles
@@ -58,7 +68,7 @@ def rebuild_lists(sim: Simulation) -> None:
                 sim.step_count,
                 sim.time,
             )
-    dims, edge = NB.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
+    dims, edge = cell_grid(sim, cell)
     axis = int(SL.choose_axis(p.position, sim.lower, edge, dims))
     sim.slab_axis = axis  # the particles' memory order is by layers along it (range set)
     axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)

@@ -122,6 +122,9 @@ class RangePairSet:
         # its halo, periodic only where the halo wraps: Simulation.grid_box)
         lower, upper, periodic = sim.grid_box()
         dims, edge = nbr.cell_grid(lower, upper, cell, periodic)
+        if getattr(sim, "planar", False):  # 2D: one cell layer along z (as the contact list)
+            dims[2] = 1
+            edge[2] = upper[2] - lower[2]
         # the slab axis of the contact list: the particles lie in memory by layers along it,
         # so each group of this set touches a compact block of memory (see below)
         axis = getattr(sim, "slab_axis", None)

@@ -95,6 +95,8 @@ DERIVED: tuple[str, ...] = (
     "lower",
     "upper",
     "periodic",
+    "planar",  # 2D (simulation.dimension) and the disc thickness: from the case
+    "disc_thickness",
     "wall_kind",
     "wall_labels",
     "wall_material",

@@ -92,6 +92,10 @@ class Simulation:
         self.case = case
         sim = case.simulation
         self.dt = float(sim.time_step)
+        # 2D (docs/two-dimensional.md): particles in the plane z = 0, discs of thickness b
+        # (disc_thickness > 0) or spheres kept in the plane (disc_thickness = 0)
+        self.planar = bool(sim.planar)
+        self.disc_thickness = float(sim.disc_thickness)
         self.time = 0.0
         self.step_count = 0
         self.gravity = np.asarray(sim.gravity, np.float64)
@@ -120,9 +124,12 @@ class Simulation:
         dom = case.domain
         self.lower = np.asarray(dom.lower, np.float64)
         self.upper = np.asarray(dom.upper, np.float64)
+        if self.planar:  # the slab of the discs around z = 0 (one cell layer, see rebuild)
+            half = 0.5 * (self.disc_thickness if self.disc_thickness > 0.0 else 1.0)
+            self.lower[2], self.upper[2] = -half, half
         self.periodic = np.asarray(dom.periodic, np.bool_)
         self.wall_kind, self.wall_rows, self.wall_labels = wall_rows(
-            case.walls, self.material_index
+            case.walls, self.material_index, self.planar
         )
         self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
@@ -150,7 +157,7 @@ class Simulation:
             check_insertion_memory(case)  # before anything is allocated (engine/validation.py)
         for k, entry in enumerate(case.insertion):
             if entry.kind == "pour":
-                self.pourers.append(Pourer(entry, self.rng))
+                self.pourers.append(Pourer(entry, self.rng, self.planar))
             elif insert_particles:
                 self.add_particles(
                     insert(
@@ -161,6 +168,7 @@ class Simulation:
                         key=f"insertion.{k}",
                         domain=(self.lower, self.upper),
                         max_overlap_ratio=sim.max_overlap_ratio,
+                        planar=self.planar,
                     )
                 )
         if case.external_force and insert_particles:
@@ -278,6 +286,7 @@ class Simulation:
             temperature,
             mechanisms=self.mechanisms,
             external=bool(self.case.external_force),
+            disc_thickness=self.disc_thickness,
         )
         EL.assign(self.case, extra, self.material_index)
         if hasattr(self, "ledger_cumulative"):
@@ -354,7 +363,7 @@ class Simulation:
             th.after_contact_pass(self.time, self._complete)
         if kick:
             final_kick(p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
-                       p.moment_of_inertia, self.dt)  # fmt: skip
+                       p.moment_of_inertia, self.dt, self.planar)  # fmt: skip
         self._accumulate_ledger(kick)
 
     def _accumulate_ledger(self, count_dissipation: bool) -> None:
@@ -423,6 +432,7 @@ class Simulation:
             self.periodic,
             self.reference,
             self.chunk_check,
+            self.planar,
         )
         self.moved, bad, code = reduce_checks(self.chunk_check, p.count)
         if bad >= 0:

@@ -26,6 +26,7 @@ import numpy as np
 from thermodem.config.thermal import Selection
 from thermodem.engine.expressions import compile_expression
 from thermodem.geometry import wall_layout as wall_cols
+from thermodem.geometry.walls import row_count
 from thermodem.kernels.conditions import (
     CHUNK,
     FIXED,
@@ -72,7 +73,7 @@ class ThermalConditions:
         constant = True
         for w in sim.case.walls:
             fn = wall_temperature_function(w.thermal) if w.thermal.kind == "fixed" else None
-            count = 6 - int(w.open_top) if w.kind == "box" else 1
+            count = row_count(w, bool(getattr(sim, "planar", False)))
             self.wall_functions.extend([fn] * count)
             constant &= not isinstance(getattr(w.thermal, "temperature", None), list | str)
         #: no wall temperature depends on time: the rows are written once
@@ -155,7 +156,8 @@ class ThermalConditions:
         classify_conditions(
             reference, p.radius, self.static_mask, self.kinds, self.values, self.has_region,
             self.boxes, allowance, sim.lower, sim.upper, sim.periodic, self.fixed,
-            self.base_source, self.bath, self.code,
+            self.base_source, self.bath, self.code, float(getattr(sim, "disc_thickness", 0.0)),
+            2 if getattr(sim, "planar", False) else 3,
         )  # fmt: skip
         self.listed = np.flatnonzero(self.code).astype(np.int64)
         self.static_valid = True
@@ -200,11 +202,13 @@ class ThermalConditions:
             split = int(np.searchsorted(self.listed, own))
             parts = (self.listed[:split], self.listed[split:])
         reset = 0.0
+        thickness = float(getattr(self.sim, "disc_thickness", 0.0))  # 2D discs
         for k, listed in enumerate(parts):
             r = apply_listed(
                 listed, self.code, p.position, p.radius, p.mass, p.type_id, p.temperature,
                 specific_heat_by_type, self.static_mask, self.kinds, self.values,
                 self.has_region, self.boxes, self.fixed, self.base_source, self.bath, self._part,
+                thickness,
             )  # fmt: skip
             reset = r if k == 0 else reset
         active = [e for e in self.settings.external_source if e.start_time <= time < e.end_time]

@@ -319,19 +319,19 @@ def insertion_counts(case: Case) -> list[tuple[str, float, str]]:
 
     out: list[tuple[str, float, str]] = []
     end = case.simulation.end_time
+    planar = case.simulation.planar
     for k, entry in enumerate(case.insertion):
         key = f"insertion.{k}"
         if entry.kind == "lattice":
-            nx, ny, nz = lattice_axis_counts(entry)
+            nx, ny, nz = lattice_axis_counts(entry, planar)
             out.append((key, float(nx) * ny * nz, f"a lattice of {nx} × {ny} × {nz} sites"))
         elif entry.kind in ("random_box", "random_cylinder"):
             if entry.count is not None:
                 out.append((key, float(entry.count), f"count {entry.count}"))
             else:
-                volume = entry.volume_fraction * float(
-                    np.prod(np.subtract(entry.upper, entry.lower))
-                )
-                n = volume / mean_sphere_volume(entry.distribution)
+                extent = np.subtract(entry.upper, entry.lower)
+                volume = entry.volume_fraction * float(np.prod(extent[:2] if planar else extent))
+                n = volume / mean_sphere_volume(entry.distribution, planar=planar)
                 out.append((key, n, f"volume_fraction {entry.volume_fraction}"))
         elif entry.kind == "pour":
             n, _ = poured_particles(entry, 0.0, end)

@@ -72,27 +72,44 @@ def sample_radii(dist: Any, count: int, rng: np.random.Generator) -> np.ndarray:
     raise TypeError(f"unknown radius distribution {type(dist).__name__}")
 
 
-def _radii_for_volume(dist: Any, volume: float, rng: np.random.Generator) -> np.ndarray:
-    """Radii drawn one after another until their summed sphere volume reaches ``volume``."""
+def _measure(r: np.ndarray, planar: bool) -> np.ndarray:
+    """Sphere volumes 4/3 π r³, or disc areas π r² (``planar``: a 2D case fills areas)."""
+    return np.pi * r**2 if planar else 4.0 / 3.0 * np.pi * r**3
+
+
+def _radii_for_volume(
+    dist: Any, volume: float, rng: np.random.Generator, planar: bool = False
+) -> np.ndarray:
+    """Radii drawn one after another until their summed sphere volume (``planar``: disc area)
+    reaches ``volume``."""
     chunks: list[np.ndarray] = []
     total = 0.0
     size = 1024
     while total < volume:
         r = sample_radii(dist, size, rng)
         chunks.append(r)
-        total += float(np.sum(4.0 / 3.0 * np.pi * r**3))
+        total += float(np.sum(_measure(r, planar)))
         size *= 2
     radii = np.concatenate(chunks)
-    cumulative = np.cumsum(4.0 / 3.0 * np.pi * radii**3)
+    cumulative = np.cumsum(_measure(radii, planar))
     n = int(np.searchsorted(cumulative, volume)) + 1
     return radii[: min(n, radii.size)]
 
 
-def mean_sphere_volume(dist: Any, samples: int = 8192) -> float:
+def mean_sphere_volume(dist: Any, samples: int = 8192, planar: bool = False) -> float:
     """Mean sphere volume 4/3 π E[r³] [m³] of a radius distribution: exact for ``mono`` and
     ``discrete``, else estimated from ``samples`` radii drawn with a fixed seed of their own
     (the run's generator is not touched, so the particles of the run do not change). Used to
-    judge whether a requested count can fit a region before drawing it."""
+    judge whether a requested count can fit a region before drawing it. ``planar`` (a 2D
+    case): the mean disc area π E[r²] [m²] instead."""
+    if planar:
+        if isinstance(dist, MonoRadius):
+            return math.pi * dist.radius**2
+        if isinstance(dist, DiscreteRadius):
+            radii = np.asarray(dist.radii, dtype=np.float64)
+            return float(math.pi * np.sum(dist.number_fractions() * radii**2))
+        r = sample_radii(dist, samples, np.random.default_rng(20240601))
+        return float(math.pi * np.mean(r**2))
     if isinstance(dist, MonoRadius):
         return 4.0 / 3.0 * math.pi * dist.radius**3
     if isinstance(dist, DiscreteRadius):

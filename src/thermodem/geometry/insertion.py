@@ -33,9 +33,11 @@ from thermodem.geometry.distributions import _radii_for_volume, mean_sphere_volu
 from thermodem.geometry.random_fill import (
     _AXES,
     _Box,
+    _Circle,
     _Cylinder,
     _Obstacles,
     _random_fill,
+    _Rect,
     _region_of,
 )
 from thermodem.io.particle_file import (  # noqa: F401 (re-exported)
@@ -120,31 +122,39 @@ def _assemble(
 # --------------------------------------------------------------------------------------------
 
 
-def lattice_axis_counts(entry: LatticeInsertion) -> tuple[int, int, int]:
-    """Number of lattice sites along x, y and z (without allocating them)."""
+def lattice_axis_counts(entry: LatticeInsertion, planar: bool = False) -> tuple[int, int, int]:
+    """Number of lattice sites along x, y and z (without allocating them); ``planar`` (2D):
+    one layer at z = 0."""
     r_max = entry.distribution.max_radius_bound
     if r_max is None:
         raise ValueError("lattice insertion needs a bounded radius distribution (set max_radius)")
     if entry.count is not None:
-        return (int(entry.count[0]), int(entry.count[1]), int(entry.count[2]))
+        nz = 1 if planar else int(entry.count[2])
+        return (int(entry.count[0]), int(entry.count[1]), nz)
     margin = r_max + entry.jitter
     out = []
-    for a in range(3):
+    for a in range(2 if planar else 3):
         span = entry.upper[a] - entry.lower[a] - 2.0 * margin
         spacing = entry.axis_spacing(a)
         assert spacing is not None
         out.append(int(math.floor(max(span, 0.0) / spacing + 1e-9)) + 1)
+    if planar:
+        out.append(1)
     return (out[0], out[1], out[2])
 
 
-def lattice_sites(entry: LatticeInsertion) -> np.ndarray:
-    """Unjittered lattice sites (n, 3) of a ``lattice`` entry, x varying fastest, then y, z."""
+def lattice_sites(entry: LatticeInsertion, planar: bool = False) -> np.ndarray:
+    """Unjittered lattice sites (n, 3) of a ``lattice`` entry, x varying fastest, then y, z;
+    ``planar`` (2D): one layer at z = 0."""
     r_max = entry.distribution.max_radius_bound
     if r_max is None:
         raise ValueError("lattice insertion needs a bounded radius distribution (set max_radius)")
     margin = r_max + entry.jitter
     coords = []
     for a, axis in enumerate(_AXES):
+        if planar and a == 2:
+            coords.append(np.zeros(1))
+            continue
         lo, hi = entry.lower[a], entry.upper[a]
         span = hi - lo - 2.0 * margin
         if span < 0.0:
@@ -175,15 +185,21 @@ def _insert_lattice(
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
     walls_ok: WallsOk | None,
+    planar: bool = False,
 ) -> InsertedParticles:
-    sites = lattice_sites(entry)
+    sites = lattice_sites(entry, planar)
     radii = sample_radii(entry.distribution, sites.shape[0], rng)
     if entry.jitter > 0.0:
-        sites = sites + rng.uniform(-entry.jitter, entry.jitter, sites.shape)
+        jitter = rng.uniform(-entry.jitter, entry.jitter, sites.shape)
+        if planar:
+            jitter[:, 2] = 0.0
+        sites = sites + jitter
     keep = np.ones(radii.size, dtype=np.bool_)
     if radii.size:
-        lower = np.asarray(entry.lower, dtype=np.float64)
-        upper = np.asarray(entry.upper, dtype=np.float64)
+        lower = np.array(entry.lower, dtype=np.float64)
+        upper = np.array(entry.upper, dtype=np.float64)
+        if planar:
+            lower[2] = upper[2] = 0.0
         obstacles = _Obstacles(
             lower, upper, float(radii.max()), existing_positions, existing_radii, 0
         )
@@ -199,29 +215,36 @@ def _insert_random(
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
     walls_ok: WallsOk | None,
+    planar: bool = False,
 ) -> InsertedParticles:
+    region: _Box | _Cylinder | _Circle
     if isinstance(entry, RandomBoxInsertion):
-        region: _Box | _Cylinder = _Box(entry.lower, entry.upper)
+        region = _Rect(entry.lower, entry.upper) if planar else _Box(entry.lower, entry.upper)
+    elif planar:  # a circle in the plane (the axis is along z: checked with the case)
+        region = _Circle(entry.base_centre, entry.radius)
     else:
         region = _Cylinder(entry.base_centre, entry.axis, entry.radius, entry.length)
     bound = entry.distribution.max_radius_bound
     if bound is not None:
         region.check_fits(float(bound), f"{entry.kind} insertion")
     if entry.count is not None:
-        fraction = entry.count * mean_sphere_volume(entry.distribution) / region.volume()
+        mean = mean_sphere_volume(entry.distribution, planar=planar)
+        fraction = entry.count * mean / region.volume()
         if fraction > RSA_MAX_FRACTION:
+            what, unit = ("disc area", "m²") if planar else ("sphere volume", "m³")
+            jam = "0.55 for equal discs" if planar else "0.38 for equal spheres"
             raise ValueError(
-                f"count: {entry.count} particles (mean sphere volume "
-                f"{mean_sphere_volume(entry.distribution):.3g} m³) would fill {fraction:.3g} of "
-                f"the region's volume {region.volume():.3g} m³; random sequential addition "
-                f"jams near 0.38 for equal spheres, so more than {RSA_MAX_FRACTION} is refused: "
-                "lower count, enlarge the region, or use a lattice (and let the particles "
-                "settle)"
+                f"count: {entry.count} particles (mean {what} {mean:.3g} {unit}) would fill "
+                f"{fraction:.3g} of the region's {'area' if planar else 'volume'} "
+                f"{region.volume():.3g} {unit}; random sequential addition jams near {jam}, "
+                f"so more than {RSA_MAX_FRACTION} is refused: lower count, enlarge the region, "
+                "or use a lattice (and let the particles settle)"
             )
         radii = sample_radii(entry.distribution, entry.count, rng)
     else:
         assert isinstance(entry, RandomBoxInsertion) and entry.volume_fraction is not None
-        radii = _radii_for_volume(entry.distribution, entry.volume_fraction * region.volume(), rng)
+        target = entry.volume_fraction * region.volume()
+        radii = _radii_for_volume(entry.distribution, target, rng, planar)
     region.check_fits(float(radii.max()), f"{entry.kind} insertion")
     positions, placed = _random_fill(
         region, radii, rng, existing_positions, existing_radii, walls_ok, entry.max_attempts
@@ -250,8 +273,14 @@ def insert(
     key: str = "insertion",
     domain: tuple[np.ndarray, np.ndarray] | None = None,
     max_overlap_ratio: float = DEFAULT_MAX_OVERLAP_RATIO,
+    planar: bool = False,
 ) -> InsertedParticles:
     """Insert the particles of one static entry (``lattice``, ``random_*``, ``file``, ``list``).
+
+    ``planar`` (a 2D case): the particles lie in the plane z = 0: a lattice has one layer, a
+    random box fills its x-y rectangle and a random cylinder (along z) its circle, with
+    ``volume_fraction`` an area fraction; a file may give ``x y r`` (z = 0), and given
+    particles with z != 0 are refused.
 
     ``existing_positions`` (n, 3) and ``existing_radii`` (n,) are the particles already present
     (None or empty arrays for none). ``walls_ok`` optionally screens spheres against the walls.
@@ -274,15 +303,20 @@ def insert(
     if isinstance(entry, PourInsertion):
         raise TypeError("'pour' insertion entries are time dependent: use Pourer(entry, rng)")
     try:
+        existing = (existing_positions, existing_radii, walls_ok, planar)
         if isinstance(entry, LatticeInsertion):
-            return _insert_lattice(entry, rng, existing_positions, existing_radii, walls_ok)
+            return _insert_lattice(entry, rng, *existing)
         if isinstance(entry, RandomBoxInsertion | RandomCylinderInsertion):
-            return _insert_random(entry, rng, existing_positions, existing_radii, walls_ok)
+            return _insert_random(entry, rng, *existing)
         if isinstance(entry, FileInsertion | ListInsertion):
-            given = _insert_file(entry, walls_ok) if isinstance(entry, FileInsertion) else None
+            given = (
+                _insert_file(entry, walls_ok, planar) if isinstance(entry, FileInsertion) else None
+            )
             if isinstance(entry, ListInsertion):
                 given = _insert_list(entry)
             assert given is not None
+            if planar:
+                _check_planar(given, entry)
             _check_given(
                 entry, given, key, domain, max_overlap_ratio, existing_positions, existing_radii
             )
@@ -314,10 +348,13 @@ class Pourer:
     ``skipped``; they are not requested again.
     """
 
-    def __init__(self, entry: PourInsertion, rng: np.random.Generator) -> None:
+    def __init__(
+        self, entry: PourInsertion, rng: np.random.Generator, planar: bool = False
+    ) -> None:
         self.entry = entry
         self.rng = rng
-        self._region = _region_of(entry.region)
+        self.planar = planar
+        self._region = _region_of(entry.region, planar)
         self.inserted = 0
         """Particles inserted so far."""
         self.skipped = 0
@@ -326,7 +363,11 @@ class Pourer:
         """Time up to which particles have been requested [s]."""
         self.batch_cap = max(
             1,
-            int(RSA_MAX_FRACTION * self._region.volume() / mean_sphere_volume(entry.distribution)),
+            int(
+                RSA_MAX_FRACTION
+                * self._region.volume()
+                / mean_sphere_volume(entry.distribution, planar=planar)
+            ),
         )
         """Most particles one batch tries to place: more than :data:`RSA_MAX_FRACTION` of the
         region could not be placed anyway (the rest of the batch is skipped at once, which
@@ -440,8 +481,22 @@ class _Given:
     """index -> 'insertion.0.positions.3' or "insertion.0.path: particle file 'f', line 7"."""
 
 
-def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None) -> _Given:
-    parsed = _parse_particle_file(entry.path, entry.material)
+def _check_planar(given: _Given, entry: FileInsertion | ListInsertion) -> None:
+    """2D: every given particle in the plane z = 0, moving in it."""
+    p = given.particles
+    for what, values in (("centre", p.position), ("velocity", p.velocity)):
+        bad = np.flatnonzero(values[:, 2] != 0.0)
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"{given.where(i)}: the particle {what} {_vec(values[i])} has a z component; "
+                f"in a 2D case particles lie and move in the plane z = 0 ({bad.size} of "
+                f"{len(p)} particles have z != 0)"
+            )
+
+
+def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None, planar: bool = False) -> _Given:
+    parsed = _parse_particle_file(entry.path, entry.material, planar)
     p = parsed.particles
     n = len(p)
     if not parsed.has_velocity:

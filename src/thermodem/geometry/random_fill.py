@@ -307,14 +307,82 @@ class _Cylinder:
         )
 
 
-def _region_of(region: BoxRegion | CylinderRegion) -> _Box | _Cylinder:
+class _Rect(_Box):
+    """A box region of a 2D case: the rectangle of its x-y extent in the plane z = 0; its
+    "volume" is the area (discs fill areas)."""
+
+    def __init__(self, lower: Any, upper: Any) -> None:
+        super().__init__(lower, upper)
+        self.lower[2] = 0.0
+        self.upper[2] = 0.0
+
+    def check_fits(self, r_max: float, what: str) -> None:
+        extent = self.upper - self.lower
+        for a, axis in enumerate(_AXES[:2]):
+            if extent[a] < 2.0 * r_max:
+                raise ValueError(
+                    f"{what}: a particle of radius {r_max!r} m does not fit in the box, which is "
+                    f"{extent[a]!r} m wide along {axis}; enlarge the box or use smaller radii"
+                )
+
+    def volume(self) -> float:
+        return float((self.upper[0] - self.lower[0]) * (self.upper[1] - self.lower[1]))
+
+    def sample(self, radii: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
+        r = radii[:, None, None]
+        u = rng.random((radii.size, k, 2))
+        out = np.zeros((radii.size, k, 3))
+        out[..., :2] = self.lower[:2] + r + u * (self.upper[:2] - self.lower[:2] - 2.0 * r)
+        return out
+
+
+class _Circle:
+    """A cylinder region along z of a 2D case: the circle of its radius around the axis in
+    the plane z = 0; its "volume" is the area. Centres keep a distance r from the circle."""
+
+    def __init__(self, base_centre: Any, radius: float) -> None:
+        self.centre = np.asarray(base_centre, dtype=np.float64).copy()
+        self.centre[2] = 0.0
+        self.radius = float(radius)
+
+    def bbox(self) -> tuple[np.ndarray, np.ndarray]:
+        half = np.array([self.radius, self.radius, 0.0])
+        return self.centre - half, self.centre + half
+
+    def check_fits(self, r_max: float, what: str) -> None:
+        if self.radius < r_max:
+            raise ValueError(
+                f"{what}: a particle of radius {r_max!r} m does not fit in the circle of "
+                f"radius {self.radius!r} m; enlarge the region or use smaller radii"
+            )
+
+    def volume(self) -> float:
+        return math.pi * self.radius**2
+
+    def sample(self, radii: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
+        r = radii[:, None]
+        u = rng.random((radii.size, k, 2))
+        rho = (self.radius - r) * np.sqrt(u[..., 0])
+        theta = 2.0 * np.pi * u[..., 1]
+        out = np.zeros((radii.size, k, 3))
+        out[..., 0] = self.centre[0] + rho * np.cos(theta)
+        out[..., 1] = self.centre[1] + rho * np.sin(theta)
+        return out
+
+
+def _region_of(
+    region: BoxRegion | CylinderRegion, planar: bool = False
+) -> _Box | _Cylinder | _Circle:
+    """The sampler of a region; ``planar`` (2D case): its x-y section in the plane z = 0."""
     if isinstance(region, BoxRegion):
-        return _Box(region.lower, region.upper)
+        return _Rect(region.lower, region.upper) if planar else _Box(region.lower, region.upper)
+    if planar:  # (the axis is along z: checked with the case)
+        return _Circle(region.base_centre, region.radius)
     return _Cylinder(region.base_centre, region.axis, region.radius, region.length)
 
 
 def _random_fill(
-    region: _Box | _Cylinder,
+    region: _Box | _Cylinder | _Circle,
     radii: np.ndarray,
     rng: np.random.Generator,
     existing_positions: np.ndarray | None,

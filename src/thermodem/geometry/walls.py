@@ -5,13 +5,12 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
+from thermodem.config.planar import Vec3, box_axes
 from thermodem.config.thermal import WallThermal
 from thermodem.geometry import wall_layout as L
-
-Vec3 = tuple[float, float, float]
 
 
 def _unit(v: Vec3, name: str) -> np.ndarray:
@@ -71,11 +70,15 @@ class BoxWall(_WallBase):
     kind: Literal["box"] = "box"
     lower: Vec3
     upper: Vec3
-    open_top: bool = Field(default=False, description="omit the face at upper z")
+    open_top: bool = Field(
+        default=False, description="omit the face at upper z (2D: the side at upper y)"
+    )
 
     @model_validator(mode="after")
-    def _check(self) -> BoxWall:
-        if any(u <= lo for lo, u in zip(self.lower, self.upper, strict=True)):
+    def _check(self, info: ValidationInfo) -> BoxWall:
+        axes = box_axes(info)  # 2D: the four sides x-, x+, y-, y+ (lines)
+        pairs = zip("xyz", self.lower, self.upper, strict=True)
+        if any(a in axes and u <= lo for a, lo, u in pairs):
             raise ValueError(
                 f"lower {list(self.lower)} must be below upper {list(self.upper)} on every axis"
             )
@@ -103,8 +106,25 @@ class CylinderWall(_WallBase):
 Wall = Annotated[PlaneWall | RectangleWall | BoxWall | CylinderWall, Field(discriminator="kind")]
 
 
-def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, np.ndarray, list]:
-    """Run-time (kinds, rows, labels) of every wall; a box expands to rectangles."""
+def row_count(wall: _WallBase, planar: bool = False) -> int:
+    """Rows :func:`wall_rows` makes of one wall: a box gives its faces (6, or 4 sides in 2D;
+    one less with ``open_top``), every other wall one row."""
+    if isinstance(wall, BoxWall):
+        return (4 if planar else 6) - int(wall.open_top)
+    return 1
+
+
+def wall_rows(
+    walls: list, material_index: dict[str, int], planar: bool = False
+) -> tuple[np.ndarray, np.ndarray, list]:
+    """Run-time (kinds, rows, labels) of every wall; a box expands to rectangles.
+
+    ``planar`` (a 2D case): walls are lines in the x-y plane (z = 0). A rectangle is a segment:
+    its extent along z is unbounded (inf) and its centre moves to z = 0; a box gives its four
+    sides x-, x+, y-, y+ (``open_top`` omits y+); a cylinder (axis along z, checked with the
+    case) is a circle: centre at z = 0, no length. The case checks (``config/planar_case.py``)
+    have made sure that every normal and velocity lies in the plane.
+    """
     kinds: list[int] = []
     rows: list[np.ndarray] = []
     labels: list[str] = []
@@ -117,9 +137,10 @@ def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, 
             c = 0.5 * (lo + hi)
             h = 0.5 * (hi - lo)
             faces = []
-            for axis in range(3):
+            top = 1 if planar else 2  # the open top: upper y in 2D, upper z in 3D
+            for axis in range(2 if planar else 3):
                 for side in (-1.0, 1.0):
-                    if axis == 2 and side > 0 and w.open_top:
+                    if axis == top and side > 0 and w.open_top:
                         continue
                     normal = np.zeros(3)
                     normal[axis] = -side  # inward
@@ -129,13 +150,17 @@ def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, 
                     va = (axis + 2) % 3
                     u = np.zeros(3)
                     u[ua] = 1.0
+                    h_face = h.copy()
+                    if planar:  # a line: unbounded along z, in the plane z = 0
+                        center[2] = 0.0
+                        h_face[2] = np.inf
                     faces.append(
                         (
                             center,
                             normal,
                             u,
-                            h[ua],
-                            h[va],
+                            h_face[ua],
+                            h_face[va],
                             f"{label}.{'xyz'[axis]}{'-' if side < 0 else '+'}",
                         )
                     )
@@ -166,6 +191,10 @@ def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, 
             row[L.COL_U : L.COL_U + 3] = _unit(w.u_axis, "u_axis")
             row[L.COL_HALF_U] = w.half_extents[0]
             row[L.COL_HALF_V] = w.half_extents[1]
+            if planar:  # a segment: unbounded along z (u or v = normal x u is along z)
+                row[L.COL_POINT + 2] = 0.0
+                along_z = 0 if abs(row[L.COL_U + 2]) > 0.5 else 1
+                row[L.COL_HALF_U + along_z] = np.inf
             kinds.append(L.RECTANGLE)
         elif isinstance(w, CylinderWall):
             row[L.COL_POINT : L.COL_POINT + 3] = w.center
@@ -174,6 +203,9 @@ def wall_rows(walls: list, material_index: dict[str, int]) -> tuple[np.ndarray, 
             row[L.COL_HALF_LENGTH] = np.inf if w.length is None else 0.5 * w.length
             row[L.COL_SIDE] = 1.0 if w.inside else -1.0
             row[L.COL_OMEGA] = w.angular_velocity
+            if planar:  # a circle in the plane (the axis is along z)
+                row[L.COL_POINT + 2] = 0.0
+                row[L.COL_HALF_LENGTH] = np.inf
             kinds.append(L.CYLINDER)
         rows.append(row)
         labels.append(label)

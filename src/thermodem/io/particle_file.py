@@ -33,7 +33,7 @@ COLUMN_ALIASES: dict[str, tuple[str, ...]] = {
 _CANONICAL = {alias: name for name, aliases in COLUMN_ALIASES.items() for alias in aliases}
 _ALLOWED_TEXT = (
     "x, y, z, radius (or r, rad; or diameter, d), and optionally vx, vy, vz and temperature "
-    "(or t, temp)"
+    "(or t, temp); in a 2D case z and vz may be left out (x y r)"
 )
 
 
@@ -125,31 +125,35 @@ def _data_line_numbers(path: Path) -> np.ndarray:
     return np.asarray(numbers, dtype=np.int64)
 
 
-def _columns(header: list[str]) -> dict[str, int] | None:
-    """Canonical column name -> index, None unless the header is complete and unambiguous."""
+def _columns(header: list[str], planar: bool = False) -> dict[str, int] | None:
+    """Canonical column name -> index, None unless the header is complete and unambiguous
+    (``planar``: z and vz may be missing)."""
     names = [_CANONICAL.get(n) for n in header]
     if any(n is None for n in names) or len(set(names)) != len(names):
         return None
     col = {str(n): j for j, n in enumerate(names)}
-    if ("radius" in col) == ("diameter" in col) or any(a not in col for a in "xyz"):
+    needed = "xy" if planar else "xyz"
+    if ("radius" in col) == ("diameter" in col) or any(a not in col for a in needed):
         return None
-    vel = [a in col for a in ("vx", "vy", "vz")]
+    vel = [a in col for a in (("vx", "vy") if planar else ("vx", "vy", "vz"))]
     if any(vel) and not all(vel):
+        return None
+    if "vz" in col and "vx" not in col:
         return None
     return col
 
 
-def _parse_particle_file(path: str | Path, material: str = "") -> _ParsedFile:
+def _parse_particle_file(path: str | Path, material: str = "", planar: bool = False) -> _ParsedFile:
     """Fast path: NumPy's C parser, no Python object per value (a 50,000-particle file needed
     ~780 B/particle of transient memory with the token-by-token parser, and left ~250 B/particle
     of fragmented heap behind). Any irregularity falls back to :func:`_parse_checked`, which
     gives the error message with file, line and column."""
     path = Path(path)
-    fast = _parse_fast(path, material)
-    return fast if fast is not None else _parse_checked(path, material)
+    fast = _parse_fast(path, material, planar)
+    return fast if fast is not None else _parse_checked(path, material, planar)
 
 
-def _parse_fast(path: Path, material: str) -> _ParsedFile | None:
+def _parse_fast(path: Path, material: str, planar: bool = False) -> _ParsedFile | None:
     try:
         header: list[str] | None = None
         header_line = 0
@@ -162,7 +166,7 @@ def _parse_fast(path: Path, material: str) -> _ParsedFile | None:
                 else:  # the first data line tells the delimiter
                     comma = "," in line
                     break
-        col = _columns(header) if header else None
+        col = _columns(header, planar) if header else None
         if col is None:
             return None
         with warnings.catch_warnings():
@@ -195,7 +199,15 @@ def _assemble(
     path: Path,
 ) -> _ParsedFile:
     n = data.shape[0]
-    velocity = data[:, [col["vx"], col["vy"], col["vz"]]] if has_velocity else np.zeros((n, 3))
+
+    def triple(names: tuple[str, str, str]) -> np.ndarray:  # a missing z column (2D) is 0
+        out = np.zeros((n, 3))
+        for a, name in enumerate(names):
+            if name in col:
+                out[:, a] = data[:, col[name]]
+        return out
+
+    velocity = triple(("vx", "vy", "vz")) if has_velocity else np.zeros((n, 3))
     from thermodem.geometry.insertion import InsertedParticles
 
     if "radius" in col:
@@ -203,7 +215,7 @@ def _assemble(
     else:
         radius = 0.5 * data[:, col["diameter"]]
     particles = InsertedParticles(
-        position=np.ascontiguousarray(data[:, [col["x"], col["y"], col["z"]]]),
+        position=triple(("x", "y", "z")),
         radius=radius,
         velocity=np.ascontiguousarray(velocity),
         temperature=np.ascontiguousarray(data[:, col["temperature"]])
@@ -234,7 +246,7 @@ def _read_text(path: Path) -> str:
         ) from None
 
 
-def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
+def _parse_checked(path: Path, material: str = "", planar: bool = False) -> _ParsedFile:
     """Token-by-token parse that names the file, line and column of the first problem."""
     text = _read_text(path)
     header: list[str] | None = None
@@ -276,18 +288,21 @@ def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
         )
     if "radius" in canonical and "diameter" in canonical:
         raise ValueError(f"{where}, line {header_line}: give the radius or the diameter, not both")
-    missing = [a for a in "xyz" if a not in canonical]
+    missing = [a for a in ("xy" if planar else "xyz") if a not in canonical]
     if "radius" not in canonical and "diameter" not in canonical:
         missing.append("radius")
     if missing:
+        needed = "x, y (z optional in 2D)" if planar else "x, y, z"
         raise ValueError(
             f"{where}, line {header_line}: the header lacks required column(s) "
-            f"{', '.join(missing)}; it must name x, y, z and radius (or r, or diameter)"
+            f"{', '.join(missing)}; it must name {needed} and radius (or r, or diameter)"
         )
     vel_cols = [name for name in ("vx", "vy", "vz") if name in canonical]
-    if vel_cols and len(vel_cols) != 3:
+    vel_needed = ("vx", "vy") if planar and "vz" not in canonical else ("vx", "vy", "vz")
+    if vel_cols and any(v not in vel_cols for v in vel_needed):
+        what = "vx, vy (and vz or not)" if planar else "vx, vy, vz"
         raise ValueError(
-            f"{where}, line {header_line}: give all of vx, vy, vz or none, got only "
+            f"{where}, line {header_line}: give all of {what} or none, got only "
             f"{', '.join(vel_cols)}"
         )
     if not rows:
@@ -334,7 +349,9 @@ def _parse_checked(path: Path, material: str = "") -> _ParsedFile:
     return _assemble(data, col, bool(vel_cols), material, lines, path)
 
 
-def load_particle_file(path: str | Path, material: str = "") -> InsertedParticles:
+def load_particle_file(
+    path: str | Path, material: str = "", planar: bool = False
+) -> InsertedParticles:
     """Read particles from a whitespace- or comma-separated text file.
 
     The header names the columns (a leading ``#`` is allowed; comment lines may come before
@@ -346,8 +363,9 @@ def load_particle_file(path: str | Path, material: str = "") -> InsertedParticle
     on a data line are ignored. Missing velocity columns give zero velocities; a missing
     temperature column gives ``temperature=None``. Errors name the file, the line number and
     the column (a missing file, a header without rows, text that is not UTF-8 included).
+    ``planar`` (a 2D case): ``x y r`` suffice (z = 0; ``vx vy`` without ``vz``).
     """
-    return _parse_particle_file(path, material).particles
+    return _parse_particle_file(path, material, planar).particles
 
 
 def save_particle_file(path: str | Path, particles: InsertedParticles) -> None:

@@ -41,6 +41,13 @@ A run's frames (:func:`write_particle_frame`, :func:`write_wall_frame`): particl
 thermal run), ``coordination_number``; wall triangles carry ``wall_id``, ``material_id``
 and ``temperature`` (the wall's temperature for a wall at a fixed temperature, NaN for an
 adiabatic wall).
+
+A 2D case (``simulation.dimension: 2``) writes its particles as discs: the same points (in
+the plane z = 0) with ``radius``, the disc axis ``normal`` = (0, 0, 1) and the disc
+``thickness`` (0 for spheres kept in the plane). In ParaView: *Glyph* with glyph type
+*2D Glyph*, *Circle* with *Filled* on, scale array ``radius``, scale factor 2: filled discs
+in the x-y plane (docs/two-dimensional.md). Walls are drawn as strips of the disc thickness
+around z = 0 (lines and circles seen along z).
 """
 
 from __future__ import annotations
@@ -440,6 +447,11 @@ def particle_frame_fields(sim: Simulation) -> dict[str, np.ndarray]:
         "heat_rate": p.heat_rate,
         "coordination_number": sim.coordination_number().astype(np.int32),
     }
+    if getattr(sim, "planar", False):  # 2D: discs of a thickness with their axis (z)
+        normal = np.zeros((p.count, 3))
+        normal[:, 2] = 1.0
+        fields["normal"] = normal
+        fields["thickness"] = np.full(p.count, float(sim.disc_thickness))
     if sim.thermal is not None:
         from thermodem.state.particles import HEAT_MECHANISMS
 
@@ -464,6 +476,12 @@ def write_wall_frame(path: str | os.PathLike[str], sim: Simulation, extent: floa
     """The walls of ``sim`` now: ``wall_id`` with the wall names, ``material_id`` with the
     material names, ``temperature`` (NaN for an adiabatic wall)."""
     rows = sim.wall_rows
+    if getattr(sim, "planar", False):  # 2D: the unbounded z extents drawn as the disc slab
+        rows = rows.copy()
+        half = float(sim.upper[2])
+        for col in (COL_HALF_U, COL_HALF_V):  # (COL_HALF_V is the cylinders' half length)
+            column = rows[:, col]
+            column[np.isinf(column)] = half
     fixed = rows[:, COL_THERMAL_KIND] > 0.0
     temperature = np.where(fixed, rows[:, COL_TEMPERATURE], np.nan)
     fields = {

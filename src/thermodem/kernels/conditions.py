@@ -26,14 +26,29 @@ HELD = 2  # fixed whatever it does until the next classification: its temperatur
 
 
 @njit(cache=True, inline="always")
-def _region_class(ref, b, margin, lower, upper, periodic):
+def _source_rate(kind, value, r, disc_thickness):
+    """Heat rate [W] of a flux q (FLUX) on a particle's surface, or a power density s
+    (VOLUMETRIC) in its volume: q 4π R² and s 4/3 π R³ for spheres; for the discs of a 2D case
+    (``disc_thickness`` b > 0) q 2π R b (the rim: a 2D model has no faces) and s π R² b."""
+    if kind == FLUX:
+        if disc_thickness > 0.0:
+            return value * 2.0 * math.pi * r * disc_thickness
+        return value * 4.0 * math.pi * r * r
+    if disc_thickness > 0.0:
+        return value * math.pi * r * r * disc_thickness
+    return value * 4.0 / 3.0 * math.pi * r * r * r
+
+
+@njit(cache=True, inline="always")
+def _region_class(ref, b, margin, lower, upper, periodic, naxes):
     """0: a particle within ``margin`` of ``ref`` (per axis) is outside box ``b`` (lower 0:3,
     upper 3:6, faces included); 1: inside; 2: it may be either. On a periodic axis a particle
     whose margin interval crosses a face of the domain may wrap: it is 2 unless another axis
-    keeps it out."""
+    keeps it out. ``naxes``: 3, or 2 in a 2D case (the particles stay at z = 0, which the
+    boxes of a 2D case contain)."""
     out = False
     inside = True
-    for a in range(3):
+    for a in range(naxes):
         lo = ref[a] - margin
         hi = ref[a] + margin
         if periodic[a] and (lo < lower[a] or hi >= upper[a]):
@@ -51,7 +66,7 @@ def _region_class(ref, b, margin, lower, upper, periodic):
 @njit(cache=True, parallel=True, error_model="numpy")
 def classify_conditions(
     reference, radius, static_mask, kinds, values, has_region, boxes, margin, lower, upper,
-    periodic, fixed, source, bath, code,
+    periodic, fixed, source, bath, code, disc_thickness, naxes,
 ):  # fmt: skip
     """Which particles the selections of fixed temperatures and flux/volumetric sources hold
     for until every particle has moved at most ``margin`` from ``reference`` (the positions of
@@ -63,7 +78,9 @@ def classify_conditions(
     that every region entry of its static selections keeps surely inside or surely outside
     gets its ``fixed``, ``bath`` (the last holding FIXED entry wins) and ``source`` here, and
     ``code`` HELD (fixed) or UNLISTED; one that some region may hold or not is a CANDIDATE,
-    evaluated at every thermal step by :func:`apply_listed`.
+    evaluated at every thermal step by :func:`apply_listed`. The source rates are those of
+    :func:`_source_rate` (``disc_thickness`` > 0: discs of a 2D case, whose boxes are tested
+    on ``naxes`` = 2 axes).
     """
     n = radius.shape[0]
     nentries = kinds.shape[0]
@@ -76,7 +93,7 @@ def classify_conditions(
             if not static_mask[i, e]:
                 continue
             if has_region[e]:
-                where = _region_class(reference[i], boxes[e], margin, lower, upper, periodic)
+                where = _region_class(reference[i], boxes[e], margin, lower, upper, periodic, naxes)
                 if where == 0:
                     continue
                 if where == 2:
@@ -86,10 +103,8 @@ def classify_conditions(
             if kind == FIXED:
                 is_fixed = True
                 t_bath = values[e]
-            elif kind == FLUX:
-                q += values[e] * 4.0 * math.pi * radius[i] * radius[i]
             else:
-                q += values[e] * 4.0 / 3.0 * math.pi * radius[i] * radius[i] * radius[i]
+                q += _source_rate(kind, values[e], radius[i], disc_thickness)
         if candidate:
             code[i] = CANDIDATE
             fixed[i] = False
@@ -105,7 +120,7 @@ def classify_conditions(
 @njit(cache=True, parallel=True, error_model="numpy")
 def apply_listed(
     listed, code, position, radius, mass, type_id, temperature, c_by_type, static_mask, kinds,
-    values, has_region, boxes, fixed, source, bath, part,
+    values, has_region, boxes, fixed, source, bath, part, disc_thickness,
 ):  # fmt: skip
     """The per-step part of the conditions, over the listed particles only (``listed``: the
     indices whose ``code`` is HELD or CANDIDATE, ascending): a HELD particle takes its bath
@@ -113,7 +128,8 @@ def apply_listed(
     in :func:`classify_conditions`, without the margin) and gets ``fixed``, ``source`` and,
     if fixed, its bath temperature. ``part[c]`` collects per chunk of CHUNK listed particles
     the energy the resets add, m c (T_bath - T), with the constant specific heats
-    ``c_by_type``; returns their sum in chunk order (independent of the thread count)."""
+    ``c_by_type``; returns their sum in chunk order (independent of the thread count).
+    Source rates: :func:`_source_rate` (``disc_thickness`` > 0: the discs of a 2D case)."""
     n = listed.shape[0]
     nentries = kinds.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
@@ -141,12 +157,8 @@ def apply_listed(
                     if kind == FIXED:
                         is_fixed = True
                         t_bath = values[e]
-                    elif kind == FLUX:
-                        r = radius[i]
-                        q += values[e] * 4.0 * math.pi * r * r
                     else:
-                        r = radius[i]
-                        q += values[e] * 4.0 / 3.0 * math.pi * r * r * r
+                        q += _source_rate(kind, values[e], radius[i], disc_thickness)
                 fixed[i] = is_fixed
                 source[i] = q
                 if not is_fixed:

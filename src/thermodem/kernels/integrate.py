@@ -5,6 +5,11 @@ Velocity Verlet (spheres, so rotation needs no orientation):
     v(t+dt)   = v(t+dt/2) + F(t+dt) dt / 2m,
 and the same for ω with T / I. Contact forces at t+dt use x(t+dt) and the half-step velocities
 (the usual choice for velocity-dependent forces in DEM).
+
+``planar`` (a 2D case): the particles move in the plane z = 0 and turn about z only, so each
+kick leaves v_z = 0 and ω_x = ω_y = 0 (and the drift keeps z). With in-plane loads these are
+already exactly zero (every normal, lever arm and velocity has z = 0); the constraint makes sure
+of it whatever the round-off.
 """
 
 from __future__ import annotations
@@ -32,8 +37,10 @@ def kick_drift(
     periodic,
     reference,
     chunk_check,
+    planar,
 ):
-    """First half kick and drift; wraps positions on periodic axes.
+    """First half kick and drift; wraps positions on periodic axes (``planar``: out-of-plane
+    force and torque components dropped first, see the module docstring).
 
     In the same pass, per chunk of CHECK_CHUNK particles, ``chunk_check`` receives the largest
     squared displacement since ``reference`` (minimum image), and the first particle with a
@@ -51,6 +58,13 @@ def kick_drift(
             inv_m = half / mass[i]
             inv_i = half / inertia[i]
             d2 = 0.0
+            if planar:  # (the force arrays are set again before the next use)
+                force[i, 2] = 0.0
+                torque[i, 0] = 0.0
+                torque[i, 1] = 0.0
+                velocity[i, 2] = 0.0
+                angular_velocity[i, 0] = 0.0
+                angular_velocity[i, 1] = 0.0
             for a in range(3):
                 velocity[i, a] += force[i, a] * inv_m
                 angular_velocity[i, a] += torque[i, a] * inv_i
@@ -146,8 +160,9 @@ def external_power(velocity, angular_velocity, external_force, external_torque, 
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def final_kick(velocity, angular_velocity, force, torque, mass, inertia, dt):
-    """Second half kick of velocity Verlet with the forces and torques at t + dt."""
+def final_kick(velocity, angular_velocity, force, torque, mass, inertia, dt, planar):
+    """Second half kick of velocity Verlet with the forces and torques at t + dt
+    (``planar``: v_z and ω_x, ω_y kept at zero)."""
     half = 0.5 * dt
     for i in prange(force.shape[0]):
         inv_m = half / mass[i]
@@ -155,6 +170,10 @@ def final_kick(velocity, angular_velocity, force, torque, mass, inertia, dt):
         for a in range(3):
             velocity[i, a] += force[i, a] * inv_m
             angular_velocity[i, a] += torque[i, a] * inv_i
+        if planar:
+            velocity[i, 2] = 0.0
+            angular_velocity[i, 0] = 0.0
+            angular_velocity[i, 1] = 0.0
 
 
 @njit(cache=True, error_model="numpy")

@@ -49,6 +49,23 @@ FAMILIES: tuple[str, ...] = (
 #: given from outside with per-pair inputs (Voronoi faces), ``particles`` single particles.
 TARGETS: tuple[str, ...] = ("contacts", "range", "external", "particles")
 
+#: Particle shapes of a two-dimensional case (``simulation.particle_shape``): discs of the
+#: case's thickness, or spheres kept in the plane z = 0.
+PLANAR_SHAPES: tuple[str, ...] = ("disc", "sphere")
+
+
+def planar_support(spec: ModelSpec) -> str:
+    """What ``thermodem models`` says of a model in 2D."""
+    if spec.only_2d:
+        return "discs only (a 2D law: refused in 3D)"
+    if set(spec.planar) == set(PLANAR_SHAPES):
+        return "discs and spheres in a plane"
+    if spec.planar == ("disc",):
+        return "discs only"
+    if spec.planar == ("sphere",):
+        return "spheres in a plane only (3D form)"
+    return "no (3D only)"
+
 
 @dataclass(frozen=True)
 class ModelSpec:
@@ -76,6 +93,8 @@ class ModelSpec:
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
     uses_contact_radius: bool = True
     example_params: dict[str, Any] = field(default_factory=dict)
+    planar: tuple[str, ...] = ()
+    only_2d: bool = False
     range_parameter: str | None = None
 
     @property
@@ -118,6 +137,8 @@ def register(
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
     uses_contact_radius: bool = True,
     example_params: dict[str, Any] | None = None,
+    planar: tuple[str, ...] = (),
+    only_2d: bool = False,
     range_parameter: str | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
@@ -132,7 +153,12 @@ def register(
     None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
     argument (the range pass then does not compute it); ``example_params`` parameters the
     conformance tests use for a model without defaults; ``range_parameter`` the parameter
-    that sets ``interaction_range`` (in proportion), named by the range errors.
+    that sets ``interaction_range`` (in proportion), named by the range errors; ``planar`` the
+    particle shapes of a two-dimensional case (``simulation.dimension: 2``) the model
+    supports: ``"disc"`` (discs of ``simulation.thickness``: the model has a 2D form, or
+    needs none) and/or ``"sphere"`` (spheres kept in the plane: the 3D form is right for
+    them); empty: 3D only, refused in 2D before the run (:data:`PLANAR_SHAPES`); ``only_2d``
+    a 2D law (refused in 3D cases).
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -146,6 +172,9 @@ def register(
             )
     if len(history_flip) != history_width:
         raise ValueError(f"{family}.{name}: history_flip must have history_width entries")
+    for shape in planar:
+        if shape not in PLANAR_SHAPES:
+            raise ValueError(f"{family}.{name}: planar shape {shape!r} not in {PLANAR_SHAPES}")
     if target not in TARGETS:
         raise ValueError(f"{family}.{name}: target {target!r} is not one of {TARGETS}")
     for a, b in swap_pairs:
@@ -174,6 +203,8 @@ def register(
         conductance_reuse_refusal=conductance_reuse_refusal,
         uses_contact_radius=uses_contact_radius,
         example_params=dict(example_params or {}),
+        planar=tuple(planar),
+        only_2d=only_2d,
         range_parameter=range_parameter,
     )
     if range_parameter is not None and range_parameter not in params.model_fields:

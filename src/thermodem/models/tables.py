@@ -36,6 +36,7 @@ def pair_table(
     table = np.zeros((n, n, spec.width))
     overrides = {frozenset(o.materials): o for o in case.interactions}
     gas = case.thermal.gas if case.thermal is not None else None  # None: default air
+    thickness = case.simulation.disc_thickness  # 2D discs: b; else 0
     for a in range(n):
         for b in range(n):
             if meets is not None and not meets(names[a], names[b]):
@@ -44,7 +45,7 @@ def pair_table(
             mb = case.materials[names[b]]
             override = overrides.get(frozenset((names[a], names[b])))
             wall = is_wall(names[a], names[b]) if is_wall is not None else False
-            pair = resolve_pair(ma, mb, override, is_wall=wall, gas=gas)
+            pair = resolve_pair(ma, mb, override, is_wall=wall, gas=gas, thickness=thickness)
             try:
                 row = spec.pack(choice.params, pair)
             except ValueError as exc:

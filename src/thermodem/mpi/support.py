@@ -23,11 +23,12 @@ if TYPE_CHECKING:
 
 #: (case key, why) of every refused feature, in the order they are checked (docs/mpi.md).
 REFUSED: tuple[tuple[str, str], ...] = (
+    ("simulation.dimension: 2", "two-dimensional discs"),
     ("insertion.N.kind: pour", "pouring inserts particles while the run goes"),
     ("external_force", "constant external loads"),
     ("output.contacts", "contact frames"),
     ("thermal.frozen_mechanics", "frozen mechanics"),
-    ("thermal.scheme", "the implicit schemes (backward_euler, crank_nicolson)"),
+    ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
     ("thermal.external_source", "external sources shared by the particles of a box"),
     ("thermal.convection", "per-particle terms (convection)"),
     ("thermal.radiation", "per-particle terms (radiation)"),
@@ -47,6 +48,8 @@ def _refuse(key: str, what: str) -> ConfigError:
 
 def check_case(case: Case) -> None:
     """ConfigError for the first case key that a multi-rank run does not support."""
+    if getattr(case.simulation, "dimension", 3) == 2:
+        raise _refuse("simulation.dimension = 2", "two-dimensional discs")
     for k, entry in enumerate(case.insertion):
         if entry.kind == "pour":
             raise _refuse(

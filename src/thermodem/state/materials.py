@@ -130,6 +130,10 @@ class PairContext:
 
     ``surface_roughness`` and ``surface_slope``: the pair's equivalent σ and τ when an
     ``interactions`` entry gives them, else None (a model combines the materials' values).
+
+    ``thickness``: the disc thickness b [m] of a two-dimensional case of discs
+    (``simulation.dimension: 2``, ``particle_shape: disc``); 0 in 3D and for spheres kept in a
+    plane. The models with a 2D form read it (docs/two-dimensional.md).
     """
 
     mat_i: Material
@@ -141,6 +145,7 @@ class PairContext:
     gas: GasProperties = field(default_factory=GasProperties)
     surface_roughness: float | None = None
     surface_slope: float | None = None
+    thickness: float = 0.0
 
     @property
     def effective_youngs_modulus(self) -> float:
@@ -157,9 +162,11 @@ def resolve_pair(
     override: InteractionOverride | None = None,
     is_wall: bool = False,
     gas: GasProperties | None = None,
+    thickness: float = 0.0,
 ) -> PairContext:
     """Pair coefficients from the mixing rule, replaced where an override gives them; ``gas``
-    None: the default gas (air at 300 K, 1 atm)."""
+    None: the default gas (air at 300 K, 1 atm); ``thickness`` the disc thickness of a 2D case
+    of discs (0 otherwise)."""
 
     def pick(attr: str) -> float:
         if override is not None and getattr(override, attr) is not None:
@@ -176,4 +183,5 @@ def resolve_pair(
         gas=gas if gas is not None else GasProperties(),
         surface_roughness=None if override is None else override.surface_roughness,
         surface_slope=None if override is None else override.surface_slope,
+        thickness=float(thickness),
     )

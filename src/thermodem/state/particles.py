@@ -18,6 +18,16 @@ import numpy as np
 from thermodem.state.heat import HEAT_MECHANISMS  # the columns, defined in state/heat.py
 
 
+def particle_mass(
+    density: np.ndarray, radius: np.ndarray, disc_thickness: float = 0.0
+) -> np.ndarray:
+    """Mass [kg] of solid spheres, ρ 4/3 π R³, or (``disc_thickness`` b > 0) of solid discs,
+    ρ π R² b."""
+    if disc_thickness > 0.0:
+        return density * np.pi * radius**2 * disc_thickness
+    return density * (4.0 / 3.0) * np.pi * radius**3
+
+
 @dataclass
 class Particles:
     """Per-particle arrays (SI units)."""
@@ -66,8 +76,11 @@ class Particles:
         temperature: np.ndarray | None = None,
         mechanisms: int = len(HEAT_MECHANISMS),
         external: bool = False,
+        disc_thickness: float = 0.0,
     ) -> Particles:
-        """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R².
+        """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R²; with ``disc_thickness`` b > 0 (a 2D
+        case of discs) solid discs of that thickness: m = ρ π R² b, I = 1/2 m R² (about the
+        disc's axis, z).
 
         ``mechanisms`` is the number of columns of ``heat_rate_by_mechanism``: all of
         :data:`HEAT_MECHANISMS` with a thermal engine, 0 for mechanics only (64 B/particle less).
@@ -76,7 +89,7 @@ class Particles:
         """
         n = radius.shape[0]
         radius = np.ascontiguousarray(radius, dtype=np.float64)
-        mass = np.asarray(density, dtype=np.float64) * (4.0 / 3.0) * np.pi * radius**3
+        mass = particle_mass(np.asarray(density, dtype=np.float64), radius, disc_thickness)
         return cls(
             position=np.ascontiguousarray(position, dtype=np.float64).reshape(n, 3),
             velocity=np.zeros((n, 3))
@@ -87,7 +100,7 @@ class Particles:
             torque=np.zeros((n, 3)),
             radius=radius,
             mass=mass,
-            moment_of_inertia=0.4 * mass * radius**2,
+            moment_of_inertia=(0.5 if disc_thickness > 0.0 else 0.4) * mass * radius**2,
             temperature=np.zeros(n)
             if temperature is None
             else np.ascontiguousarray(temperature, dtype=np.float64),

@@ -20,6 +20,8 @@ def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass):
         return normal.hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass)
     if model_id == normal.LINEAR:
         return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+    if model_id == normal.HERTZ_2D:
+        return normal.hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass)
     nan = np.nan  # unknown id: NaN forces stop the run at the next check
     return nan, nan, nan, nan, nan
 

@@ -33,12 +33,15 @@ from thermodem.state.materials import PairContext
 
 HERTZ = 1
 LINEAR = 2
+HERTZ_2D = 3
 
 #: Parameter row columns (named; ``register(columns=...)`` sets the row width).
 HERTZ_COLUMNS = ("effective_youngs_modulus", "damping_factor")
 HERTZ_E_STAR, HERTZ_ALPHA = 0, 1
 LINEAR_COLUMNS = ("stiffness", "damping_ratio")
 LINEAR_STIFFNESS, LINEAR_DAMPING_RATIO = 0, 1
+HERTZ_2D_COLUMNS = ("effective_youngs_modulus", "thickness", "damping_ratio")
+HERTZ_2D_E_STAR, HERTZ_2D_THICKNESS, HERTZ_2D_DAMPING_RATIO = 0, 1, 2
 
 
 # ----------------------------------------------------------------------------------- Hertz
@@ -193,6 +196,45 @@ def linear_force(p, overlap, overlap_rate, eff_radius, eff_mass):
     return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
 
 
+# ------------------------------------------------------------------- 2D Hertz (line contact)
+class Hertz2DParams(StrictModel):
+    """Line contact of two discs (2D), F = (π/4) E* b δ + γ dδ/dt, b the disc thickness.
+
+    A disc of a 2D case is a cylinder of length b (``simulation.thickness``) and two discs
+    touch along a line: Hertz's theory of two parallel cylinders (Johnson, K.L. (1985) Contact
+    Mechanics, CUP, ch. 4-5) gives the contact half width a = sqrt(4 F R*/(π b E*)), but the
+    approach of the centres is only defined up to the size of the bodies (the displacement
+    of a half-plane under a line load grows logarithmically with distance), so there is no
+    closed-form δ(F). The law chosen here is the stiffness F = (π/4) E* b δ of two parallel
+    cylinders used as the 2D Hertz law of Kratos DEM (Celigueta & Latorre, CIMNE,
+    ``DEM_D_Hertz_viscous_Coulomb2D``: K_n = π/4 E* per unit thickness): linear in δ and
+    independent of the radii. E* = [(1-ν_i²)/E_i + (1-ν_j²)/E_j]^-1 as for spheres; a wall is
+    the same body of infinite radius.
+
+    Damping: a linear law, so γ = 2 ζ sqrt(m* k) with ζ = -ln e / sqrt(π² + ln² e) gives the
+    restitution coefficient e exactly for every impact velocity, and the contact time is
+    π / (ω_0 sqrt(1 - ζ²)), ω_0 = sqrt(k/m*) (docs/models/normal-hertz_2d.md; tested).
+    No parameters: E*, e, m* from the materials and the pair, b from the case.
+    """
+
+
+def pack_hertz_2d(params: Hertz2DParams, pair: PairContext) -> np.ndarray:
+    """[E*, b, ζ(e)]; b = ``pair.thickness`` (1 m, per unit thickness, when a pair is packed
+    outside a 2D case of discs, e.g. by the conformance tests)."""
+    thickness = pair.thickness if pair.thickness > 0.0 else 1.0
+    zeta = linear_damping_ratio(pair.restitution)
+    values = {"effective_youngs_modulus": pair.effective_youngs_modulus, "thickness": thickness,
+              "damping_ratio": zeta}  # fmt: skip
+    return packed(HERTZ_2D_COLUMNS, values)
+
+
+@njit(cache=True, error_model="numpy")
+def hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+    k = 0.25 * math.pi * p[HERTZ_2D_E_STAR] * p[HERTZ_2D_THICKNESS]
+    gamma = 2.0 * p[HERTZ_2D_DAMPING_RATIO] * math.sqrt(eff_mass * k)
+    return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
+
+
 register(
     family="normal",
     name="hertz",
@@ -204,6 +246,7 @@ register(
     summary="Hertz elastic force with Tsuji (1992) δ^1/4 damping calibrated to the restitution",
     reference="Hertz (1882); Tsuji, Tanaka & Ishida (1992) Powder Technol. 71, 239-250",
     requires=("youngs_modulus", "poisson_ratio", "restitution"),
+    planar=("sphere",),
 )
 register(
     family="normal",
@@ -216,10 +259,40 @@ register(
     summary="linear spring-dashpot with the exact restitution-damping relation",
     reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
     requires=("restitution",),
+    planar=("disc", "sphere"),
+)
+register(
+    family="normal",
+    name="hertz_2d",
+    model_id=HERTZ_2D,
+    kernel=hertz_2d_force,
+    params=Hertz2DParams,
+    pack=pack_hertz_2d,
+    columns=HERTZ_2D_COLUMNS,
+    summary="2D line contact of discs F = (π/4) E* b δ, damping exact for the restitution",
+    reference="Johnson (1985) Contact Mechanics ch. 4-5 (parallel cylinders); Kratos DEM 2D "
+    "Hertz law (Celigueta & Latorre, CIMNE)",
+    requires=("youngs_modulus", "poisson_ratio", "restitution"),
+    planar=("disc",),
+    only_2d=True,
 )
 
 
 # ------------------------------------------------------------------- closed forms (tests, docs)
+def linear_collision_time(eff_mass: float, stiffness: float, restitution: float) -> float:
+    """Contact time of the linear spring-dashpot (and of hertz_2d, k = π/4 E* b):
+    π / (ω_0 sqrt(1 - ζ²)), ω_0 = sqrt(k/m*), ζ = ζ(e); infinite for e = 0 (critical)."""
+    zeta = linear_damping_ratio(restitution)
+    if zeta >= 1.0:
+        return math.inf
+    return math.pi / (math.sqrt(stiffness / eff_mass) * math.sqrt(1.0 - zeta * zeta))
+
+
+def hertz_2d_stiffness(e_star: float, thickness: float) -> float:
+    """k = (π/4) E* b of the 2D line contact [N/m]."""
+    return 0.25 * math.pi * e_star * thickness
+
+
 def hertz_collision_time(eff_mass: float, eff_radius: float, e_star: float, speed: float) -> float:
     """Total elastic Hertz collision time, t_c = 2.87 (m*²/(R* E*² v))^{1/5} (spec, appendix A)."""
     return 2.87 * (eff_mass**2 / (eff_radius * e_star**2 * speed)) ** 0.2

@@ -158,6 +158,7 @@ register(
     columns=(),
     summary="no rolling resistance",
     reference="-",
+    planar=("disc", "sphere"),
 )
 register(
     family="rolling",
@@ -170,6 +171,7 @@ register(
     summary="constant directional torque μ_r R* F_n opposing relative rolling",
     reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model A); Zhou et al. (1999)",
     requires=("rolling_friction",),
+    planar=("disc", "sphere"),
 )
 register(
     family="rolling",
@@ -184,4 +186,5 @@ register(
     requires=("rolling_friction",),
     history_width=3,
     history_flip=(True, True, True),
+    planar=("disc", "sphere"),
 )

@@ -228,6 +228,7 @@ register(
     reference="-",
     history_width=0,
     history_flip=(),
+    planar=("disc", "sphere"),
 )
 register(
     family="tangential",
@@ -240,6 +241,7 @@ register(
     summary="Mindlin no-slip stiffness 8G*sqrt(R*δ), Coulomb cap, history rescaled",
     reference="Mindlin (1949) J. Appl. Mech. 16, 259-268; Di Renzo & Di Maio (2004)",
     requires=("youngs_modulus", "poisson_ratio", "sliding_friction"),
+    planar=("sphere",),
     **_COMMON,
 )
 register(
@@ -253,5 +255,6 @@ register(
     summary="linear tangential spring k_t = r k_n, Coulomb cap, history rescaled",
     reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
     requires=("sliding_friction",),
+    planar=("disc", "sphere"),
     **_COMMON,
 )

@@ -360,6 +360,11 @@ def contact_radius_dispatch(model_id, p, r_i, r_j, dist, overlap, f_n, t_contact
 
 # --------------------------------------------------------------------------- registration
 _COMMON = dict(family=FAMILY, antisymmetric=False, symmetric=True, swap_pairs=())
+#: 2D (``planar``): the geometric radius is the half length of the chord of two overlapping
+#: circles (the spec's formula is written for "circles / spheres"), so it holds for discs;
+#: the Hertz-based radii are those of two spheres (point contact): spheres in a plane only.
+_BOTH = ("disc", "sphere")
+_SPHERE = ("sphere",)
 _NO_COLUMNS = ()
 _HERTZ = "Hertz (1882); Johnson (1985) Contact Mechanics, CUP"
 _REAL = ("youngs_modulus", "poisson_ratio", "youngs_modulus_real")
@@ -373,6 +378,7 @@ register(
     pack=pack_none,
     summary="no contact radius (0)",
     reference="-",
+    planar=_BOTH,
     **_COMMON,
 )
 register(
@@ -382,8 +388,9 @@ register(
     kernel=geometric_radius,
     params=GeometricParams,
     pack=pack_geometric,
-    summary="radius of the intersection circle of the overlapping spheres",
+    summary="radius of the intersection circle of the overlapping spheres (chord of discs)",
     reference="Musser (2011) PhD thesis WVU; Weisstein, Sphere-Sphere Intersection (MathWorld)",
+    planar=_BOTH,
     **_COMMON,
 )
 register(
@@ -396,6 +403,7 @@ register(
     summary="static Hertz radius from the normal force, (3 F R*/(4 E*))^(1/3)",
     reference=_HERTZ,
     requires=("youngs_modulus", "poisson_ratio"),
+    planar=_SPHERE,
     **_COMMON,
 )
 register(
@@ -407,6 +415,7 @@ register(
     pack=pack_hertz_overlap,
     summary="Hertz radius from the overlap, sqrt(R* δ)",
     reference=_HERTZ,
+    planar=_SPHERE,
     **_COMMON,
 )
 register(
@@ -419,6 +428,7 @@ register(
     summary="Hertz radius × (E*_sim/E*_real)^(1/5) low-stiffness correction",
     reference="Zhou, Yu & Zulli (2010) Powder Technol. 197, 102-110",
     requires=_REAL,
+    planar=_SPHERE,
     **_COMMON,
 )
 register(
@@ -432,6 +442,7 @@ register(
     reference="Lu, Morris, Li & Benyahia (2017) Int. J. Heat Mass Transf. 111, 723-735",
     requires=_REAL,
     example_params={"normal_stiffness": 1.0e5},
+    planar=_SPHERE,
     **_COMMON,
 )
 register(
@@ -444,6 +455,7 @@ register(
     summary="real Hertz radius at the simulated normal force (Morris 2016a area correction)",
     reference="Morris, Pannala, Ma & Hrenya (2016a) AIChE J. 62, 4526-4535",
     requires=_REAL,
+    planar=_SPHERE,
     **_COMMON,
 )
 register(
@@ -456,5 +468,6 @@ register(
     summary="Morris 2016a area × (t_c,real/t_c)^(2/3) collision-time correction (effective radius)",
     reference="Morris, Pannala, Ma & Hrenya (2016a) AIChE J. 62, 4526-4535",
     requires=_REAL,
+    planar=_SPHERE,
     **_COMMON,
 )

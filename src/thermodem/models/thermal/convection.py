@@ -349,6 +349,7 @@ register(
     reference="-",
     columns=(),
     target="particles",
+    planar=("disc", "sphere"),
 )
 register(
     **_COMMON,

@@ -333,29 +333,57 @@ def bob_modified_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact,
 
 
 # ------------------------------------------------------------------------- thermal pipes
+#: Rows of the two models with a 2D form: the head, then the disc thickness b [m] of a 2D
+#: case of discs (0: the 3D form, also for spheres kept in a plane).
+PIPE_COLUMNS = (*HEAD, "thickness")
+PIPE_THICKNESS = 4
+
+
+def pack_pipe(params: StrictModel, pair: PairContext, model: str) -> np.ndarray:
+    """[k_i, k_j, 0, 0, b]: b = ``pair.thickness`` (0 in 3D and for spheres in a plane)."""
+    values = head_values(_conductivities(pair, model)) | {"thickness": pair.thickness}
+    return packed(PIPE_COLUMNS, values)
+
+
 class ThermalPipeParams(StrictModel):
-    """Generic thermal pipe Q = k A_p / d_ij (T_j - T_i), A_p = π R_c² (spec 2.4; Jebahi et al.
-    2015; Hahn et al. 2011). k: two equal half pipes in series, i.e. the harmonic mean
-    2 k_i k_j/(k_i + k_j). Wall: the particle's pipe from its centre to the wall plane,
-    Q = k_i A_p / (R_i - δ) ΔT. Row: [k_i, k_j]."""
+    """Generic thermal pipe Q = k A_p / d_ij (T_j - T_i) (spec 2.4; Jebahi et al. 2015; Hahn
+    et al. 2011), A_p = π R_c² (3D: a circular pipe of the contact radius). k: two equal half
+    pipes in series, i.e. the harmonic mean 2 k_i k_j/(k_i + k_j). Wall: the particle's pipe
+    from its centre to the wall plane, Q = k_i A_p / (R_i - δ) ΔT.
+
+    2D discs of thickness b (``simulation.dimension: 2``): the pipe is a strip of the contact
+    length 2 R_c across the thickness, A_p = 2 R_c b (as Rojek (2014)'s 2D bar, A_p = 2 r̃ b,
+    with the contact half length R_c in place of r̃; R_c from the ``contact_radius`` model, the
+    chord of the overlapping circles with ``geometric``). Row: [k_i, k_j, 0, 0, b].
+    """
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _pipe(k_i, k_j, t_i, t_j, r_i, r_j, overlap, r_c, thickness):
+    """Thermal pipe rate; ``thickness`` > 0: the 2D strip A_p = 2 R_c b, else π R_c²."""
+    if overlap <= 0.0 or r_c <= 0.0:
+        return 0.0
+    if thickness > 0.0:
+        area = 2.0 * r_c * thickness
+    else:
+        area = math.pi * r_c * r_c
+    if math.isinf(r_j):
+        return k_i * area / (r_i - overlap) * (t_j - t_i)
+    k_h = 2.0 * k_i * k_j / (k_i + k_j)
+    return k_h * area / ((r_i + r_j) - overlap) * (t_j - t_i)
 
 
 @njit(cache=True, error_model="numpy")
 def thermal_pipe_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
-    if overlap <= 0.0 or r_c <= 0.0:
-        return 0.0
-    area = math.pi * r_c * r_c
-    if math.isinf(r_j):
-        return p[K_I] * area / (r_i - overlap) * (t_j - t_i)
-    k_h = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
-    return k_h * area / ((r_i + r_j) - overlap) * (t_j - t_i)
+    return _pipe(p[K_I], p[K_J], t_i, t_j, r_i, r_j, overlap, r_c, p[PIPE_THICKNESS])
 
 
 class QuintanaRuizCampello2020Params(StrictModel):
     """Quintana-Ruiz & Campello (2020) J. Braz. Soc. Mech. Sci. Eng. 42, 387 (spec 2.4):
     Q = k̃ π R_c² / d_ij ΔT, k̃ = (R_i + R_j)(R_i/k_i + R_j/k_j)^-1 (segments proportional to
     the radii). Wall: the wall segment is dropped and the particle's segment tends to R_i,
-    Q = k_i π R_c² / R_i ΔT. Row: [k_i, k_j]."""
+    Q = k_i π R_c² / R_i ΔT. Row: [k_i, k_j]. 3D only (the source's pipe is circular; refused
+    for 2D discs)."""
 
 
 @njit(cache=True, error_model="numpy")
@@ -370,20 +398,34 @@ def qrc2020_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_im
 
 
 class Rojek2014Params(StrictModel):
-    """Rojek (2014) Comput. Part. Mech. 1, 71-84, 3D bar (spec 2.4): Q = k_p b ΔT with
-    A_p = 2 r̃ b, d_ij = 2 r̃, b = r̃ = (R_i + R_j)/2; two half bars in series give k_p = the
-    harmonic mean of k_i, k_j. Independent of the contact radius (only of touching).
-    Wall: the particle's half bar (r̃ = R_i), Q = 2 k_i R_i ΔT. Row: [k_i, k_j]."""
+    """Rojek (2014) Comput. Part. Mech. 1, 71-84 (spec 2.4): a bar between the centres,
+    Q = k_p A_p / d_ij ΔT with A_p = 2 r̃ b and d_ij = 2 r̃, so Q = k_p b ΔT; r̃ = (R_i + R_j)/2;
+    two half bars in series give k_p = the harmonic mean of k_i, k_j. Independent of the
+    contact radius (only of touching).
+
+    3D: b = r̃ (Q = k_p r̃ ΔT); wall: the particle's half bar (r̃ = R_i), Q = 2 k_i R_i ΔT.
+    2D discs: b is the thickness of the discs (``simulation.thickness``; "b is assumed as
+    unity" in the paper, the default 1 m), Q = k_p b ΔT; wall: the half bar of length R_i and
+    section 2 R_i b, Q = 2 k_i b ΔT. Row: [k_i, k_j, 0, 0, b] (b = 0: the 3D form).
+    """
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _rojek(k_i, k_j, t_i, t_j, r_i, r_j, overlap, thickness):
+    """Rojek's bar; ``thickness`` > 0: the 2D bar of that thickness, else the 3D one."""
+    if overlap <= 0.0:
+        return 0.0
+    if math.isinf(r_j):
+        b = thickness if thickness > 0.0 else r_i
+        return 2.0 * k_i * b * (t_j - t_i)
+    k_h = 2.0 * k_i * k_j / (k_i + k_j)
+    b = thickness if thickness > 0.0 else 0.5 * (r_i + r_j)
+    return k_h * b * (t_j - t_i)
 
 
 @njit(cache=True, error_model="numpy")
 def rojek2014_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
-    if overlap <= 0.0:
-        return 0.0
-    if math.isinf(r_j):
-        return 2.0 * p[K_I] * r_i * (t_j - t_i)
-    k_h = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
-    return k_h * 0.5 * (r_i + r_j) * (t_j - t_i)
+    return _rojek(p[K_I], p[K_J], t_i, t_j, r_i, r_j, overlap, p[PIPE_THICKNESS])
 
 
 # ----------------------------------------------------------------------- collisional
@@ -401,16 +443,17 @@ StaticModel = Literal[tuple(_STATIC_MODELS)]
 def static_rate(
     static_id, p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff
 ):
-    """The static model a collisional model switches to after t_c (reads row columns 0-1)."""
+    """The static model a collisional model switches to after t_c (reads row columns 0-1;
+    the 3D forms)."""
     args = (t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff)
     if static_id == BATCHELOR_OBRIEN_SIMPLE:
         return bob_simple_rate(p, *args)
-    elif static_id == THERMAL_PIPE:
-        return thermal_pipe_rate(p, *args)
+    elif static_id == THERMAL_PIPE:  # (the 3D forms: the collisional models are 3D only)
+        return _pipe(p[K_I], p[K_J], t_i, t_j, r_i, r_j, overlap, r_c, 0.0)
     elif static_id == QUINTANA_RUIZ_CAMPELLO2020:
         return qrc2020_rate(p, *args)
     elif static_id == ROJEK2014:
-        return rojek2014_rate(p, *args)
+        return _rojek(p[K_I], p[K_J], t_i, t_j, r_i, r_j, overlap, 0.0)
     return 0.0
 
 
@@ -580,6 +623,11 @@ def direct_conduction_dispatch(
 
 # --------------------------------------------------------------------------- registration
 _BOB = "Batchelor & O'Brien (1977) Proc. R. Soc. Lond. A 355, 313-333"
+#: 2D (``planar``): rojek2014 and thermal_pipe have a 2D form for discs (a bar / strip of the
+#: disc thickness); the other models are the conduction between spheres (their 3D form holds
+#: for spheres kept in a plane, refused for discs); none needs no form.
+_BOTH = ("disc", "sphere")
+_SPHERE = ("sphere",)
 _COLL = ("thermal_conductivity", "density", "specific_heat", "youngs_modulus", "poisson_ratio")
 
 
@@ -591,12 +639,16 @@ def _register(name, model_id, kernel, params, summary, reference, pack=None, **k
 
     kw.setdefault("requires", ("thermal_conductivity",))
     kw.setdefault("columns", HEAD)
+    kw.setdefault("planar", _SPHERE)
     register(family=FAMILY, name=name, model_id=model_id, kernel=kernel, params=params,
              pack=pack or pack_k, summary=summary, reference=reference, swap_pairs=SWAP_PAIRS,
              **kw)  # fmt: skip
 
 
-_register("none", NONE, none_rate, NoneParams, "no direct conduction", "-", pack_none, requires=())
+_register(
+    "none", NONE, none_rate, NoneParams, "no direct conduction", "-", pack_none, requires=(),
+    planar=_BOTH,
+)  # fmt: skip
 _register(
     "batchelor_obrien_simple", BATCHELOR_OBRIEN_SIMPLE, bob_simple_rate,
     BatchelorOBrienSimpleParams,
@@ -624,8 +676,10 @@ _register(
 )  # fmt: skip
 _register(
     "thermal_pipe", THERMAL_PIPE, thermal_pipe_rate, ThermalPipeParams,
-    "thermal pipe Q = k_h π R_c² / d ΔT between the centres",
+    "thermal pipe Q = k_h A_p / d ΔT between the centres, A_p = π R_c² (2D: 2 R_c b)",
     "Jebahi et al. (2015) DEM for 3D continuous materials, Wiley; Hahn et al. (2011)",
+    lambda params, pair: pack_pipe(params, pair, f"{FAMILY}.thermal_pipe"),
+    columns=PIPE_COLUMNS, planar=_BOTH,
 )  # fmt: skip
 _register(
     "quintana_ruiz_campello2020", QUINTANA_RUIZ_CAMPELLO2020, qrc2020_rate,
@@ -635,7 +689,10 @@ _register(
 )  # fmt: skip
 _register(
     "rojek2014", ROJEK2014, rojek2014_rate, Rojek2014Params,
-    "3D bar Q = k_h r̃ ΔT, r̃ = (R_i + R_j)/2", "Rojek (2014) Comput. Part. Mech. 1, 71-84",
+    "bar Q = k_h b ΔT: 3D b = r̃ = (R_i + R_j)/2, 2D b = the disc thickness",
+    "Rojek (2014) Comput. Part. Mech. 1, 71-84",
+    lambda params, pair: pack_pipe(params, pair, f"{FAMILY}.rojek2014"),
+    columns=PIPE_COLUMNS, planar=_BOTH,
 )  # fmt: skip
 _register(
     "sun_chen1988", SUN_CHEN1988, sun_chen1988_rate, SunChen1988Params,

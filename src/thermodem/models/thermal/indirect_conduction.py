@@ -199,6 +199,7 @@ register(
     columns=NONE_COLUMNS,
     swap_pairs=(),
     target="contacts",
+    planar=("disc", "sphere"),
 )
 register(
     family=FAMILY,
@@ -221,4 +222,5 @@ register(
     columns=BOB_COLUMNS,
     swap_pairs=BOB_SWAP_PAIRS,
     target="range",
+    planar=("sphere",),
 )

@@ -288,6 +288,7 @@ register(
     reference="-",
     columns=(),
     target="particles",
+    planar=("disc", "sphere"),
 )
 register(
     family=FAMILY,
@@ -304,6 +305,7 @@ register(
     columns=SURROUNDINGS_COLUMNS,
     target="particles",
     example_params={"environment_temperature": 300.0},
+    planar=("sphere",),
 )
 register(
     family=FAMILY,

@@ -375,4 +375,5 @@ register(
         "heat_capacity_ratio",
         "mean_free_path",
     ),
+    planar=("sphere",),
 )

@@ -380,6 +380,7 @@ register(
     columns=RH_COLUMNS,
     uses_contact_radius=False,
     **_COMMON,
+    planar=("sphere",),
 )
 register(
     name="musser2011",
@@ -393,4 +394,5 @@ register(
     range_parameter="layer_thickness_ratio",
     columns=MUSSER_COLUMNS,
     **_COMMON,
+    planar=("sphere",),
 )

@@ -218,4 +218,5 @@ register(
     columns=VM_COLUMNS,
     swap_pairs=(),
     target="contacts",
+    planar=("sphere",),
 )
