@@ -198,7 +198,7 @@ class DistributedSimulation(Simulation):
         kick_drift(
             p.position[:own], p.velocity[:own], p.angular_velocity[:own], p.force[:own],
             p.torque[:own], p.mass[:own], p.moment_of_inertia[:own], self.dt, self.lower,
-            self.upper, self.periodic, self.reference[:own], self.chunk_check,
+            self.upper, self.periodic, self.reference[:own], self.chunk_check, self.planar,
         )  # fmt: skip
         moved, bad, code = reduce_checks(self.chunk_check, own)
         error = None
@@ -289,7 +289,7 @@ class DistributedSimulation(Simulation):
             own = self.owned_count
             final_kick(p.velocity[:own], p.angular_velocity[:own], p.force[:own],
                        p.torque[:own], p.mass[:own], p.moment_of_inertia[:own],
-                       self.dt)  # fmt: skip
+                       self.dt, self.planar)  # fmt: skip
         self._accumulate_ledger(kick)
 
     # ---------------------------------------------------------------------------- rebuild
