@@ -26,8 +26,10 @@ the local porosity of ``--porosity`` (default cell), ``--radiation`` a radiation
 krause2017; emissivity 0.9), both per-particle terms on top of the heat cases (issue 13:
 ``--cases region --convection gunn1978 --radiation krause2017`` against ``--cases region``).
 
-Each (case, thread count) runs in a fresh process; prints particle-steps per second and the
-peak memory above the interpreter's baseline per particle.
+Each (case, thread count) runs in a fresh process; prints particle-steps per second (wall
+clock, and per CPU-second of the process: with one thread the CPU time is what a busy shared
+machine disturbs least), the 1-minute load average, and the peak memory above the
+interpreter's baseline per particle.
 """
 
 from __future__ import annotations
@@ -152,6 +154,13 @@ def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = Fals
     return case
 
 
+def cpu_seconds() -> float:
+    """CPU time of this process (user + system, every thread) [s]: with one thread a measure
+    of the work that a busy machine disturbs much less than the wall-clock time."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
 def rss_bytes() -> int:
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
@@ -169,9 +178,11 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
     sim = Simulation(case_from_dict(case_dict(kind, indirect, substeps, False, terms)),
                      threads=threads)  # fmt: skip
     sim.run(steps=warmup)
+    c0 = cpu_seconds()
     t0 = time.perf_counter()
     sim.run(steps=steps)
     elapsed = time.perf_counter() - t0
+    cpu = cpu_seconds() - c0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     n = sim.particles.count
     out = {
@@ -181,6 +192,9 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
         "steps": steps,
         "particle_steps_per_s": n * steps / elapsed,
         "seconds": elapsed,
+        "cpu_seconds": cpu,
+        "particle_steps_per_cpu_s": n * steps / cpu,
+        "load_average": os.getloadavg()[0],
         "contacts_per_particle": 2 * sim.contact_count / n,
         "bytes_per_particle_above_baseline": (peak - baseline) / n,
     }
@@ -267,7 +281,9 @@ def main() -> None:
                               "neighbourhood pairs/particle")  # fmt: skip
                 print(
                     f"{kind:10s} {threads} thread(s): "
-                    f"{result['particle_steps_per_s'] / 1e6:6.2f} M particle-steps/s, "
+                    f"{result['particle_steps_per_s'] / 1e6:6.2f} M particle-steps/s "
+                    f"({result['particle_steps_per_cpu_s'] / 1e6:.2f} M per CPU-s, load "
+                    f"{result['load_average']:.1f}), "
                     f"{result['bytes_per_particle_above_baseline']:.0f} B/particle{extra}",
                     flush=True,
                 )

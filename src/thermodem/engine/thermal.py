@@ -110,6 +110,13 @@ class ThermalEngine:
         self.voronoi: VoronoiProvider | None = None
         self.external_wall_conductance = np.zeros(0)
         self.external_stamp = -1  # the external set's update count of the stored H (frozen)
+        # the Voronoi conductance reuse (thermal.tessellation.conductance_gap_tolerance): a
+        # row per pair of the external set (kernels/heat_terms.py, REUSE_*), valid for the
+        # set's update count ``external_reuse_stamp``; evaluations / pair-steps so far
+        self.external_reuse = np.zeros((0, passes.REUSE_WIDTH))
+        self.external_reuse_stamp = -1
+        self.external_evaluations = 0
+        self.external_pair_steps = 0
         for term in self.terms:
             if term.target == "external":
                 self._voronoi_term(term)
@@ -476,11 +483,19 @@ class ThermalEngine:
         rows = max(ext.count // passes.PARTICLE_CHUNK, p.count // passes.WALL_CHUNK) + 1
         scratch = self._term_rows(rows)
         if not reuse:
-            passes.external_pair_pass(
+            tolerance = 0.0
+            if term.evaluator == passes.EVAL_VORONOI and not frozen:
+                tolerance = float(self.settings.tessellation.conductance_gap_tolerance)
+            if tolerance > 0.0 and (self.external_reuse_stamp != ext.updates
+                                    or self.external_reuse.shape[0] != ext.count):  # fmt: skip
+                self.external_reuse = np.full((ext.count, passes.REUSE_WIDTH), np.nan)
+                self.external_reuse_stamp = ext.updates
+            self.external_evaluations += passes.external_pair_pass(
                 p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
                 sim.periodic, term.evaluator, term.model_id, term.table, k_i, k_j, self.k_p,
-                scratch, h,
+                scratch, h, tolerance, self.external_reuse,
             )  # fmt: skip
+            self.external_pair_steps += ext.count
             self.external_stamp = ext.updates
         if term.evaluator == passes.EVAL_VORONOI and ext.wall_count:
             passes.external_wall_pass(
@@ -744,6 +759,9 @@ class ThermalEngine:
             out["voronoi_pair_count"] = self.external.count
             out["tessellation_count"] = self.voronoi.count
             out["tessellation_seconds"] = self.voronoi.seconds
+            out["voronoi_evaluated_fraction"] = self.external_evaluations / max(
+                self.external_pair_steps, 1
+            )
         return out
 
     # ------------------------------------------------------------------------ checkpoints

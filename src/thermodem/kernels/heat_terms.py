@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
@@ -48,7 +49,7 @@ from thermodem.models.thermal.convection import convection_dispatch
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.radiation import radiation_dispatch
-from thermodem.models.thermal.voronoi import voronoi_dispatch
+from thermodem.models.thermal.voronoi import voronoi_dispatch, voronoi_side
 
 #: Evaluators of pair terms: an indirect_conduction model, or the separated-pair part of a
 #: direct_conduction model with an interaction range.
@@ -260,36 +261,86 @@ def pair_csr(pair_i, pair_j, n, offsets, entries):
         fill[pair_j[k]] += 1
 
 
+#: Columns of the per-pair state of the Voronoi conductance reuse (``external_pair_pass``):
+#: centre distance, face area and conductance at the last evaluation, secant slope dH/dd
+#: through the last two evaluations (NaN: none).
+REUSE_DISTANCE, REUSE_AREA, REUSE_CONDUCTANCE, REUSE_SLOPE = 0, 1, 2, 3
+REUSE_WIDTH = 4
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def external_pair_pass(
     position, radius, type_id, pair_i, pair_j, inputs, lower, upper, periodic, evaluator,
-    model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance,
+    model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance, tolerance, reuse,
 ):  # fmt: skip
     """Conductance of every pair of an external pair set (``inputs``: a row per pair, read
-    by the models made for such sets; the gap-conduction models ignore it)."""
+    by the models made for such sets; the gap-conduction models ignore it). Returns the
+    number of pairs whose model was evaluated.
+
+    With ``tolerance`` > 0 (Voronoi models only; ``reuse``: a row per pair, NaN rows: no
+    evaluation yet) a pair keeps its conductance H_b of the last evaluation at distance d_b
+    while its face area is unchanged, it is on the same side of touching and of the cut-off
+    (``voronoi_side``) and |d - d_b| <= tolerance × w, w = |d_b - R_i - R_j| its surface gap
+    (or overlap) then: H = H_b + S (d - d_b) with S the secant slope through its last two
+    evaluations (when they were at most 2 tolerance w apart), else H = H_b within
+    tolerance² × w. Otherwise the model is evaluated and the row updated.
+    docs/models/indirect_conduction-voronoi_a.md, "Conductance reuse"."""
     length = upper - lower
     npairs = pair_i.shape[0]
     nchunks = (npairs + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
+    evaluated = 0
     for c in prange(nchunks):
         srow = scratch[c]
+        count = 0
         for k in range(c * PARTICLE_CHUNK, min(npairs, (c + 1) * PARTICLE_CHUNK)):
             i = pair_i[k]
             j = pair_j[k]
             dist = pair_separation(position, i, j, length, periodic)[3]
             ri = radius[i]
             rj = radius[j]
-            r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
             ki = kj = 0.0
             if k_col_i >= 0:
                 ki = k_particle[i]
                 kj = k_particle[j]
             p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+            if tolerance > 0.0:
+                row = reuse[k]
+                d_b = row[REUSE_DISTANCE]
+                same = row[REUSE_AREA] == inputs[k, 0] and voronoi_side(
+                    model_id, p, ri, rj, dist
+                ) == voronoi_side(model_id, p, ri, rj, d_b)
+                delta = dist - d_b
+                window = tolerance * abs(d_b - (ri + rj))
+                slope = row[REUSE_SLOPE]
+                if same and abs(delta) <= window:
+                    if not math.isnan(slope):
+                        out_conductance[k] = row[REUSE_CONDUCTANCE] + slope * delta
+                        continue
+                    if abs(delta) <= tolerance * window:
+                        out_conductance[k] = row[REUSE_CONDUCTANCE]
+                        continue
+                r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+                h = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
+                count += 1
+                out_conductance[k] = h
+                slope = np.nan
+                if same and delta != 0.0 and abs(delta) <= 2.0 * tolerance * abs(dist - ri - rj):
+                    slope = (h - row[REUSE_CONDUCTANCE]) / delta
+                row[REUSE_DISTANCE] = dist
+                row[REUSE_AREA] = inputs[k, 0]
+                row[REUSE_CONDUCTANCE] = h
+                row[REUSE_SLOPE] = slope
+                continue
+            r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+            count += 1
             if evaluator == EVAL_VORONOI:
                 out_conductance[k] = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
             else:
                 out_conductance[k] = term_conductance(
                     evaluator, model_id, p, ri, rj, dist, r_c, 0.0
                 )
+        evaluated += count
+    return evaluated
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
