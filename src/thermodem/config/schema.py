@@ -356,9 +356,9 @@ class Case(StrictModel):
     def _check_voronoi_reuse(self, th: ThermalSettings) -> None:
         """The Voronoi conductance reuse holds H for a pair geometry: a Voronoi model, and
         constant conductivities."""
-        tol = th.tessellation.conductance_gap_tolerance
-        if tol == 0.0:
+        if th.tessellation is None or th.tessellation.conductance_gap_tolerance == 0.0:
             return
+        tol = th.tessellation.conductance_gap_tolerance
         key = "thermal.tessellation.conductance_gap_tolerance"
         model = th.indirect_conduction.model
         if model not in ("voronoi_a", "voronoi_b"):

@@ -484,8 +484,9 @@ class ThermalEngine:
         scratch = self._term_rows(rows)
         if not reuse:
             tolerance = 0.0
-            if term.evaluator == passes.EVAL_VORONOI and not frozen:
-                tolerance = float(self.settings.tessellation.conductance_gap_tolerance)
+            settings = self.settings.tessellation
+            if term.evaluator == passes.EVAL_VORONOI and not frozen and settings is not None:
+                tolerance = float(settings.conductance_gap_tolerance)
             if tolerance > 0.0 and (self.external_reuse_stamp != ext.updates
                                     or self.external_reuse.shape[0] != ext.count):  # fmt: skip
                 self.external_reuse = np.full((ext.count, passes.REUSE_WIDTH), np.nan)
