@@ -48,6 +48,7 @@ from thermodem.engine.range_set import RangePairSet
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as fk
+from thermodem.kernels import neighbourhood as nh
 from thermodem.models.thermal import convection as conv
 from thermodem.models.thermal import radiation as rad
 
@@ -60,6 +61,8 @@ if TYPE_CHECKING:
 GAS_CONSTANT = 8.314462618
 #: Prefix of the neighbourhood set's arrays in the engine's checkpoint.
 STATE_PREFIX = "fields__"
+#: Arrays of the neighbour listing of the continuum radiation models in checkpoints.
+MEMBER_ARRAYS = ("members_offsets", "members_border", "members_index")
 #: The correlation validity ranges are checked at every this many-th field update.
 RANGE_CHECK_INTERVAL = 10
 
@@ -190,14 +193,17 @@ class FieldProvider:
             if self.radiation is not None and self.radiation.table.ndim == 2
             else np.zeros(1)
         )
-        self.radiation_mode = 0
-        if self.radiation is not None and self.radiation.choice.model == "krause2017":
-            self.radiation_mode = fk.NB_KRAUSE
-        elif self.radiation is not None and self.radiation.choice.model == "zhou2009":
-            self.radiation_mode = fk.NB_ZHOU
         self.lattice = fk.unit_ball_points()
         self.sums = np.zeros((0, 4))
         self.weights = np.zeros((0, 4))
+        # the continuum radiation's neighbours of each particle (kernels/neighbourhood.py):
+        # listed at range-set build ``members_builds`` when the set had moved
+        # ``members_moved``, valid while 2 (moved + members_moved) <= members_band
+        self.members = nh.empty_members(0)
+        self.members_builds = -1
+        self.members_moved = 0.0
+        self.members_band = 0.0
+        self.members_listings = 0
         self.scratch = np.zeros((1, 4))
         # cell porosity (the grid is set up at the first evaluation: its default size)
         self.cell_size = 0.0
@@ -460,23 +466,54 @@ class FieldProvider:
         if self.sums.shape[0] != n:
             self.sums = np.zeros((n, 4))
             self.weights = np.zeros((n, 4))
-        args = (p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower, sim.upper,
-                sim.periodic, self.weights)  # fmt: skip
         if self.radiation_ratio > 0.0:
-            fk.neighbour_weights(p.radius, p.temperature, p.type_id, self.emissivity,
-                                 self.weights, self.sums)  # fmt: skip
-            fk.neighbourhood_pass(*args, self.radiation_mode, self.radiation_ratio, 0.0,
-                                  self.sums)  # fmt: skip
-            fk.neighbour_columns(self.sums, fields)
+            if (
+                ns.builds != self.members_builds
+                or self.members[0].shape[0] != n + 1
+                or 2.0 * (ns.moved + self.members_moved) > self.members_band
+            ):
+                self._list_members()
+            nh.neighbourhood_weights(p.radius, p.temperature, p.type_id, self.emissivity,
+                                     self.weights)  # fmt: skip
+            nh.neighbourhood_sums(p.position, p.radius, *self.members, self.weights, sim.lower,
+                                  sim.upper, sim.periodic, self.radiation_ratio,
+                                  fields)  # fmt: skip
         if self.shell_ratio > 0.0:
             fk.zero_rows(self.sums)
-            fk.neighbourhood_pass(*args, fk.NB_SHELL, 0.0, self.shell_ratio, self.sums)
+            fk.shell_pass(p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower,
+                          sim.upper, sim.periodic, self.shell_ratio, self.sums)  # fmt: skip
             width = 4 * max(sim.wall_kind.shape[0], 1)
             if self.scratch.shape[0] < self._chunks() or self.scratch.shape[1] < width:
                 self.scratch = np.zeros((self._chunks(), width))
             fk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
                               self.shell_ratio, self.lattice, self.sums, self.scratch,
                               fields)  # fmt: skip
+
+    def _list_members(self) -> None:
+        """List each particle's neighbours in (or near) its sphere of radiative influence
+        from the neighbourhood set at the current positions (kernels/neighbourhood.py): the
+        band is half the set's skin (at least 1e-9 R_min), so a listing lasts until the
+        particles have moved a quarter of the skin, half as long as the set itself."""
+        sim = self.sim
+        p = sim.particles
+        ns = self.neighbourhood
+        n = p.count
+        band = max(0.5 * ns.skin, 1e-9 * float(p.radius.min()))
+        counts = np.zeros(n, np.int64)
+        nh.member_counts(p.position, p.radius, ns.i, ns.j, ns.count, sim.lower, sim.upper,
+                         sim.periodic, self.radiation_ratio, band, counts)  # fmt: skip
+        offsets = np.zeros(n + 1, np.int64)
+        np.cumsum(counts, out=offsets[1:])
+        border = np.zeros(n, np.int64)
+        index = np.zeros(int(offsets[-1]), np.int32)
+        nh.member_fill(p.position, p.radius, ns.i, ns.j, ns.count, sim.lower, sim.upper,
+                       sim.periodic, self.radiation_ratio, band, offsets, border,
+                       index)  # fmt: skip
+        self.members = (offsets, border, index)
+        self.members_builds = ns.builds
+        self.members_moved = ns.moved
+        self.members_band = band
+        self.members_listings += 1
 
     # ------------------------------------------------------------------ cell porosity
     def _cell_grid(self, size: float) -> None:
@@ -564,6 +601,11 @@ class FieldProvider:
             sub = self.neighbourhood.state_dict()
             scalars["neighbourhood"] = sub["scalars"]
             arrays.update(sub["arrays"])
+        if self.radiation_ratio > 0.0:  # the listing fixes the order of the sums
+            scalars["members"] = [self.members_builds, self.members_moved, self.members_band,
+                                  self.members_listings]  # fmt: skip
+            for name, values in zip(MEMBER_ARRAYS, self.members, strict=True):
+                arrays[name] = values.copy()
         return {"scalars": scalars, "arrays": arrays}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -576,6 +618,13 @@ class FieldProvider:
             self.neighbourhood.load_state_dict(
                 {"scalars": scalars["neighbourhood"], "arrays": arrays}
             )
+        if self.radiation_ratio > 0.0 and "members" in scalars:
+            builds, moved, band, listings = scalars["members"]
+            self.members_builds, self.members_listings = int(builds), int(listings)
+            self.members_moved, self.members_band = float(moved), float(band)
+            offsets, border, index = (arrays[name] for name in MEMBER_ARRAYS)
+            self.members = (np.array(offsets, np.int64), np.array(border, np.int64),
+                            np.array(index, np.int32))  # fmt: skip
         self._constants_for = None
 
 

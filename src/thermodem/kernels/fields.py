@@ -14,9 +14,9 @@ thread count):
 - :func:`grid_sample`: trilinear interpolation of a rectilinear grid field at the particles;
 - :func:`relative_speed`: |u_f - v_p|;
 - :func:`cell_fluid_volume`, :func:`cell_porosity`: porosity by a cell count;
-- :func:`neighbour_weights`, :func:`neighbourhood_pass`, :func:`neighbour_columns`: sums over
-  the neighbours within a sphere of influence (count, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2;
-  or the solid volume within a shell);
+- :func:`shell_pass`: the solid volume of the neighbours within a shell (the sums over the
+  sphere of radiative influence of the continuum radiation models are in
+  ``kernels/neighbourhood.py``);
 - :func:`shell_porosity`: 1 - solid volume / shell volume inside the walls;
 - :func:`wall_view`: view factors and Σ F T_w⁴ of the fixed-temperature walls in view.
 """
@@ -352,87 +352,25 @@ def lens_volume(a, b, d):
     return math.pi * s * s * (d * d + 2.0 * d * (a + b) - 3.0 * (a - b) * (a - b)) / (12.0 * d)
 
 
-#: What :func:`neighbourhood_pass` sums (bits of its ``mode``).
-NB_KRAUSE = 1  # Σ ε_j A_j T_j⁴ / 2 and Σ ε_j A_j / 2 (krause2017)
-NB_ZHOU = 2  # n_p and Σ T_j (zhou2009)
-NB_SHELL = 4  # the neighbours' volume in the shell (shell porosity)
-
-
 @njit(cache=True, parallel=True, error_model="numpy")
-def neighbour_weights(radius, temperature, type_id, emissivity, weights, sums):
-    """Per particle: weights[i] = (ε_i A_i / 2, ε_i A_i T_i⁴ / 2, T_i, 0), read by the pairs,
-    and sums[i] = 0 (:func:`neighbourhood_pass` adds to it; a compact (n, 4) array: written
-    at random rows it is faster than the wide fields array: median 5-9 against 17-19 ns per
-    pair on the 50k bed, busy machine)."""
-    n = radius.shape[0]
-    for c in prange((n + CHUNK - 1) // CHUNK):
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            t = temperature[i]
-            w = 2.0 * math.pi * radius[i] * radius[i] * emissivity[type_id[i]]
-            weights[i, 0] = w
-            weights[i, 1] = w * (t * t) * (t * t)
-            weights[i, 2] = t
-            weights[i, 3] = 0.0
-            for q in range(4):
-                sums[i, q] = 0.0
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def neighbourhood_pass(
-    position, radius, pair_i, pair_j, group_start, lower, upper, periodic, weights, mode,
-    radiation_ratio, shell_ratio, sums,
-):  # fmt: skip
-    """Sums over the pairs of a range set, by slab groups (race-free, fixed order), into
-    ``sums`` (n, 4), zeroed by the caller: for every particle i, over the particles j whose
-    centre is within radiation_ratio × R_i, [n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2, Σ ε_j A_j / 2]
-    (``mode`` bits NB_ZHOU, NB_KRAUSE; ``weights`` from :func:`neighbour_weights`); with
-    ``mode`` = NB_SHELL (a pass of its own), sums[i, 0] is instead the volume of the
-    neighbours inside the sphere of radius shell_ratio × R_i."""
+def shell_pass(position, radius, pair_i, pair_j, group_start, lower, upper, periodic,
+               shell_ratio, sums):  # fmt: skip
+    """Shell porosity: sums[i, 0] += the volume of the neighbours inside the sphere of radius
+    shell_ratio × R_i (exact lens volumes), over the pairs of a range set, by slab groups
+    (race-free, fixed order; ``sums`` zeroed by the caller)."""
     length = upper - lower
     ngroups = group_start.shape[0] - 1
-    krause = (mode & NB_KRAUSE) != 0
-    zhou = (mode & NB_ZHOU) != 0
-    shell = (mode & NB_SHELL) != 0
-    q2 = radiation_ratio * radiation_ratio
     for parity in range(2):
         for half in prange((ngroups + 1 - parity) // 2):
             g = 2 * half + parity
             for k in range(group_start[g], group_start[g + 1]):
                 i = pair_i[k]
                 j = pair_j[k]
-                dx, dy, dz, d = pair_separation(position, i, j, length, periodic)
-                d2 = dx * dx + dy * dy + dz * dz
+                d = pair_separation(position, i, j, length, periodic)[3]
                 ri = radius[i]
                 rj = radius[j]
-                if shell:
-                    sums[i, 0] += lens_volume(shell_ratio * ri, rj, d)
-                    sums[j, 0] += lens_volume(shell_ratio * rj, ri, d)
-                    continue
-                # 0/1 weights instead of branches: whether a centre lies inside the other's
-                # sphere is random along the list (mispredicted branches cost ~1/3 of the
-                # pass); adding 0 leaves a sum unchanged, so the sums are the same
-                m_i = 1.0 if d2 < q2 * ri * ri else 0.0
-                m_j = 1.0 if d2 < q2 * rj * rj else 0.0
-                if zhou:
-                    sums[i, 0] += m_i
-                    sums[i, 1] += m_i * weights[j, 2]
-                    sums[j, 0] += m_j
-                    sums[j, 1] += m_j * weights[i, 2]
-                if krause:
-                    sums[i, 2] += m_i * weights[j, 1]
-                    sums[i, 3] += m_i * weights[j, 0]
-                    sums[j, 2] += m_j * weights[i, 1]
-                    sums[j, 3] += m_j * weights[i, 0]
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def neighbour_columns(sums, fields):
-    """fields[:, F_NEIGHBOURS:F_NEIGHBOUR_AREA + 1] = sums (n, 4)."""
-    n = sums.shape[0]
-    for c in prange((n + CHUNK - 1) // CHUNK):
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            for q in range(4):
-                fields[i, F_NEIGHBOURS + q] = sums[i, q]
+                sums[i, 0] += lens_volume(shell_ratio * ri, rj, d)
+                sums[j, 0] += lens_volume(shell_ratio * rj, ri, d)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -552,7 +490,7 @@ def shell_porosity(
     position, radius, wall_kind, wall_rows, shell_ratio, lattice, solid, scratch, fields
 ):  # solid: (n, 4), the neighbours' volume in column 0
     """ε_i = 1 - (V_i + solid_i) / V_shell,i, clipped to [0, 1]: V_i the particle's own
-    volume, solid_i the neighbours' volume inside the shell (:func:`neighbourhood_pass`),
+    volume, solid_i the neighbours' volume inside the shell (:func:`shell_pass`),
     V_shell,i the volume of the sphere of radius shell_ratio × R_i on the particles' side of
     the walls. Each wall closer than the shell radius cuts a cap (the wall taken as its
     tangent plane at the closest point: exact for planes and box faces). Inclusion and

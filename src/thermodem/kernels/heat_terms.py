@@ -49,7 +49,11 @@ from thermodem.models.thermal.convection import convection_dispatch
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.radiation import radiation_dispatch
-from thermodem.models.thermal.voronoi import voronoi_dispatch, voronoi_side
+from thermodem.models.thermal.voronoi import (
+    voronoi_cutoff_distance,
+    voronoi_dispatch,
+    voronoi_side,
+)
 
 #: Evaluators of pair terms: an indirect_conduction model, or the separated-pair part of a
 #: direct_conduction model with an interaction range.
@@ -262,10 +266,52 @@ def pair_csr(pair_i, pair_j, n, offsets, entries):
 
 
 #: Columns of the per-pair state of the Voronoi conductance reuse (``external_pair_pass``):
-#: centre distance, face area and conductance at the last evaluation, secant slope dH/dd
-#: through the last two evaluations (NaN: none).
-REUSE_DISTANCE, REUSE_AREA, REUSE_CONDUCTANCE, REUSE_SLOPE = 0, 1, 2, 3
-REUSE_WIDTH = 4
+#: the interval of centre distances where the last evaluation is reused, the distance,
+#: conductance and face area of that evaluation, and the slope dH/dd applied (the secant
+#: through the last two evaluations, or 0).
+REUSE_LOW, REUSE_HIGH, REUSE_DISTANCE, REUSE_CONDUCTANCE, REUSE_SLOPE, REUSE_AREA = range(6)
+REUSE_WIDTH = 6
+#: Relative guard of the reuse intervals at the cut-off distance (never reuse across it).
+CUTOFF_GUARD = 1e-12
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _reuse_row(model_id, p, ri, rj, dist, h, area, tolerance, row):
+    """Store an evaluation H(dist) in the pair's reuse row (see ``external_pair_pass``)."""
+    touch = ri + rj
+    side = voronoi_side(model_id, p, ri, rj, dist)
+    d_b = row[REUSE_DISTANCE]
+    w = abs(dist - touch)
+    delta = dist - d_b
+    slope = 0.0
+    window = tolerance * tolerance * w
+    if (
+        row[REUSE_AREA] == area
+        and side == voronoi_side(model_id, p, ri, rj, d_b)
+        and delta != 0.0
+        and abs(delta) <= 2.0 * tolerance * w
+    ):
+        slope = (h - row[REUSE_CONDUCTANCE]) / delta
+        window = tolerance * w
+    # the distances of this side of touching and of the cut-off (with a guard: the
+    # interval never holds a distance of the other side)
+    cut = voronoi_cutoff_distance(model_id, p, ri, rj)
+    if side == 0:
+        lo, hi = -np.inf, touch * (1.0 - 4e-16)
+    elif side == 1:
+        lo, hi = touch, cut * (1.0 - CUTOFF_GUARD)
+    else:
+        lo, hi = cut * (1.0 + CUTOFF_GUARD), np.inf
+    if lo <= dist <= hi:
+        row[REUSE_LOW] = max(dist - window, lo)
+        row[REUSE_HIGH] = min(dist + window, hi)
+    else:  # in a guard zone: evaluate again next time
+        row[REUSE_LOW] = np.inf
+        row[REUSE_HIGH] = -np.inf
+    row[REUSE_DISTANCE] = dist
+    row[REUSE_CONDUCTANCE] = h
+    row[REUSE_SLOPE] = slope
+    row[REUSE_AREA] = area
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -278,12 +324,12 @@ def external_pair_pass(
     number of pairs whose model was evaluated.
 
     With ``tolerance`` > 0 (Voronoi models only; ``reuse``: a row per pair, NaN rows: no
-    evaluation yet) a pair keeps its conductance H_b of the last evaluation at distance d_b
-    while its face area is unchanged, it is on the same side of touching and of the cut-off
-    (``voronoi_side``) and |d - d_b| <= tolerance × w, w = |d_b - R_i - R_j| its surface gap
-    (or overlap) then: H = H_b + S (d - d_b) with S the secant slope through its last two
-    evaluations (when they were at most 2 tolerance w apart), else H = H_b within
-    tolerance² × w. Otherwise the model is evaluated and the row updated.
+    evaluation yet) a pair keeps its last evaluation H_b at distance d_b while its face area
+    is unchanged and its distance d is within the row's interval: d_b ± tolerance × w,
+    w = |d_b - R_i - R_j| its surface gap (or overlap) then, clipped to d_b's side of touching
+    and of the cut-off; H = H_b + S (d - d_b) with S the secant slope through its last two
+    evaluations (when they were at most 2 tolerance w apart; without one S = 0 and the
+    interval is d_b ± tolerance² w). Otherwise the model is evaluated and the row updated.
     docs/models/indirect_conduction-voronoi_a.md, "Conductance reuse"."""
     length = upper - lower
     npairs = pair_i.shape[0]
@@ -296,6 +342,13 @@ def external_pair_pass(
             i = pair_i[k]
             j = pair_j[k]
             dist = pair_separation(position, i, j, length, periodic)[3]
+            if tolerance > 0.0:
+                row = reuse[k]
+                if row[REUSE_AREA] == inputs[k, 0] and row[REUSE_LOW] <= dist <= row[REUSE_HIGH]:
+                    out_conductance[k] = row[REUSE_CONDUCTANCE] + row[REUSE_SLOPE] * (
+                        dist - row[REUSE_DISTANCE]
+                    )
+                    continue
             ri = radius[i]
             rj = radius[j]
             ki = kj = 0.0
@@ -303,42 +356,15 @@ def external_pair_pass(
                 ki = k_particle[i]
                 kj = k_particle[j]
             p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
-            if tolerance > 0.0:
-                row = reuse[k]
-                d_b = row[REUSE_DISTANCE]
-                same = row[REUSE_AREA] == inputs[k, 0] and voronoi_side(
-                    model_id, p, ri, rj, dist
-                ) == voronoi_side(model_id, p, ri, rj, d_b)
-                delta = dist - d_b
-                window = tolerance * abs(d_b - (ri + rj))
-                slope = row[REUSE_SLOPE]
-                if same and abs(delta) <= window:
-                    if not math.isnan(slope):
-                        out_conductance[k] = row[REUSE_CONDUCTANCE] + slope * delta
-                        continue
-                    if abs(delta) <= tolerance * window:
-                        out_conductance[k] = row[REUSE_CONDUCTANCE]
-                        continue
-                r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
-                h = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
-                count += 1
-                out_conductance[k] = h
-                slope = np.nan
-                if same and delta != 0.0 and abs(delta) <= 2.0 * tolerance * abs(dist - ri - rj):
-                    slope = (h - row[REUSE_CONDUCTANCE]) / delta
-                row[REUSE_DISTANCE] = dist
-                row[REUSE_AREA] = inputs[k, 0]
-                row[REUSE_CONDUCTANCE] = h
-                row[REUSE_SLOPE] = slope
-                continue
             r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
             count += 1
             if evaluator == EVAL_VORONOI:
-                out_conductance[k] = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
+                h = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
             else:
-                out_conductance[k] = term_conductance(
-                    evaluator, model_id, p, ri, rj, dist, r_c, 0.0
-                )
+                h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+            out_conductance[k] = h
+            if tolerance > 0.0:
+                _reuse_row(model_id, p, ri, rj, dist, h, inputs[k, 0], tolerance, reuse[k])
         evaluated += count
     return evaluated
 

@@ -456,6 +456,13 @@ def voronoi_dispatch(model_id, p, r_i, r_j, dist, r_c, inputs):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def voronoi_cutoff_distance(model_id, p, r_i, r_j):
+    """The centre distance of the cut-off, R_i + R_j + cutoff_gap_ratio × (R_i + R_j)/2."""
+    ratio = p[A_CUTOFF] if model_id == VORONOI_A else p[B_CUTOFF]
+    return (r_i + r_j) * (1.0 + 0.5 * ratio)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def voronoi_side(model_id, p, r_i, r_j, dist):
     """Where a pair at centre distance ``dist`` is relative to the two places where H(d) is
     not smooth: 0 overlapping (d < R_i + R_j: a contact radius R_c > 0), 1 separated within
