@@ -430,13 +430,21 @@ class ThermalEngine:
             self.range_set.build(sim, *self._range_gaps())
             self.term_ready[:] = False
         frozen = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        fused = -1  # a per-particle term already evaluated with the one before it
         for index, term in enumerate(self.terms):
+            if index == fused:
+                continue
             if term.target == "range":
                 self._range_term(index, term, frozen)
             elif term.target == "contacts":
                 self._contact_term(index, term, frozen)
             elif term.target == "particles":
-                self._particle_term(term)
+                following = self.terms[index + 1] if index + 1 < len(self.terms) else None
+                if following is not None and following.target == "particles":
+                    fused = index + 1
+                    self._particle_term(term, following)
+                else:
+                    self._particle_term(term)
             elif term.target == "external":
                 self._external_term(index, term)
             else:  # pragma: no cover - the registry refuses other targets
@@ -511,11 +519,15 @@ class ThermalEngine:
             p.heat_rate_by_mechanism, self.conductance_sum,
         )  # fmt: skip
 
-    def _particle_term(self, term: HeatTerm) -> None:
+    def _particle_term(self, term: HeatTerm, second: HeatTerm | None = None) -> None:
+        """A per-particle term, and the next one in the same pass if given."""
         p = self.sim.particles
+        other = second or term
         passes.particle_pass(
             p.temperature, p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
-            term.table, term.column, p.heat_rate_by_mechanism, self.conductance_sum,
+            term.table, term.column, other.evaluator, other.model_id, other.table,
+            -1 if second is None else second.column, p.heat_rate_by_mechanism,
+            self.conductance_sum,
         )  # fmt: skip
 
     def _stored(self, index: int, pairs: int, walls: int) -> tuple[np.ndarray, np.ndarray]:

@@ -313,16 +313,19 @@ def _cell_index(x, lower, edge, dims):
     return c
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy")
 def _bin_solid(position, radius, lower, edge, dims, solid, cell):
-    """Solid volume of the particles by the cell of their centre (serial: a fixed order)."""
+    """Solid volume of the particles by the cell of their centre: the cells in parallel,
+    the sums serially (a fixed order)."""
+    n = position.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            cell[i] = _cell_index(position[i], lower, edge, dims)
     for c in range(solid.shape[0]):
         solid[c] = 0.0
-    for i in range(position.shape[0]):
-        k = _cell_index(position[i], lower, edge, dims)
-        cell[i] = k
+    for i in range(n):
         r = radius[i]
-        solid[k] += 4.0 / 3.0 * math.pi * r * r * r
+        solid[cell[i]] += 4.0 / 3.0 * math.pi * r * r * r
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

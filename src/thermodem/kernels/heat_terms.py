@@ -438,19 +438,27 @@ def particle_term(evaluator, model_id, p, t_i, r_i, fields, i):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def particle_pass(
-    temperature, radius, type_id, fields, evaluator, model_id, table, column, by_mechanism,
-    conductance_sum,
+    temperature, radius, type_id, fields, evaluator, model_id, table, column, evaluator2,
+    model_id2, table2, column2, by_mechanism, conductance_sum,
 ):  # fmt: skip
-    """One per-particle term over every particle (``table``: a row per material)."""
+    """One per-particle term over every particle (``table``: a row per material), and a
+    second one in the same pass when ``column2`` >= 0 (two consecutive terms, e.g. convection
+    and radiation: one pass over the particles and their fields; each particle adds the
+    first term, then the second, as two passes would)."""
     n = temperature.shape[0]
     nchunks = (n + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
     for c in prange(nchunks):
         for i in range(c * PARTICLE_CHUNK, min(n, (c + 1) * PARTICLE_CHUNK)):
-            q, g = particle_term(
-                evaluator, model_id, table[type_id[i]], temperature[i], radius[i], fields, i
-            )
+            t_i = temperature[i]
+            r_i = radius[i]
+            q, g = particle_term(evaluator, model_id, table[type_id[i]], t_i, r_i, fields, i)
             by_mechanism[i, column] += q
             conductance_sum[i] += g
+            if column2 >= 0:
+                q, g = particle_term(evaluator2, model_id2, table2[type_id[i]], t_i, r_i,
+                                     fields, i)  # fmt: skip
+                by_mechanism[i, column2] += q
+                conductance_sum[i] += g
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

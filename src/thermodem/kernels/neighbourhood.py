@@ -24,11 +24,13 @@ Rows are CSR (``offsets``; ``index`` the neighbour rows, each row its members, t
 ``border[i]`` its border entries, each part sorted by neighbour index). Each particle sums
 its own row in that order (the border entries with 0/1 weights): the sums do not depend on
 the thread count; they depend on the listing (which entries are members), so the listing is
-saved in checkpoints and a restart is bit-identical. One pass over the particles reading
-the neighbours' weights, most entries without a distance: against the pair pass over the
-range set it replaces (a distance per pair, four read-modify-writes of the neighbours' sums
-per pair) about half the time on the 50k bed (1 thread, busy machine; ~14.6 listed
-neighbours per particle, 14 % of them border entries with b = half the range set's skin).
+saved in checkpoints and a restart is bit-identical. The members' count and Σ ε_j A_j / 2 do
+not change while the listing holds (:func:`member_constants`); at each step a row sums the
+members' ε_j A_j T_j⁴ / 2 (krause2017) or T_j (zhou2009) from one compact array, and tests its
+border entries. Against the pair pass over the range set it replaces (a distance per pair,
+four read-modify-writes of the neighbours' sums), about a third of the time on the 50k bed
+(1 thread, busy machine; ~14 listed neighbours per particle, ~7 % of them border entries
+with b = a quarter of the range set's skin).
 """
 
 from __future__ import annotations
@@ -137,29 +139,52 @@ def _sort_rows(offsets, border, index):
             _insertion_sort(index, border[a], offsets[a + 1])
 
 
+#: What :func:`neighbourhood_sums` computes (bits of its ``mode``).
+NB_KRAUSE = 1  # Σ ε_j A_j T_j⁴ / 2 and Σ ε_j A_j / 2 (krause2017)
+NB_ZHOU = 2  # n_p and Σ T_j (zhou2009)
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
-def neighbourhood_weights(radius, temperature, type_id, emissivity, weights):
-    """Per particle: weights[i] = (ε_i A_i / 2, ε_i A_i T_i⁴ / 2, T_i, 0), what a particle
-    adds to the sums of the spheres it lies in."""
+def neighbourhood_weights(radius, temperature, type_id, emissivity, area, emission):
+    """Per particle: area[i] = ε_i A_i / 2 and emission[i] = ε_i A_i T_i⁴ / 2, what it adds
+    to the sums of the spheres it lies in (krause2017)."""
     n = radius.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             t = temperature[i]
             w = 2.0 * math.pi * radius[i] * radius[i] * emissivity[type_id[i]]
-            weights[i, 0] = w
-            weights[i, 1] = w * (t * t) * (t * t)
-            weights[i, 2] = t
-            weights[i, 3] = 0.0
+            area[i] = w
+            emission[i] = w * (t * t) * (t * t)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def neighbourhood_sums(position, radius, offsets, border, index, weights, lower, upper,
-                       periodic, ratio, fields):  # fmt: skip
+def member_constants(offsets, border, index, area, member_area, member_count):
+    """The parts of the sums that do not change while the listing holds: Σ ε_j A_j / 2 and
+    the count over each row's members (in row order: the same numbers as summing them at
+    every step)."""
+    n = offsets.shape[0] - 1
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            s = 0.0
+            for e in range(offsets[i], border[i]):
+                s += area[index[e]]
+            member_area[i] = s
+            member_count[i] = float(border[i] - offsets[i])
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def neighbourhood_sums(position, radius, temperature, offsets, border, index, area, emission,
+                       member_area, member_count, lower, upper, periodic, ratio, mode,
+                       fields):  # fmt: skip
     """fields[i, F_NEIGHBOURS .. F_NEIGHBOUR_AREA] = (n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2,
-    Σ ε_j A_j / 2) over the members of row i, then over its border entries inside q R_i
-    (tested here, with 0/1 weights: no branch on the random outcome)."""
+    Σ ε_j A_j / 2) over the particles j inside q R_i: the members of row i (their count and
+    area from :func:`member_constants`), then its border entries, tested here with 0/1
+    weights (no branch on the random outcome). ``mode``: NB_KRAUSE and/or NB_ZHOU (the
+    other columns are 0)."""
     length = upper - lower
     q2 = ratio * ratio
+    krause = (mode & NB_KRAUSE) != 0
+    zhou = (mode & NB_ZHOU) != 0
     n = offsets.shape[0] - 1
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
@@ -167,12 +192,14 @@ def neighbourhood_sums(position, radius, offsets, border, index, weights, lower,
             s1 = 0.0
             s2 = 0.0
             s3 = 0.0
-            for e in range(offsets[i], border[i]):
-                j = index[e]
-                s0 += 1.0
-                s1 += weights[j, 2]
-                s2 += weights[j, 1]
-                s3 += weights[j, 0]
+            if krause:
+                s3 = member_area[i]
+                for e in range(offsets[i], border[i]):
+                    s2 += emission[index[e]]
+            if zhou:
+                s0 = member_count[i]
+                for e in range(offsets[i], border[i]):
+                    s1 += temperature[index[e]]
             limit = q2 * radius[i] * radius[i]
             x = position[i, 0]
             y = position[i, 1]
@@ -183,10 +210,12 @@ def neighbourhood_sums(position, radius, offsets, border, index, weights, lower,
                 dy = minimum_image(position[j, 1] - y, length[1], periodic[1])
                 dz = minimum_image(position[j, 2] - z, length[2], periodic[2])
                 m = 1.0 if dx * dx + dy * dy + dz * dz < limit else 0.0
-                s0 += m
-                s1 += m * weights[j, 2]
-                s2 += m * weights[j, 1]
-                s3 += m * weights[j, 0]
+                if krause:
+                    s2 += m * emission[j]
+                    s3 += m * area[j]
+                if zhou:
+                    s0 += m
+                    s1 += m * temperature[j]
             fields[i, F_NEIGHBOURS] = s0
             fields[i, F_NEIGHBOUR_TEMPERATURE] = s1
             fields[i, F_NEIGHBOUR_EMISSION] = s2

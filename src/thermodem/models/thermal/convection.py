@@ -171,6 +171,13 @@ def pack_li_mason(params: LiMasonParams, pair: PairContext) -> np.ndarray:
 
 # ---------------------------------------------------------------------- Nusselt numbers
 @njit(cache=True, inline="always", error_model="numpy")
+def power(x, a):
+    """x^a for x >= 0, a > 0 as exp(a ln x): the same to a few ulp as x**a, and about a
+    third faster in these kernels (numba's pow); 0 for x = 0."""
+    return math.exp(a * math.log(x)) if x > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def nusselt_ranz_marshall(re, pr_cbrt):
     """Ranz & Marshall (1952): 2 + 0.6 Re^½ Pr^⅓."""
     return 2.0 + 0.6 * math.sqrt(re) * pr_cbrt
@@ -179,7 +186,7 @@ def nusselt_ranz_marshall(re, pr_cbrt):
 @njit(cache=True, inline="always", error_model="numpy")
 def nusselt_whitaker(re, pr, viscosity_ratio):
     """Whitaker (1972): 2 + (0.4 Re^½ + 0.06 Re^⅔) Pr^0.4 (μ_f/μ_fs)^¼."""
-    return 2.0 + (0.4 * math.sqrt(re) + 0.06 * re ** (2.0 / 3.0)) * pr**0.4 * math.sqrt(
+    return 2.0 + (0.4 * math.sqrt(re) + 0.06 * power(re, 2.0 / 3.0)) * power(pr, 0.4) * math.sqrt(
         math.sqrt(viscosity_ratio)
     )
 
@@ -187,7 +194,7 @@ def nusselt_whitaker(re, pr, viscosity_ratio):
 @njit(cache=True, inline="always", error_model="numpy")
 def nusselt_gunn(re, pr_cbrt, eps):
     """Gunn (1978): (7 - 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 - 2.4ε + 1.2ε²) Re^0.7 Pr^⅓."""
-    re02 = re**0.2
+    re02 = power(re, 0.2)
     re07 = re02 * math.sqrt(re)  # Re^0.7 = Re^0.2 Re^0.5
     a = 7.0 - 10.0 * eps + 5.0 * eps * eps
     b = 1.33 - 2.4 * eps + 1.2 * eps * eps
@@ -198,12 +205,12 @@ def nusselt_gunn(re, pr_cbrt, eps):
 def nusselt_li_mason(re, pr_cbrt, eps, m):
     """Li & Mason (2000): 2 + 0.6 ε^m Re^½ Pr^⅓ (Re < 200); 2 + ε^m (0.5 Re^½ + 0.02 Re^0.8)
     Pr^⅓ (Re < 1500); 2 + 4.5e-5 ε^m Re^1.8 (otherwise)."""
-    em = eps**m
+    em = power(eps, m)
     if re < 200.0:
         return 2.0 + 0.6 * em * math.sqrt(re) * pr_cbrt
     if re < 1500.0:
-        return 2.0 + em * (0.5 * math.sqrt(re) + 0.02 * re**0.8) * pr_cbrt
-    return 2.0 + 0.000045 * em * re**1.8
+        return 2.0 + em * (0.5 * math.sqrt(re) + 0.02 * power(re, 0.8)) * pr_cbrt
+    return 2.0 + 0.000045 * em * power(re, 1.8)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
