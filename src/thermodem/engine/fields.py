@@ -48,6 +48,7 @@ from thermodem.engine.range_set import RangePairSet
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as fk
+from thermodem.kernels import heat_terms
 from thermodem.kernels import neighbourhood as nh
 from thermodem.models.thermal import convection as conv
 from thermodem.models.thermal import radiation as rad
@@ -196,8 +197,8 @@ class FieldProvider:
         self.lattice = fk.unit_ball_points()
         self.sums = np.zeros((0, 4))
         # the continuum radiation's neighbours of each particle (kernels/neighbourhood.py):
-        # listed at range-set build ``members_builds`` when the set had moved
-        # ``members_moved``, valid while 2 (moved + members_moved) <= members_band
+        # listed from range-set build ``members_builds`` at the positions
+        # ``members_reference``, valid while no particle moved more than members_band / 2
         self.members = nh.empty_members(0)
         self.member_sums = tuple(np.zeros(0) for _ in range(4))
         self.radiation_mode = 0
@@ -206,7 +207,7 @@ class FieldProvider:
         elif self.radiation is not None and self.radiation.choice.model == "zhou2009":
             self.radiation_mode = nh.NB_ZHOU
         self.members_builds = -1
-        self.members_moved = 0.0
+        self.members_reference = np.zeros((0, 3))
         self.members_band = 0.0
         self.members_listings = 0
         self.scratch = np.zeros((1, 4))
@@ -468,13 +469,11 @@ class FieldProvider:
         if ns.due(sim):
             ns.build(sim, self._neighbourhood_gap(), 0.0)
         n = p.count
-        if self.sums.shape[0] != n:
-            self.sums = np.zeros((n, 4))
         if self.radiation_ratio > 0.0:
             if (
                 ns.builds != self.members_builds
                 or self.members[0].shape[0] != n + 1
-                or 2.0 * (ns.moved + self.members_moved) > self.members_band
+                or 2.0 * self._moved_since_listing() > self.members_band
             ):
                 self._list_members()
             if self.member_sums[0].shape[0] != n:
@@ -488,6 +487,8 @@ class FieldProvider:
                                   sim.periodic, self.radiation_ratio, self.radiation_mode,
                                   fields)  # fmt: skip
         if self.shell_ratio > 0.0:
+            if self.sums.shape[0] != n:
+                self.sums = np.zeros((n, 4))
             fk.zero_rows(self.sums)
             fk.shell_pass(p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower,
                           sim.upper, sim.periodic, self.shell_ratio, self.sums)  # fmt: skip
@@ -523,9 +524,18 @@ class FieldProvider:
         self.members = (offsets, border, index)
         self._member_constants()
         self.members_builds = ns.builds
-        self.members_moved = ns.moved
+        self.members_reference = p.position.copy()
         self.members_band = band
         self.members_listings += 1
+
+    def _moved_since_listing(self) -> float:
+        """Largest displacement of a particle since the listing [m] (parallel, by chunks:
+        the same for any thread count)."""
+        sim = self.sim
+        return float(heat_terms.largest_displacement(sim.particles.position,
+                                                     self.members_reference, sim.lower,
+                                                     sim.upper, sim.periodic,
+                                                     self._part()))  # fmt: skip
 
     def _member_constants(self) -> None:
         """ε A / 2 of every particle and the members' count and Σ ε A / 2 of every row."""
@@ -625,10 +635,10 @@ class FieldProvider:
             scalars["neighbourhood"] = sub["scalars"]
             arrays.update(sub["arrays"])
         if self.radiation_ratio > 0.0:  # the listing fixes the order of the sums
-            scalars["members"] = [self.members_builds, self.members_moved, self.members_band,
-                                  self.members_listings]  # fmt: skip
+            scalars["members"] = [self.members_builds, self.members_band, self.members_listings]
             for name, values in zip(MEMBER_ARRAYS, self.members, strict=True):
                 arrays[name] = values.copy()
+            arrays["members_reference"] = self.members_reference.copy()
         return {"scalars": scalars, "arrays": arrays}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -642,9 +652,12 @@ class FieldProvider:
                 {"scalars": scalars["neighbourhood"], "arrays": arrays}
             )
         if self.radiation_ratio > 0.0 and "members" in scalars:
-            builds, moved, band, listings = scalars["members"]
+            builds, band, listings = scalars["members"]
             self.members_builds, self.members_listings = int(builds), int(listings)
-            self.members_moved, self.members_band = float(moved), float(band)
+            self.members_band = float(band)
+            self.members_reference = np.array(arrays["members_reference"], np.float64).reshape(
+                -1, 3
+            )
             offsets, border, index = (arrays[name] for name in MEMBER_ARRAYS)
             self.members = (np.array(offsets, np.int64), np.array(border, np.int64),
                             np.array(index, np.int32))  # fmt: skip
