@@ -226,7 +226,7 @@ def test_porosity_closure_runs_on_near_pairs(tmp_path: Path, porosity: dict) -> 
 
     p = sim.particles
     ext.prepare(sim)
-    eps = th.fields[:, F_POROSITY]
+    eps = th.fields[F_POROSITY]
     if porosity["kind"] == "global":
         assert np.all(eps == 0.4)
     else:
@@ -244,7 +244,7 @@ def test_voronoi_porosity_is_one_minus_the_solid_fraction_of_the_cell(tmp_path: 
     sim.run(steps=1)
     from thermodem.kernels.fields import F_POROSITY
 
-    assert sim.thermal.fields[:, F_POROSITY] == pytest.approx(1 - math.pi / 6, rel=1e-6)
+    assert sim.thermal.fields[F_POROSITY] == pytest.approx(1 - math.pi / 6, rel=1e-6)
 
 
 def test_a_particle_beyond_a_plane_wall_stops_the_run_with_a_clear_error(tmp_path: Path) -> None:

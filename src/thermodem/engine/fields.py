@@ -1,8 +1,9 @@
 """Per-particle fields: the fluid at each particle, the local porosity, the neighbourhood.
 
-The per-particle heat terms (convection, radiation) read a field array ``fields`` (n,
-``NFIELDS``) whose columns are defined in ``kernels/fields.py``. :class:`FieldProvider` fills
-the columns the case's terms need, at every thermal step, before those terms run
+The per-particle heat terms (convection, radiation) read a field array ``fields``
+(``NFIELDS``, n: a row per field) whose rows are defined in ``kernels/fields.py``.
+:class:`FieldProvider` fills the rows the case's terms need, at every thermal step, before
+those terms run
 (``ThermalEngine.evaluate_terms``):
 
 - **fluid temperature** T_f and **velocity** u_f (``thermal.fluid``): uniform, a table of
@@ -69,7 +70,7 @@ RANGE_CHECK_INTERVAL = 10
 
 
 class PorosityProvider(Protocol):
-    """Fills ``fields[:, F_POROSITY]`` for the current particles (the Voronoi hook)."""
+    """Fills ``fields[F_POROSITY]`` for the current particles (the Voronoi hook)."""
 
     def update(self, sim: Simulation, fields: np.ndarray) -> None: ...
 
@@ -208,6 +209,7 @@ class FieldProvider:
             self.radiation_mode = nh.NB_ZHOU
         self.members_builds = -1
         self.members_reference = np.zeros((0, 3))
+        self.members_offset = 0.0
         self.members_band = 0.0
         self.members_listings = 0
         self.scratch = np.zeros((1, 4))
@@ -228,7 +230,7 @@ class FieldProvider:
         self.warned: list[str] = []
         self.updates = 0  # field updates so far (the range checks run on every 10th)
         self.numbers_buffer = np.zeros((0, len(conv.NUMBER_NAMES)))
-        self.velocity_buffer = np.zeros((1, 3))
+        self.velocity_buffer = np.zeros((3, 1))  # u_f: (3, n), or (3, 1) if uniform
         self.part = np.zeros(1)
         self._constants_for: np.ndarray | None = None
 
@@ -403,7 +405,7 @@ class FieldProvider:
                     time,
                     int(p.global_id[k]),
                 )
-            fields[:, fk.F_FLUID_TEMPERATURE] = values
+            fields[fk.F_FLUID_TEMPERATURE, :] = values
         else:
             _, axes, values, file = source
             outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values, fields,
@@ -416,25 +418,25 @@ class FieldProvider:
         kind = source[0]
         uniform = kind in ("uniform", "table")
         if kind == "uniform":
-            self.velocity_buffer[0] = source[1]
+            self.velocity_buffer[:, 0] = source[1]
         elif kind == "table":
             table = source[1]
             for a in range(3):
-                self.velocity_buffer[0, a] = np.interp(time, table[:, 0], table[:, 1 + a])
+                self.velocity_buffer[a, 0] = np.interp(time, table[:, 0], table[:, 1 + a])
         else:
-            if self.velocity_buffer.shape[0] != p.count:
-                self.velocity_buffer = np.zeros((p.count, 3))
+            if self.velocity_buffer.shape[1] != p.count:
+                self.velocity_buffer = np.zeros((3, p.count))
             if kind == "expression":
                 pos = p.position
                 for a in range(3):
-                    self.velocity_buffer[:, a] = source[1][a](time, pos[:, 0], pos[:, 1],
+                    self.velocity_buffer[a, :] = source[1][a](time, pos[:, 0], pos[:, 1],
                                                               pos[:, 2])  # fmt: skip
-                bad = ~np.isfinite(self.velocity_buffer).all(axis=1)
+                bad = ~np.isfinite(self.velocity_buffer).all(axis=0)
                 if bad.any():
                     k = int(np.argmax(bad))
                     raise SimulationError(
                         f"thermal.fluid.velocity: the expressions {list(source[2])} give "
-                        f"{self.velocity_buffer[k].tolist()} m/s at particle "
+                        f"{self.velocity_buffer[:, k].tolist()} m/s at particle "
                         f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s)",
                         self.sim.step_count,
                         time,
@@ -449,7 +451,7 @@ class FieldProvider:
 
     def fluid_velocity(self) -> np.ndarray:
         """u_f at the particles at the last update [m/s], (n, 3) (or (1, 3) if uniform)."""
-        return self.velocity_buffer.copy()
+        return self.velocity_buffer.T.copy()
 
     # ----------------------------------------------------------------- neighbourhood
     def _neighbourhood_gap(self) -> float:
@@ -473,7 +475,7 @@ class FieldProvider:
             if (
                 ns.builds != self.members_builds
                 or self.members[0].shape[0] != n + 1
-                or 2.0 * self._moved_since_listing() > self.members_band
+                or self._listing_expired()
             ):
                 self._list_members()
             if self.member_sums[0].shape[0] != n:
@@ -525,17 +527,24 @@ class FieldProvider:
         self._member_constants()
         self.members_builds = ns.builds
         self.members_reference = p.position.copy()
+        self.members_offset = ns.moved  # the set's displacement at the listing
         self.members_band = band
         self.members_listings += 1
 
-    def _moved_since_listing(self) -> float:
-        """Largest displacement of a particle since the listing [m] (parallel, by chunks:
-        the same for any thread count)."""
+    def _listing_expired(self) -> bool:
+        """Whether a particle may have moved more than band / 2 since the listing. First the
+        bound |x - x_list| <= |x - x_set| + |x_list - x_set| from the range set's own
+        displacement (found by its due() this step) and the one at the listing: no pass of
+        its own while a bed hardly moves; then, if the bound is too large, the displacement
+        since the listing itself (parallel, by chunks: the same for any thread count)."""
+        ns = self.neighbourhood
+        if 2.0 * (ns.moved + self.members_offset) <= self.members_band:
+            return False
         sim = self.sim
-        return float(heat_terms.largest_displacement(sim.particles.position,
-                                                     self.members_reference, sim.lower,
-                                                     sim.upper, sim.periodic,
-                                                     self._part()))  # fmt: skip
+        moved = heat_terms.largest_displacement(sim.particles.position, self.members_reference,
+                                                sim.lower, sim.upper, sim.periodic,
+                                                self._part())  # fmt: skip
+        return 2.0 * float(moved) > self.members_band
 
     def _member_constants(self) -> None:
         """ε A / 2 of every particle and the members' count and Σ ε A / 2 of every row."""
@@ -635,7 +644,8 @@ class FieldProvider:
             scalars["neighbourhood"] = sub["scalars"]
             arrays.update(sub["arrays"])
         if self.radiation_ratio > 0.0:  # the listing fixes the order of the sums
-            scalars["members"] = [self.members_builds, self.members_band, self.members_listings]
+            scalars["members"] = [self.members_builds, self.members_band, self.members_listings,
+                                  self.members_offset]  # fmt: skip
             for name, values in zip(MEMBER_ARRAYS, self.members, strict=True):
                 arrays[name] = values.copy()
             arrays["members_reference"] = self.members_reference.copy()
@@ -652,9 +662,9 @@ class FieldProvider:
                 {"scalars": scalars["neighbourhood"], "arrays": arrays}
             )
         if self.radiation_ratio > 0.0 and "members" in scalars:
-            builds, band, listings = scalars["members"]
+            builds, band, listings, offset = scalars["members"]
             self.members_builds, self.members_listings = int(builds), int(listings)
-            self.members_band = float(band)
+            self.members_band, self.members_offset = float(band), float(offset)
             self.members_reference = np.array(arrays["members_reference"], np.float64).reshape(
                 -1, 3
             )

@@ -135,7 +135,7 @@ class ThermalEngine:
         #: per-particle fields read by per-particle terms (columns: kernels/fields.py), filled
         #: by the providers of engine/fields.py before the terms run (fluid, porosity, ...)
         self.field_provider = FieldProvider(sim, settings, self.terms)
-        self.fields = np.zeros((0, field_kernels.NFIELDS))
+        self.fields = np.zeros((field_kernels.NFIELDS, 0))  # a row per field
         self._empty = np.zeros(0)
         self.conductance_sum = np.zeros(0)
         #: cumulative ledger [J]: heat in through every boundary mechanism, heat absorbed by
@@ -420,8 +420,8 @@ class ThermalEngine:
         sim = self.sim
         if self.field_provider.active:
             n = sim.particles.count
-            if self.fields.shape[0] != n:
-                self.fields = np.zeros((n, field_kernels.NFIELDS))
+            if self.fields.shape[1] != n:
+                self.fields = np.zeros((field_kernels.NFIELDS, n))
             self.field_provider.update(time, self.fields)
         if self.voronoi is not None:
             self.voronoi.update(self.fields)

@@ -1,9 +1,14 @@
 """Per-particle fields read by the per-particle heat terms (convection, radiation).
 
-The thermal engine holds one array ``fields`` of shape (n, NFIELDS); its columns are defined
-here, once, and filled by the providers of ``engine/fields.py`` at every thermal step before
-the per-particle terms run. A model kernel reads ``fields[i, F_...]``. Columns a case does not
-need stay zero (a zero wall view factor, for example, means "no wall in view").
+The thermal engine holds one array ``fields`` of shape (NFIELDS, n): a row per field (a
+contiguous array over the particles), defined here, once, and filled by the providers of
+``engine/fields.py`` at every thermal step before the per-particle terms run. A model kernel
+reads ``fields[F_..., i]``. A pass that fills one field writes one contiguous row (with a
+row per particle, (n, NFIELDS), it wrote one value in every 128-byte row: on the 50k bed the
+relative speed pass took 0.66 ms and the cell porosity 1.19 ms per step inside a run, busy
+machine). Rows a case does not need stay zero (a zero wall view factor, for example, means
+"no wall in view"). The constants below name the rows ("columns" in the names of the
+helpers, as before).
 
 Kernels of this module (all compiled, no Python loops over particles; every particle writes
 only its own row, or a pair pass adds by slab groups, so the results do not depend on the
@@ -89,21 +94,21 @@ CHUNK = 4096  # particles per chunk of the parallel passes
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def fill_column(fields, column, value):
-    """fields[:, column] = value."""
-    n = fields.shape[0]
+    """fields[column, :] = value."""
+    n = fields.shape[1]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            fields[i, column] = value
+            fields[column, i] = value
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def zero_columns(fields, first, last):
-    """fields[:, first:last] = 0."""
-    n = fields.shape[0]
+    """fields[first:last, :] = 0."""
+    n = fields.shape[1]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             for k in range(first, last):
-                fields[i, k] = 0.0
+                fields[k, i] = 0.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -128,28 +133,28 @@ def interp_held(x, nodes, values):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def table_column(fields, column, nodes, values, at_particle, temperature):
-    """fields[:, column] = table(T) with T the fluid temperature at the particle
+    """fields[column, :] = table(T) with T the fluid temperature at the particle
     (``at_particle`` False) or the particle's temperature (True)."""
-    n = fields.shape[0]
+    n = fields.shape[1]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            t = temperature[i] if at_particle else fields[i, F_FLUID_TEMPERATURE]
-            fields[i, column] = interp_held(t, nodes, values)
+            t = temperature[i] if at_particle else fields[F_FLUID_TEMPERATURE, i]
+            fields[column, i] = interp_held(t, nodes, values)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def prandtl_columns(fields):
-    """Pr = c_f μ_f / k_f and Pr^(1/3) from the property columns."""
-    n = fields.shape[0]
+    """Pr = c_f μ_f / k_f and Pr^(1/3) from the property rows."""
+    n = fields.shape[1]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             pr = (
-                fields[i, F_FLUID_SPECIFIC_HEAT]
-                * fields[i, F_FLUID_VISCOSITY]
-                / fields[i, F_FLUID_CONDUCTIVITY]
+                fields[F_FLUID_SPECIFIC_HEAT, i]
+                * fields[F_FLUID_VISCOSITY, i]
+                / fields[F_FLUID_CONDUCTIVITY, i]
             )
-            fields[i, F_PRANDTL] = pr
-            fields[i, F_PRANDTL_CBRT] = pr ** (1.0 / 3.0)
+            fields[F_PRANDTL, i] = pr
+            fields[F_PRANDTL_CBRT, i] = pr ** (1.0 / 3.0)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -177,7 +182,7 @@ def _bracket(axis, x):
 @njit(cache=True, parallel=True, error_model="numpy")
 def grid_sample(position, axis_x, axis_y, axis_z, values, out, first, part):
     """Trilinear interpolation of ``values`` (nx, ny, nz, nc) on the rectilinear grid of the
-    three axes at every particle into ``out[i, first:first + nc]``; a position outside the
+    three axes at every particle into ``out[first:first + nc, i]``; a position outside the
     grid takes the value at the nearest point of the grid's boundary (held). Returns the number
     of particles outside (``part``: a scratch value per chunk)."""
     n = position.shape[0]
@@ -204,7 +209,7 @@ def grid_sample(position, axis_x, axis_y, axis_z, values, out, first, part):
                 c11 = values[kx, ky1, kz1, q] * (1.0 - wx) + values[kx1, ky1, kz1, q] * wx
                 c0 = c00 * (1.0 - wy) + c10 * wy
                 c1 = c01 * (1.0 - wy) + c11 * wy
-                out[i, first + q] = c0 * (1.0 - wz) + c1 * wz
+                out[first + q, i] = c0 * (1.0 - wz) + c1 * wz
         part[c] = outside
     total = 0
     for c in range(nchunks):
@@ -214,15 +219,16 @@ def grid_sample(position, axis_x, axis_y, axis_z, values, out, first, part):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def relative_speed(velocity, fluid_velocity, uniform, fields):
-    """fields[:, F_RELATIVE_SPEED] = |u_f - v_p| (``uniform``: u_f is fluid_velocity[0])."""
+    """fields[F_RELATIVE_SPEED, :] = |u_f - v_p| (``fluid_velocity``: (3, n), or (3, 1) with
+    ``uniform``)."""
     n = velocity.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             k = 0 if uniform else i
-            dx = fluid_velocity[k, 0] - velocity[i, 0]
-            dy = fluid_velocity[k, 1] - velocity[i, 1]
-            dz = fluid_velocity[k, 2] - velocity[i, 2]
-            fields[i, F_RELATIVE_SPEED] = math.sqrt(dx * dx + dy * dy + dz * dz)
+            dx = fluid_velocity[0, k] - velocity[i, 0]
+            dy = fluid_velocity[1, k] - velocity[i, 1]
+            dz = fluid_velocity[2, k] - velocity[i, 2]
+            fields[F_RELATIVE_SPEED, i] = math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -340,7 +346,7 @@ def cell_porosity(position, radius, lower, edge, dims, fluid_volume, solid, cell
             k = cell[i]
             v = fluid_volume[k]
             eps = 1.0 - solid[k] / v if v > 0.0 else 0.0
-            fields[i, F_POROSITY] = min(max(eps, 0.0), 1.0)
+            fields[F_POROSITY, i] = min(max(eps, 0.0), 1.0)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -547,7 +553,7 @@ def shell_porosity(
                 volume -= extra * full / npts
             own = 4.0 / 3.0 * math.pi * ri * ri * ri
             eps = 1.0 - (own + solid[i, 0]) / volume if volume > 0.0 else 0.0
-            fields[i, F_POROSITY] = min(max(eps, 0.0), 1.0)
+            fields[F_POROSITY, i] = min(max(eps, 0.0), 1.0)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -574,5 +580,5 @@ def wall_view(position, radius, wall_kind, wall_rows, range_ratio, view_factor, 
             if view > 1.0:
                 emission /= view
                 view = 1.0
-            fields[i, F_WALL_VIEW] = view
-            fields[i, F_WALL_EMISSION] = emission
+            fields[F_WALL_VIEW, i] = view
+            fields[F_WALL_EMISSION, i] = emission

@@ -216,10 +216,10 @@ def neighbourhood_sums(position, radius, temperature, offsets, border, index, ar
                 if zhou:
                     s0 += m
                     s1 += m * temperature[j]
-            fields[i, F_NEIGHBOURS] = s0
-            fields[i, F_NEIGHBOUR_TEMPERATURE] = s1
-            fields[i, F_NEIGHBOUR_EMISSION] = s2
-            fields[i, F_NEIGHBOUR_AREA] = s3
+            fields[F_NEIGHBOURS, i] = s0
+            fields[F_NEIGHBOUR_TEMPERATURE, i] = s1
+            fields[F_NEIGHBOUR_EMISSION, i] = s2
+            fields[F_NEIGHBOUR_AREA, i] = s3
 
 
 def empty_members(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

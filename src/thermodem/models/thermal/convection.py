@@ -216,10 +216,10 @@ def nusselt_li_mason(re, pr_cbrt, eps, m):
 @njit(cache=True, inline="always", error_model="numpy")
 def reynolds(p, r_i, fields, i):
     """Re = ρ_f v 2R / μ_f, v = |u_f - v_p| (times ε with p[0] = 1: superficial)."""
-    speed = fields[i, F_RELATIVE_SPEED]
+    speed = fields[F_RELATIVE_SPEED, i]
     if p[0] != 0.0:
-        speed *= fields[i, F_POROSITY]
-    return fields[i, F_FLUID_DENSITY] * speed * 2.0 * r_i / fields[i, F_FLUID_VISCOSITY]
+        speed *= fields[F_POROSITY, i]
+    return fields[F_FLUID_DENSITY, i] * speed * 2.0 * r_i / fields[F_FLUID_VISCOSITY, i]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -227,15 +227,15 @@ def convection_nusselt(model_id, p, r_i, fields, i):
     """Nu of model ``model_id`` for particle i (NaN for an unknown id)."""
     if model_id == GUNN:
         re = reynolds(p, r_i, fields, i)
-        return nusselt_gunn(re, fields[i, F_PRANDTL_CBRT], fields[i, F_POROSITY])
+        return nusselt_gunn(re, fields[F_PRANDTL_CBRT, i], fields[F_POROSITY, i])
     if model_id == RANZ_MARSHALL:
-        return nusselt_ranz_marshall(reynolds(p, r_i, fields, i), fields[i, F_PRANDTL_CBRT])
+        return nusselt_ranz_marshall(reynolds(p, r_i, fields, i), fields[F_PRANDTL_CBRT, i])
     if model_id == WHITAKER:
-        ratio = fields[i, F_FLUID_VISCOSITY] / fields[i, F_SURFACE_VISCOSITY]
-        return nusselt_whitaker(reynolds(p, r_i, fields, i), fields[i, F_PRANDTL], ratio)
+        ratio = fields[F_FLUID_VISCOSITY, i] / fields[F_SURFACE_VISCOSITY, i]
+        return nusselt_whitaker(reynolds(p, r_i, fields, i), fields[F_PRANDTL, i], ratio)
     if model_id == LI_MASON:
         re = reynolds(p, r_i, fields, i)
-        return nusselt_li_mason(re, fields[i, F_PRANDTL_CBRT], fields[i, F_POROSITY], p[1])
+        return nusselt_li_mason(re, fields[F_PRANDTL_CBRT, i], fields[F_POROSITY, i], p[1])
     if model_id == STAGNANT:
         return p[0]
     if model_id == NONE:
@@ -246,8 +246,8 @@ def convection_nusselt(model_id, p, r_i, fields, i):
 @njit(cache=True, inline="always", error_model="numpy")
 def _newton(nu, t_i, r_i, fields, i):
     """(Q, G) = (h A (T_f - T), h A), h A = 2π R k_f Nu."""
-    ha = 2.0 * math.pi * r_i * fields[i, F_FLUID_CONDUCTIVITY] * nu
-    return ha * (fields[i, F_FLUID_TEMPERATURE] - t_i), ha
+    ha = 2.0 * math.pi * r_i * fields[F_FLUID_CONDUCTIVITY, i] * nu
+    return ha * (fields[F_FLUID_TEMPERATURE, i] - t_i), ha
 
 
 @njit(cache=True, error_model="numpy")
@@ -303,21 +303,21 @@ def convection_numbers(
         p = table[type_id[i]]
         r = radius[i]
         out[i, N_RE] = reynolds(p, r, fields, i)
-        out[i, N_PR] = fields[i, F_PRANDTL]
+        out[i, N_PR] = fields[F_PRANDTL, i]
         out[i, N_NU] = convection_nusselt(model_id, p, r, fields, i) if with_nusselt else 0.0
-        out[i, N_VISCOSITY_RATIO] = fields[i, F_FLUID_VISCOSITY] / fields[i, F_SURFACE_VISCOSITY]
-        out[i, N_POROSITY] = fields[i, F_POROSITY]
+        out[i, N_VISCOSITY_RATIO] = fields[F_FLUID_VISCOSITY, i] / fields[F_SURFACE_VISCOSITY, i]
+        out[i, N_POROSITY] = fields[F_POROSITY, i]
         if beta_mode == 0:
             out[i, N_RA] = np.nan
         else:
-            tf = fields[i, F_FLUID_TEMPERATURE]
+            tf = fields[F_FLUID_TEMPERATURE, i]
             b = 1.0 / tf if beta_mode == 1 else beta
             d = 2.0 * r
-            rho = fields[i, F_FLUID_DENSITY]
+            rho = fields[F_FLUID_DENSITY, i]
             out[i, N_RA] = (
                 gravity * b * abs(temperature[i] - tf) * d * d * d * rho * rho
-                * fields[i, F_FLUID_SPECIFIC_HEAT]
-                / (fields[i, F_FLUID_VISCOSITY] * fields[i, F_FLUID_CONDUCTIVITY])
+                * fields[F_FLUID_SPECIFIC_HEAT, i]
+                / (fields[F_FLUID_VISCOSITY, i] * fields[F_FLUID_CONDUCTIVITY, i])
             )  # fmt: skip
 
 
