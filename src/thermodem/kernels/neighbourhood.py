@@ -179,8 +179,8 @@ def neighbourhood_sums(position, radius, temperature, offsets, border, index, ar
     """fields[i, F_NEIGHBOURS .. F_NEIGHBOUR_AREA] = (n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2,
     Σ ε_j A_j / 2) over the particles j inside q R_i: the members of row i (their count and
     area from :func:`member_constants`), then its border entries, tested here with 0/1
-    weights (no branch on the random outcome). ``mode``: NB_KRAUSE and/or NB_ZHOU (the
-    other columns are 0)."""
+    weights (no branch on the random outcome). ``mode``: NB_KRAUSE and/or NB_ZHOU; the rows
+    of the other are not written (they stay 0)."""
     length = upper - lower
     q2 = ratio * ratio
     krause = (mode & NB_KRAUSE) != 0
@@ -216,10 +216,12 @@ def neighbourhood_sums(position, radius, temperature, offsets, border, index, ar
                 if zhou:
                     s0 += m
                     s1 += m * temperature[j]
-            fields[F_NEIGHBOURS, i] = s0
-            fields[F_NEIGHBOUR_TEMPERATURE, i] = s1
-            fields[F_NEIGHBOUR_EMISSION, i] = s2
-            fields[F_NEIGHBOUR_AREA, i] = s3
+            if zhou:
+                fields[F_NEIGHBOURS, i] = s0
+                fields[F_NEIGHBOUR_TEMPERATURE, i] = s1
+            if krause:
+                fields[F_NEIGHBOUR_EMISSION, i] = s2
+                fields[F_NEIGHBOUR_AREA, i] = s3
 
 
 def empty_members(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
