@@ -90,6 +90,56 @@ def _guarded(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
         raise typer.Exit(exc.exit_code) from None
 
 
+def _guarded_mpi(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+    """``_guarded`` on one of several MPI ranks: the errors agreed between the ranks (every
+    rank has the same message) are printed by rank 0 only, every rank exits with the same
+    code; any other exception cannot be agreed (the other ranks wait in a collective), so
+    its rank prints it and aborts the MPI job."""
+    import traceback
+
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    root = comm.Get_rank() == 0
+    try:
+        return fn(*args, **kwargs)
+    except ConfigError as exc:
+        if root:
+            typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_INPUT) from None
+    except SimulationError as exc:
+        if root:
+            typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(EXIT_SIMULATION) from None
+    except RunInterrupted as exc:
+        if root:
+            typer.echo(str(exc), err=True)
+        raise typer.Exit(exc.exit_code) from None
+    except Exception as exc:  # noqa: BLE001 (a bug or a resource error on this rank only)
+        typer.echo(
+            f"error on MPI rank {comm.Get_rank()} of {comm.Get_size()}: "
+            f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}aborting every rank",
+            err=True,
+        )
+        comm.Abort(EXIT_SIMULATION)
+
+
+def _mpi_ranks() -> int:
+    """The number of MPI ranks of this process (1 without mpiexec; mpi4py not imported)."""
+    from thermodem.mpi import world_size
+
+    return world_size()
+
+
+_REBALANCE = typer.Option(
+    0.1,
+    "--rebalance",
+    min=0.0,
+    help="under mpiexec: re-bisect the domain when the fullest rank has this fraction more "
+    "particles than the mean (docs/mpi.md)",
+)
+
+
 @app.command()
 def run(
     case: Path | None = typer.Argument(
@@ -109,12 +159,15 @@ def run(
     steps: int | None = typer.Option(
         None, "--steps", min=1, help="run this many steps only (a quick try of a case)"
     ),
+    rebalance: float = _REBALANCE,
 ) -> None:
-    """Run a case: VTU/PVD frames, timeseries.csv, checkpoints, run.log, status.json."""
+    """Run a case: VTU/PVD frames, timeseries.csv, checkpoints, run.log, status.json.
+    Under ``mpiexec -n P`` (P > 1) the case runs on P ranks (docs/mpi.md)."""
     from thermodem.config.load import load_case
     from thermodem.engine.runner import run_case, run_from_checkpoint
 
     threads = _threads(threads)
+    ranks = _mpi_ranks()
 
     def go() -> None:
         if case is None and restart is None:
@@ -128,12 +181,20 @@ def run(
             _shorten(loaded, end_time, steps, restart)
         name = case.stem if case is not None else None
         options = dict(progress=progress, log_interval=log_interval, case_name=name)
-        if restart is not None:
+        if ranks > 1:
+            from thermodem.mpi.runner import run_distributed
+
+            run_distributed(loaded, output, threads, overwrite, checkpoint=restart,
+                            rebalance_threshold=rebalance, **options)  # fmt: skip
+        elif restart is not None:
             run_from_checkpoint(restart, output, loaded, threads, overwrite, **options)
         else:
             run_case(loaded, output, threads, overwrite, **options)
 
-    _guarded(go)
+    if ranks > 1:
+        _guarded_mpi(go)
+    else:
+        _guarded(go)
 
 
 def _shorten(case, end_time: float | None, steps: int | None, restart: Path | None) -> None:  # noqa: ANN001
@@ -193,10 +254,25 @@ def restart(
     ),
     progress: bool | None = _PROGRESS,
     log_interval: float = _LOG_INTERVAL,
+    rebalance: float = _REBALANCE,
 ) -> None:
-    """Continue a run from the newest checkpoint in DIRECTORY (appending to its outputs)."""
+    """Continue a run from the newest checkpoint in DIRECTORY (appending to its outputs); under
+    ``mpiexec -n P`` on P ranks, whatever number of ranks wrote it."""
     from thermodem.engine.runner import restart_run
 
+    if _mpi_ranks() > 1:
+        from thermodem.mpi.runner import restart_distributed
+
+        _guarded_mpi(
+            restart_distributed,
+            directory,
+            _threads(threads),
+            end_time=end_time,
+            progress=progress,
+            log_interval=log_interval,
+            rebalance_threshold=rebalance,
+        )
+        return
     _guarded(
         restart_run,
         directory,
@@ -326,7 +402,8 @@ def _unit(description: str) -> tuple[str, str]:
     m = re.search(r"\[([^\]]*)\]", description)
     if not m:
         return "", description
-    rest = (description[: m.start()] + description[m.end() :]).strip(" ,;")
+    rest = description[: m.start()] + description[m.end() :]
+    rest = re.sub(r"\s+([,;:)])", r"\1", re.sub(r"\s+", " ", rest)).strip(" ,;")
     return m.group(1), rest
 
 
@@ -337,6 +414,17 @@ _TARGET_TEXT = {
     "external": "an external pair set (e.g. Voronoi neighbours)",
     "particles": "single particles",
 }
+
+
+def _conducts_across_gaps(spec) -> bool:  # noqa: ANN001
+    """Whether the model conducts across a gap (its interaction range is > 0)."""
+    if spec.interaction_range is None:
+        return False
+    try:
+        params = spec.params(**spec.example_params)
+    except ValueError:
+        return True
+    return spec.interaction_range(params, 1.0, 1.0) > 0.0
 
 
 @app.command()
@@ -364,8 +452,10 @@ def models(
                 typer.echo(f"    reads thermal.gas: {', '.join(spec.uses_gas)}")
             if fam in _THERMAL_PAIR_FAMILIES and spec.name != "none":
                 where = _TARGET_TEXT[spec.target]
-                if spec.interaction_range is not None and spec.target == "contacts":
+                if _conducts_across_gaps(spec) and spec.target == "contacts":
                     where += "; pairs across a gap: the range pair set"
+                if spec.range_parameter:
+                    where += f"; its range is set by {spec.range_parameter}"
                 typer.echo(f"    runs on: {where}")
             if spec.conductance_from_force:
                 typer.echo(

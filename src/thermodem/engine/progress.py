@@ -97,7 +97,7 @@ class Progress:
             completed=sim.step_count,
             t=f"{sim.time:.4g}",
             rates=f"{_short(n['sps'])} steps/s {_short(n['psps'])} particle-steps/s",
-            counts=f"{sim.particles.count} particles {sim.contact_count} contacts",
+            counts=f"{sim.global_count} particles {sim.global_contacts} contacts",
         )
 
     def _numbers(self, sim: Simulation, now: float) -> dict[str, Any]:
@@ -117,12 +117,12 @@ class Progress:
         return (
             f"t = {sim.time:.6g} / {self.end_time:g} s ({100 * n['fraction']:.1f} %), step "
             f"{sim.step_count}/{self.total}, {n['sps']:.3g} steps/s, {n['psps']:.3g} "
-            f"particle-steps/s, ETA {format_duration(n['eta'])}, {sim.particles.count} "
-            f"particles, {sim.contact_count} contacts"
+            f"particle-steps/s, ETA {format_duration(n['eta'])}, {sim.global_count} "
+            f"particles, {sim.global_contacts} contacts"
         )
 
     def update(self, sim: Simulation) -> None:
-        self.particle_steps += sim.particles.count
+        self.particle_steps += sim.global_count
         now = wallclock.perf_counter()
         self._sim = sim
         if self._bar is not None and now - self.last_bar > 0.2:

@@ -121,16 +121,19 @@ class RangePairSet:
                     sim.step_count,
                     sim.time,
                 )
-        dims, edge = nbr.cell_grid(sim.lower, sim.upper, cell, sim.periodic)
+        # the region of the particles (the domain; on several MPI ranks this rank's box and
+        # its halo, periodic only where the halo wraps: Simulation.grid_box)
+        lower, upper, periodic = sim.grid_box()
+        dims, edge = nbr.cell_grid(lower, upper, cell, periodic)
         # the slab axis of the contact list: the particles lie in memory by layers along it,
         # so each group of this set touches a compact block of memory (see below)
         axis = getattr(sim, "slab_axis", None)
         if axis is None:
-            axis = int(slabs.choose_axis(p.position, sim.lower, edge, dims))
+            axis = int(slabs.choose_axis(p.position, lower, edge, dims))
         axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
         order = np.empty(n, np.int32)
         cell_start = np.zeros(int(dims[0] * dims[1] * dims[2]) + 1, np.int64)
-        nbr.sort_by_cell(p.position, sim.lower, edge, dims, axes, order, cell_start)
+        nbr.sort_by_cell(p.position, lower, edge, dims, axes, order, cell_start)
         # the pairs are found among cell-sorted copies, then mapped back to particle indices
         position = np.ascontiguousarray(p.position[order])
         radius = np.ascontiguousarray(p.radius[order])
@@ -138,8 +141,8 @@ class RangePairSet:
         new_i, new_j = self.i, self.j
         while True:
             count = nbr.build_pairs(
-                position, radius, global_id, sim.lower, sim.upper, sim.periodic, dims, edge,
-                axes, cell_start, self.gap, self.skin, new_i, new_j,
+                position, radius, global_id, lower, upper, periodic, dims, edge, axes,
+                cell_start, self.gap, self.skin, new_i, new_j,
             )  # fmt: skip
             if count <= new_i.shape[0]:
                 break
@@ -149,9 +152,16 @@ class RangePairSet:
         new_i[:count] = order[new_i[:count]]
         new_j[:count] = order[new_j[:count]]
         del order
-        nlayers = slabs.layer_count(int(dims[axis]), bool(sim.periodic[axis]))
+        own = sim.owned_count
+        if own < n:  # several MPI ranks: a pair of two ghosts is another rank's
+            keep = np.nonzero((new_i[:count] < own) | (new_j[:count] < own))[0]
+            count = keep.shape[0]
+            new_i[:count] = new_i[keep]
+            new_j[:count] = new_j[keep]
+            del keep
+        nlayers = slabs.layer_count(int(dims[axis]), bool(periodic[axis]))
         group_start = np.zeros(nlayers + 1, np.int64)
-        args = (p.position, sim.lower, edge, dims, axis, nlayers, new_i, new_j, count, group_start)
+        args = (p.position, lower, edge, dims, axis, nlayers, new_i, new_j, count, group_start)
         if not slabs.group_pairs(*args):
             sorted_i, sorted_j = np.empty_like(new_i), np.empty_like(new_j)
             slabs.sort_pairs_by_group(*args, sorted_i, sorted_j, np.empty(count, np.int32))
@@ -164,15 +174,16 @@ class RangePairSet:
         # particle-wall pairs, grouped by particle
         if self.wall_row_start.shape[0] != n + 1:
             self.wall_row_start = np.zeros(n + 1, np.int64)
-        while True:
+        while True:  # (of the owned particles: on several MPI ranks the ghosts have none)
             wcount = nbr.build_wall_pairs(
-                p.position, p.radius, sim.wall_kind, sim.wall_rows, self.wall_gap, self.skin,
-                self.wall_i, self.wall_w, self.wall_row_start,
+                p.position[:own], p.radius[:own], sim.wall_kind, sim.wall_rows, self.wall_gap,
+                self.skin, self.wall_i, self.wall_w, self.wall_row_start[: own + 1],
             )  # fmt: skip
             if wcount <= self.wall_i.shape[0]:
                 break
             self.wall_i = np.empty(PairBuffers.grown(self.wall_i.shape[0], wcount), np.int32)
             self.wall_w = np.empty_like(self.wall_i)
+        self.wall_row_start[own + 1 :] = wcount
         self.wall_count = wcount
 
     # ------------------------------------------------------------------------ checkpoints

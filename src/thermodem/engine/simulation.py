@@ -20,7 +20,9 @@ Order inside one step (``Simulation.step``):
    into the particles by slab group (``thermodem.kernels.slabs``), dissipation per mechanism,
    history, ledger rows per group; when a thermal step follows, the same passes evaluate the
    contact conduction of the touching pairs, and the other heat terms are evaluated right
-   after them on the same state (so the heat rates are complete at the end of the step);
+   after them on the same state (so the heat rates by mechanism are complete at the end of
+   the step; the source column and the totals too, or, with ``step(complete=False)``, when
+   :meth:`Simulation.complete_rates` or the next thermal update forms them);
 5. the second half kick;
 6. overlap check; 7. writers on their triggers (owned by the caller, see
    ``thermodem.engine.runner``).
@@ -54,6 +56,7 @@ from thermodem.kernels.integrate import (
     reset_forces,
     sum_rows,
 )
+from thermodem.models import registry
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
 from thermodem.state.heat import HEAT_MECHANISMS
 from thermodem.state.pairs import PairBuffers
@@ -69,6 +72,9 @@ LEDGER_DISSIPATION = (
 
 class Simulation:
     """A thermal DEM simulation built from a validated :class:`~thermodem.config.schema.Case`."""
+
+    #: the MPI communicator of a run on several ranks (``thermodem.mpi``); None here
+    comm = None
 
     def __init__(
         self, case: Case, threads: int | None = None, *, insert_particles: bool = True
@@ -121,8 +127,9 @@ class Simulation:
         self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         # thermal engine (absent = mechanics only)
-        z1, z3 = np.zeros(0), np.zeros((1, 1, 16))
-        z2 = np.zeros((1, 16))
+        width = max(spec.width for spec in registry.all_models())  # any row fits
+        z1, z3 = np.zeros(0), np.zeros((1, 1, width))
+        z2 = np.zeros((1, width))
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
         self._no_heat = (
             (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
@@ -168,6 +175,7 @@ class Simulation:
         self.wall_row_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
         self.chunk_check = np.zeros((1, 3))
+        self._complete = True  # step(complete=...): form the total heat rates in the step
         self.moved = 0.0
         self.rebuild_count = 0
         self.slab_axis: int | None = None  # set by each neighbour rebuild
@@ -211,6 +219,40 @@ class Simulation:
         )
         numba.set_num_threads(self.threads)
         return self.threads
+
+    # ---------------------------------------------- ranks (thermodem.mpi overrides these)
+    @property
+    def owned_count(self) -> int:
+        """Particles this process owns: all of them (on several MPI ranks, the first
+        ``owned_count`` of ``particles``; the ghosts follow)."""
+        return self.particles.count
+
+    @property
+    def global_count(self) -> int:
+        """Particles of the whole simulation (on every MPI rank together)."""
+        return self.particles.count
+
+    @property
+    def global_contacts(self) -> int:
+        """Touching contacts of the whole simulation at the last report (on several MPI
+        ranks, updated by each time-series row)."""
+        return self.contact_count
+
+    def sum_over_ranks(self, value: float) -> float:
+        """``value`` summed over the MPI ranks (itself here)."""
+        return value
+
+    def grid_box(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lower, upper, periodic) of the region the neighbour grids cover: the domain (on
+        several MPI ranks, this rank's box with its halo)."""
+        return self.lower, self.upper, self.periodic
+
+    def agree_thermal(
+        self, limit: float, limit_particle: int, bad_particle: int, bad_temperature: float
+    ) -> tuple[float, int, int, float]:
+        """The explicit Euler limit, its particle (global id) and the first particle with a
+        bad temperature (global id or -1) of the whole simulation (the arguments here)."""
+        return limit, limit_particle, bad_particle, bad_temperature
 
     # ------------------------------------------------------------------ particles in and out
     def add_particles(self, new: InsertedParticles) -> None:
@@ -285,7 +327,10 @@ class Simulation:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
             pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
-            reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_rate_by_mechanism,
+            # the heat sums start at zero: zeroed here, or already by this step's Euler update
+            zero = not (th.rates_cleared and th.conductance_sum.shape[0] == p.count)
+            th.rates_cleared = False
+            reset_forces(p.force, p.torque, p.mass, self.gravity, zero, p.heat_rate_by_mechanism,
                          th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
             no_mech, no_sum = self._no_heat[0][-3:-1]
@@ -305,8 +350,8 @@ class Simulation:
             self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
             wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat,
         )  # fmt: skip
-        if heat_due:  # the other heat terms of this state, so the rates are complete now
-            th.after_contact_pass(self.time)
+        if heat_due:  # the other heat terms of this state (the totals: see step())
+            th.after_contact_pass(self.time, self._complete)
         if kick:
             final_kick(p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
                        p.moment_of_inertia, self.dt)  # fmt: skip
@@ -333,8 +378,21 @@ class Simulation:
             cum["wall_work"] += sums[C.L_WALL_WORK]
 
     # -------------------------------------------------------------------------------- step
-    def step(self) -> None:
-        """Advance one time step (see the module docstring for the order)."""
+    def complete_rates(self) -> None:
+        """Form the heat rates a step left to the next thermal step (see :meth:`step`); the
+        outputs, checkpoints, :meth:`report`, :meth:`contacts` and :meth:`run` call it."""
+        if self.thermal is not None:
+            self.thermal.complete_rates()
+
+    def step(self, complete: bool = True) -> None:
+        """Advance one time step (see the module docstring for the order).
+
+        ``complete=False``: the source column and the total heat rates of the new state are
+        left to the next step's thermal update, which forms them anyway (one pass over the
+        particles less per step), unless :meth:`complete_rates` is called first; the
+        mechanism columns are complete either way. :meth:`run` and the run loop step so and
+        complete the rates wherever they are read."""
+        self._complete = complete
         th = self.thermal
         if th is not None and th.settings.frozen_mechanics:
             th.step(th.settings.time_step, self.time)
@@ -342,9 +400,10 @@ class Simulation:
             self.time = self.step_count * th.settings.time_step
             return
         if th is not None and self.step_count >= th.next_step:
-            # heat over the next n steps from the positions, contacts and temperatures now
+            # heat over the next n steps from the positions, contacts and temperatures now;
+            # with n = 1 this step's contact pass adds the heat of the next state at once
             n = th.substeps
-            th.step(n * self.dt, self.time)
+            th.step(n * self.dt, self.time, clear=n == 1)
             th.next_step = self.step_count + n
         p = self.particles
         nchunks = p.count // CHECK_CHUNK + 1
@@ -401,9 +460,11 @@ class Simulation:
                 dt = self.thermal.settings.time_step
             steps = max(0, int(round((until - self.time) / dt)))
         for _ in range(int(steps)):
-            self.step()
+            self.step(complete=False)
             if callback is not None and self.step_count % every == 0:
+                self.complete_rates()
                 callback(self)
+        self.complete_rates()
 
     def _where(self) -> str:
         return f"at step {self.step_count} (t = {self.time:.6g} s)"
@@ -516,6 +577,7 @@ class Simulation:
         and heat rate (``thermodem.engine.contacts``)."""
         from thermodem.engine.contacts import contact_data
 
+        self.complete_rates()
         return contact_data(self)
 
     def coordination_number(self) -> np.ndarray:
@@ -544,6 +606,7 @@ class Simulation:
 
         ``engine/runner.py`` writes every key as a column of ``timeseries.csv``.
         """
+        self.complete_rates()
         out: dict[str, float] = dict(self.energies())
         out["energy_balance_error"] = self.energy_balance_error()
         out["particle_count"] = self.particles.count
@@ -557,6 +620,7 @@ class Simulation:
         """The complete restart state (copies); see :mod:`thermodem.engine.restart`."""
         from thermodem.engine.restart import capture
 
+        self.complete_rates()
         return capture(self)
 
     def load_state(self, state: dict) -> None:

@@ -125,6 +125,9 @@ class ThermalEngine:
             if any(t.target == "range" for t in self.terms)
             else None
         )
+        if self.range_set is not None and self._radius_bound() > 0.0:
+            # before the run: the largest particles the insertions can bring (pours too)
+            self.check_ranges(self._radius_bound())
         # per-pair conductances of the contact conduction (heat-only passes, frozen reuse)
         self.pair_conductance = np.zeros(0)
         self.wall_conductance = np.zeros(0)
@@ -152,6 +155,10 @@ class ThermalEngine:
         # reuse_conductance = False re-evaluates them at every thermal step (tests)
         self.conductance_ready = False
         self.reuse_conductance = True
+        #: the last explicit update zeroed the mechanism rates and conductance sums (step)
+        self.rates_cleared = False
+        #: the source column and total heat rates are not formed yet (after_contact_pass)
+        self.rates_pending = False
         # the implicit schemes read the per-pair conductances of every term at every state
         # (engine/implicit.py); the passes then store them also with k(T) tables
         self.record_conductances = settings.scheme != "explicit"
@@ -270,11 +277,13 @@ class ThermalEngine:
         if self.has_c_table and self.conditions.active:
             before = p.temperature.copy()
             fixed, source, _ = self.conditions.apply(time, self.specific_heat_by_type)
-            after = p.temperature[fixed]
+            own = fixed.copy()
+            own[self.sim.owned_count :] = False  # (on several MPI ranks: not the ghosts)
+            after = p.temperature[own]
             self.cumulative["fixed_reset"] += kernels.total_enthalpy(
-                after, p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+                after, p.mass[own], p.type_id[own], self.c_t, self.c_v, self.c_n
             ) - kernels.total_enthalpy(
-                before[fixed], p.mass[fixed], p.type_id[fixed], self.c_t, self.c_v, self.c_n
+                before[own], p.mass[own], p.type_id[own], self.c_t, self.c_v, self.c_n
             )
             return fixed, source
         fixed, source, reset = self.conditions.apply(time, self.specific_heat_by_type)
@@ -395,21 +404,62 @@ class ThermalEngine:
         p = self.sim.particles
         if p.count == 0:
             return 0.0, 0.0
-        r_max = float(p.radius.max())
-        extent = float(np.min(self.sim.upper - self.sim.lower))
+        return self.check_ranges(float(p.radius.max()))
+
+    def _radius_bound(self) -> float:
+        """Largest radius the case's insertion distributions can produce [m] (0 if none
+        is bounded; particle files and lists are checked once inserted)."""
+        bounds = [
+            getattr(getattr(e, "distribution", None), "max_radius_bound", None)
+            for e in self.sim.case.insertion
+        ]
+        return max([float(b) for b in bounds if b is not None] + [0.0])
+
+    def check_ranges(self, r_max: float) -> tuple[float, float]:
+        """The range set's largest conducting gaps of particle pairs and particle-wall pairs
+        for particles up to ``r_max`` [m]; a ConfigError naming the model's key and its range
+        parameter when a gap exceeds the domain, or when a periodic axis is too short for the
+        range set's cells (two cells of 2 r_max + gap + skin)."""
+        sim = self.sim
+        extent = float(np.min(sim.upper - sim.lower))
         gap = wall_gap = 0.0
+        widest = None
         for term in self.terms:
             if term.target != "range":
                 continue
             g, w = term.max_gap(r_max)
             if max(g, w) > extent:
                 raise ConfigError(
-                    f"{term.key} = {term.choice.model!r}: its largest conducting gap "
-                    f"{max(g, w):.6g} m (for particles of radius {r_max:.6g} m) exceeds the "
-                    f"domain's smallest extent {extent:.6g} m; check its range parameters "
-                    f"({term.params.model_dump()})"
+                    f"{_range_key(term)}: {term.choice.model!r} conducts across surface gaps up "
+                    f"to {max(g, w):.6g} m for particles of radius {r_max:.6g} m, more than the "
+                    f"domain's smallest extent {extent:.6g} m; allowed: "
+                    f"{_range_allowed(term, extent / max(g, w))}"
                 )
+            if widest is None or g > gap:
+                widest = term
             gap, wall_gap = max(gap, g), max(wall_gap, w)
+        if widest is None:
+            return gap, wall_gap
+        skin = self.settings.range_skin
+        if skin is None:  # the contact list's skin (its default: 0.2 R_max)
+            skin = getattr(sim, "skin", None) or sim.case.neighbors.skin or 0.2 * r_max
+        cell = 2.0 * r_max + gap + float(skin)
+        length = sim.upper - sim.lower
+        for a in range(3):
+            if sim.periodic[a] and length[a] < 2.0 * cell:
+                # the part of the cell the model's range can still take
+                room = 0.5 * float(length[a]) - 2.0 * r_max - float(skin)
+                raise ConfigError(
+                    f"{_range_key(widest)}: periodic axis {'xyz'[a]} of length "
+                    f"{length[a]:.6g} m is shorter than two cells of the range pair set "
+                    f"(2 R_max {2.0 * r_max:.6g} m + largest conducting gap {gap:.6g} m + "
+                    f"thermal.range_skin {float(skin):.6g} m each); allowed: "
+                    + (
+                        _range_allowed(widest, room / gap)
+                        if room > 0.0
+                        else "a longer periodic axis or a smaller thermal.range_skin"
+                    )
+                )
         return gap, wall_gap
 
     def evaluate_terms(self, time: float) -> None:
@@ -624,17 +674,29 @@ class ThermalEngine:
         self.fresh = False
         return self.finish(time)
 
-    def after_contact_pass(self, time: float) -> None:
+    def after_contact_pass(self, time: float, complete: bool = True) -> None:
         """The fused contact pass has added the contact conduction of this state: add every
-        other term and form the total heat rates, for the thermal step that follows."""
+        other term and (``complete``) form the source column and total heat rates, which the
+        thermal step that follows forms anyway: without ``complete`` they are left to it, or
+        to :meth:`complete_rates` when something reads them first (``rates_pending``)."""
         self._fixed_and_sources(time)
         self.evaluate_terms(time)
-        self.finish(time)
+        if complete:
+            self.finish(time)
+        else:
+            self.rates_pending = True
+
+    def complete_rates(self) -> None:
+        """Form the source column and the total heat rates if the last contact pass left
+        them to the next thermal step (outputs, checkpoints and the API call this)."""
+        if self.rates_pending:
+            self.finish(self.sim.time)
 
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
         kernels.finish_heat(self.source, p.heat_rate, p.heat_rate_by_mechanism, self.sum_columns)
+        self.rates_pending = False
         return self.fixed
 
     def specific_heat(self) -> np.ndarray:
@@ -644,9 +706,14 @@ class ThermalEngine:
             return self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
         return self.specific_heat_by_type[p.type_id]
 
-    def step(self, dt: float, time: float) -> None:
+    def step(self, dt: float, time: float, clear: bool = False) -> None:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler, or the
-        implicit scheme of ``thermal.scheme``: engine/implicit.py)."""
+        implicit scheme of ``thermal.scheme``: engine/implicit.py).
+
+        ``clear``: the contact pass of this same step evaluates the heat of the next state
+        (heat every step): the explicit update then zeroes the mechanism rates and conductance
+        sums it has read (``rates_cleared``), so that the force reset need not. Nothing reads
+        them in between (outputs are written after the step)."""
         if self.implicit is not None:
             self.implicit.step(dt, time)
             self.thermal_steps += 1
@@ -661,28 +728,43 @@ class ThermalEngine:
             self.evaluate_terms(time)
             fixed, source = self.fixed, self.source
         self.fresh = False
-        by_mech = p.heat_rate_by_mechanism
+        # the particles this process owns: all of them (on several MPI ranks the first
+        # owned_count, the ghosts after them are updated by their owners, thermodem.mpi)
+        n = sim.owned_count
+        temperature, heat_rate, mass = p.temperature[:n], p.heat_rate[:n], p.mass[:n]
+        by_mech, type_id = p.heat_rate_by_mechanism[:n], p.type_id[:n]
+        fixed, source, conductance = fixed[:n], source[:n], self.conductance_sum[:n]
         if self.has_c_table:
-            kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)
-            c = self.specific_heat()
-            self.limit, where = kernels.stability_limit(p.mass, c, self.conductance_sum, fixed)
+            kernels.finish_heat(source, heat_rate, by_mech, self.sum_columns)
+            self.rates_pending = False
+            c = self.specific_heat()[:n]
+            limit, where = kernels.stability_limit(mass, c, conductance, fixed)
             boundary = by_mech[:, self.boundary_columns].sum(axis=0)
-            absorbed, bad = kernels.euler_update_enthalpy(p.temperature, p.heat_rate, p.mass,
-                                                          p.type_id, self.c_t, self.c_v,
-                                                          self.c_n, fixed, dt)  # fmt: skip
+            absorbed, bad = kernels.euler_update_enthalpy(temperature, heat_rate, mass, type_id,
+                                                          self.c_t, self.c_v, self.c_n, fixed,
+                                                          dt)  # fmt: skip
         else:
             # one fused pass: heat rate, Euler limit, update and the ledger sums
-            rows = p.count // kernels.EULER_CHUNK + 1
+            rows = n // kernels.EULER_CHUNK + 1
             if self.euler_partials.shape[0] < rows:
                 self.euler_partials = np.zeros((rows, self.euler_partials.shape[1]))
-            self.limit, where, absorbed, bad = kernels.euler_step(
-                p.temperature, p.heat_rate, by_mech, self.sum_columns, source, p.mass, p.type_id,
-                self.specific_heat_by_type, self.conductance_sum, fixed, dt,
-                self.euler_partials,
+            limit, where, absorbed, bad = kernels.euler_step(
+                temperature, heat_rate, by_mech, self.sum_columns, source, mass, type_id,
+                self.specific_heat_by_type, conductance, fixed, dt, self.euler_partials, clear,
             )  # fmt: skip
+            # (with MPI ghosts after the owned particles the force reset zeroes them all)
+            self.rates_cleared = clear and n == p.count
+            self.rates_pending = False  # the update formed them
             boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
             boundary = boundary[self.boundary_columns]
-        self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
+        gid = p.global_id
+        # the whole simulation's limit and failure (the same on every MPI rank)
+        self.limit, self.limit_particle, bad_gid, bad_temperature = sim.agree_thermal(
+            float(limit),
+            int(gid[where]) if where >= 0 else -1,
+            int(gid[bad]) if bad >= 0 else -1,
+            float(temperature[bad]) if bad >= 0 else math.nan,
+        )
         if dt > self.limit and not self.settings.stability.allow_unstable:
             raise SimulationError(
                 f"thermal time step {dt:.4g} s exceeds the explicit Euler limit m c / ΣH = "
@@ -697,15 +779,14 @@ class ThermalEngine:
             self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
-        if bad >= 0:
-            gid = int(p.global_id[bad])
+        if bad_gid >= 0:
             raise SimulationError(
-                f"temperature of particle {gid} became {p.temperature[bad]:.6g} K at step "
+                f"temperature of particle {bad_gid} became {bad_temperature:.6g} K at step "
                 f"{sim.step_count} (t = {time:.6g} s); likely cause: thermal time step "
                 f"{dt:.4g} s against the limit {self.limit:.4g} s",
                 sim.step_count,
                 time,
-                gid,
+                bad_gid,
             )
         if self.settings.substeps == "auto" and math.isfinite(self.limit):
             n = int(0.5 * self.limit / sim.dt)
@@ -715,12 +796,15 @@ class ThermalEngine:
     def thermal_energy(self, mask: np.ndarray | None = None) -> float:
         """Σ m c T over all particles (or ``mask``) [J] (Σ m h(T) with a tabulated c)."""
         p = self.sim.particles
-        t, m, ty = p.temperature, p.mass, p.type_id
+        n = self.sim.owned_count  # (all particles; on several MPI ranks the owned ones)
+        t, m, ty = p.temperature[:n], p.mass[:n], p.type_id[:n]
         if mask is not None:
-            t, m, ty = t[mask], m[mask], ty[mask]
+            t, m, ty = t[mask[:n]], m[mask[:n]], ty[mask[:n]]
         if self.has_c_table:
-            return kernels.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
-        return float(np.sum(m * self.specific_heat_by_type[ty] * t))
+            return self.sim.sum_over_ranks(
+                kernels.total_enthalpy(t, m, ty, self.c_t, self.c_v, self.c_n)
+            )
+        return self.sim.sum_over_ranks(float(np.sum(m * self.specific_heat_by_type[ty] * t)))
 
     def inserted(self, temperature: np.ndarray, mass: np.ndarray, type_id: np.ndarray) -> None:
         """Ledger the thermal energy that inserted particles bring in."""
@@ -747,6 +831,7 @@ class ThermalEngine:
         ``heat_rate_<mechanism>``: for pairwise mechanisms the heat exchanged, ½ Σ|Q_i| (they
         sum to zero); for boundary mechanisms the net heat into the particles, Σ Q_i.
         """
+        self.complete_rates()
         p = self.sim.particles
         out: dict[str, float] = {}
         if p.count:
@@ -827,6 +912,11 @@ class ThermalEngine:
             for k in list(arrays)
             if k.startswith(EXTERNAL_PREFIX)
         }
+        from thermodem.engine.restart import check_thermal_arrays, keep_derived_thermal
+
+        # tables and ids made from the case stay this case's (a restart may change the case)
+        changed = keep_derived_thermal(self, scalars, arrays)
+        check_thermal_arrays(self, arrays)
         for name, value in scalars.items():
             current = getattr(self, name, None)
             if isinstance(current, float) and value is not None:
@@ -836,6 +926,9 @@ class ThermalEngine:
             setattr(self, name, value)
         for name, value in arrays.items():
             setattr(self, name, np.array(value, copy=True))
+        if changed:  # conductances kept from the old case's models are stale
+            self.conductance_ready = False
+            self.term_ready[:] = False
         if self.range_set is not None:
             if range_scalars is None:
                 raise ConfigError(
@@ -857,3 +950,20 @@ class ThermalEngine:
         if field_scalars is not None and self.field_provider.active:
             self.field_provider.load_state_dict({"scalars": field_scalars, "arrays": field_arrays})
         self.conditions.invalidate()
+
+
+def _range_key(term: HeatTerm) -> str:
+    """'thermal.indirect_conduction.cutoff_gap_ratio = 100.0' (the key that sets the range)."""
+    name = term.spec.range_parameter
+    if name is None:
+        return f"{term.key} = {term.choice.model!r}"
+    return f"{term.key}.{name} = {getattr(term.params, name)!r}"
+
+
+def _range_allowed(term: HeatTerm, factor: float) -> str:
+    """What the range parameter may be: its value scaled by ``factor`` (ranges are
+    proportional to it)."""
+    name = term.spec.range_parameter
+    if name is None:
+        return "smaller range parameters or a larger domain"
+    return f"{name} below {getattr(term.params, name) * factor:.6g} (or a larger domain)"

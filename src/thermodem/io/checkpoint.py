@@ -80,8 +80,12 @@ def write_checkpoint(
     fsync: bool = False,
     case_yaml: str | None = None,
     run_id: str = "",
+    state: dict | None = None,
 ) -> Path:
     """Write the complete state of ``sim`` to ``path`` atomically; returns the path.
+
+    ``state``: the state to write if the caller has it already (``sim.state_dict()``; on
+    several MPI ranks the state gathered to rank 0, thermodem.mpi.gather).
 
     ``case_yaml``: the resolved case text if the caller has it already (it is the same for
     every checkpoint of a run and costs more to produce than the arrays of a small case).
@@ -97,7 +101,8 @@ def write_checkpoint(
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    state = sim.state_dict()
+    if state is None:
+        state = sim.state_dict()
     tmp = path.with_name(path.name + ".tmp")
     with h5py.File(tmp, "w") as f:
         f.attrs["format"] = FORMAT
@@ -251,11 +256,13 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
         kind = _text(attrs["kind"])
         if kind not in KINDS:
             raise ConfigError(f"{damaged}: kind {kind!r} is not one of {', '.join(KINDS)}")
-    from thermodem.engine.restart import check_state
+    from thermodem.engine.restart import check_state, check_values
 
     _check_case_yaml(case_yaml, damaged)
     try:
         check_state(state)
+        if kind != "failed":  # a failed state may hold the non-finite values that stopped it
+            check_values(state)
     except ConfigError as exc:
         raise ConfigError(f"{damaged}: {exc}") from None
     return Checkpoint(

@@ -176,7 +176,7 @@ def member_constants(offsets, border, index, area, member_area, member_count):
 def neighbourhood_sums(position, radius, temperature, offsets, border, index, area, emission,
                        member_area, member_count, lower, upper, periodic, ratio, mode,
                        fields):  # fmt: skip
-    """fields[i, F_NEIGHBOURS .. F_NEIGHBOUR_AREA] = (n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2,
+    """fields[F_NEIGHBOURS .. F_NEIGHBOUR_AREA, i] = (n_p, Σ T_j, Σ ε_j A_j T_j⁴ / 2,
     Σ ε_j A_j / 2) over the particles j inside q R_i: the members of row i (their count and
     area from :func:`member_constants`), then its border entries, tested here with 0/1
     weights (no branch on the random outcome). ``mode``: NB_KRAUSE and/or NB_ZHOU; the rows

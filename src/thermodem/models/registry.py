@@ -43,10 +43,6 @@ FAMILIES: tuple[str, ...] = (
     "heat_source",
 )
 
-#: Width of a packed parameter row of a model that does not name its columns (the mechanics
-#: families; their rows are padded with zeros to this width).
-PARAM_WIDTH = 16
-
 #: Where a thermal term runs (see ``docs/architecture.md``, "Heat terms on pair sets"):
 #: ``contacts`` touching pairs of the contact list, ``range`` every pair whose surface gap is
 #: within the model's interaction range (touching pairs included), ``external`` a pair set
@@ -72,7 +68,7 @@ class ModelSpec:
     interaction_range: Callable[..., float] | None = None
     antisymmetric: bool = True
     uses_gas: tuple[str, ...] = ()
-    columns: tuple[str, ...] | None = None
+    columns: tuple[str, ...] = ()
     swap_pairs: tuple[tuple[int, int], ...] = ()
     target: str = "contacts"
     symmetric: bool = False
@@ -80,16 +76,17 @@ class ModelSpec:
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
     uses_contact_radius: bool = True
     example_params: dict[str, Any] = field(default_factory=dict)
+    range_parameter: str | None = None
 
     @property
     def width(self) -> int:
-        """Width of the packed parameter row: the named columns (at least 1; a model without
-        parameters packs one zero), or PARAM_WIDTH for a model that names no columns."""
-        return PARAM_WIDTH if self.columns is None else max(len(self.columns), 1)
+        """Width of the packed parameter row: its named columns (at least 1: a model without
+        parameters packs one zero)."""
+        return max(len(self.columns), 1)
 
     def column(self, name: str) -> int:
         """Index of the named column of the packed row (KeyError naming the columns)."""
-        if self.columns is None or name not in self.columns:
+        if name not in self.columns:
             raise KeyError(f"{self.family}.{self.name} has no column {name!r}: {self.columns}")
         return self.columns.index(name)
 
@@ -113,7 +110,7 @@ def register(
     interaction_range: Callable[..., float] | None = None,
     antisymmetric: bool = True,
     uses_gas: tuple[str, ...] = (),
-    columns: tuple[str, ...] | None = None,
+    columns: tuple[str, ...] = (),
     swap_pairs: tuple[tuple[int, int], ...] = (),
     target: str = "contacts",
     symmetric: bool = False,
@@ -121,6 +118,7 @@ def register(
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
     uses_contact_radius: bool = True,
     example_params: dict[str, Any] | None = None,
+    range_parameter: str | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
 
@@ -133,7 +131,8 @@ def register(
     ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
     None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
     argument (the range pass then does not compute it); ``example_params`` parameters the
-    conformance tests use for a model without defaults.
+    conformance tests use for a model without defaults; ``range_parameter`` the parameter
+    that sets ``interaction_range`` (in proportion), named by the range errors.
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -150,7 +149,7 @@ def register(
     if target not in TARGETS:
         raise ValueError(f"{family}.{name}: target {target!r} is not one of {TARGETS}")
     for a, b in swap_pairs:
-        if columns is not None and not (0 <= a < len(columns) and 0 <= b < len(columns)):
+        if not (0 <= a < len(columns) and 0 <= b < len(columns)):
             raise ValueError(f"{family}.{name}: swap pair {(a, b)} outside columns {columns}")
     spec = ModelSpec(
         family=family,
@@ -167,7 +166,7 @@ def register(
         interaction_range=interaction_range,
         antisymmetric=antisymmetric,
         uses_gas=tuple(uses_gas),
-        columns=None if columns is None else tuple(columns),
+        columns=tuple(columns),
         swap_pairs=tuple((int(a), int(b)) for a, b in swap_pairs),
         target=target,
         symmetric=symmetric,
@@ -175,7 +174,10 @@ def register(
         conductance_reuse_refusal=conductance_reuse_refusal,
         uses_contact_radius=uses_contact_radius,
         example_params=dict(example_params or {}),
+        range_parameter=range_parameter,
     )
+    if range_parameter is not None and range_parameter not in params.model_fields:
+        raise ValueError(f"{family}.{name}: range_parameter {range_parameter!r} is no parameter")
     models[name] = spec
     return spec
 
@@ -229,14 +231,3 @@ def packed(columns: tuple[str, ...], values: dict[str, float]) -> np.ndarray:
         raise ValueError(f"row of columns {columns}: missing {missing}, unknown {unknown}")
     row = np.array([float(values[c]) for c in columns], dtype=np.float64)
     return row if row.size else np.zeros(1)
-
-
-def pad_row(values: list[float] | tuple[float, ...] | np.ndarray) -> np.ndarray:
-    """A float64 parameter row of width PARAM_WIDTH from the first values (models without
-    named columns)."""
-    row = np.zeros(PARAM_WIDTH, dtype=np.float64)
-    values = np.asarray(values, dtype=np.float64)
-    if values.size > PARAM_WIDTH:
-        raise ValueError(f"parameter row of {values.size} values exceeds {PARAM_WIDTH}")
-    row[: values.size] = values
-    return row

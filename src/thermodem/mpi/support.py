@@ -1,0 +1,96 @@
+"""What a run on several MPI ranks supports, checked before any simulation time is spent.
+
+Supported (docs/mpi.md): the mechanics (every normal, tangential and rolling model, walls of
+every kind, moving walls, periodic axes), static insertion, the thermal engine with explicit
+Euler, the contact conduction of the fused contact pass (every contact radius and direct
+conduction model, the conductance reuse, k(T) and c(T) tables), the range pair set (gap
+conduction of Batchelor & O'Brien complete / modified, indirect conduction through the
+fluid), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
+sources, checkpoints, frames and time series.
+
+Refused, each with a message naming the case key (never a silently wrong result):
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from thermodem.errors import ConfigError
+
+if TYPE_CHECKING:
+    from thermodem.config.schema import Case
+    from thermodem.engine.thermal import ThermalEngine
+
+#: (case key, why) of every refused feature, in the order they are checked (docs/mpi.md).
+REFUSED: tuple[tuple[str, str], ...] = (
+    ("insertion.N.kind: pour", "pouring inserts particles while the run goes"),
+    ("external_force", "constant external loads"),
+    ("output.contacts", "contact frames"),
+    ("thermal.frozen_mechanics", "frozen mechanics"),
+    ("thermal.scheme", "the implicit schemes (backward_euler, crank_nicolson)"),
+    ("thermal.external_source", "external sources shared by the particles of a box"),
+    ("thermal.convection", "per-particle terms (convection)"),
+    ("thermal.radiation", "per-particle terms (radiation)"),
+    ("thermal.porosity", "per-particle porosity fields"),
+    ("thermal.fluid", "fluid fields"),
+    ("thermal.indirect_conduction", "Voronoi (external pair set) and contact-target models"),
+)
+
+
+def _refuse(key: str, what: str) -> ConfigError:
+    return ConfigError(
+        f"{key}: {what} — MPI does not support it yet (this run has several MPI ranks); run "
+        "it without mpiexec (or with mpiexec -n 1), or remove the key. Supported under MPI: "
+        "docs/mpi.md"
+    )
+
+
+def check_case(case: Case) -> None:
+    """ConfigError for the first case key that a multi-rank run does not support."""
+    for k, entry in enumerate(case.insertion):
+        if entry.kind == "pour":
+            raise _refuse(
+                f"insertion.{k}.kind", "pouring ('pour' inserts particles during the run)"
+            )
+    if case.external_force:
+        raise _refuse("external_force", "constant external loads")
+    if case.output.contacts:
+        raise _refuse("output.contacts", "contact frames")
+    th = case.thermal
+    if th is None:
+        return
+    if th.frozen_mechanics:
+        raise _refuse("thermal.frozen_mechanics", "frozen mechanics (heat only)")
+    if th.scheme != "explicit":
+        raise _refuse(f"thermal.scheme = {th.scheme!r}", "the implicit heat schemes")
+    if th.external_source:
+        raise _refuse("thermal.external_source", "external sources shared over a box")
+    for key in ("convection", "radiation"):
+        choice = getattr(th, key)
+        if choice is not None and getattr(choice, "model", "none") != "none":
+            raise _refuse(f"thermal.{key} = {choice.model!r}", "per-particle heat terms")
+    ic = th.indirect_conduction
+    if ic is not None and ic.model != "none" and ic.spec.target != "range":
+        what = {
+            "external": "Voronoi models (their external pair set)",
+            "contacts": "heat terms on the contact lists outside the fused contact pass",
+        }.get(ic.spec.target, f"heat terms on the pair set {ic.spec.target!r}")
+        raise _refuse(f"thermal.indirect_conduction = {ic.model!r}", what)
+    if th.porosity is not None:
+        raise _refuse("thermal.porosity", "per-particle porosity fields")
+    if th.fluid is not None:
+        raise _refuse("thermal.fluid", "fluid fields")
+
+
+def check_thermal(engine: ThermalEngine) -> None:
+    """ConfigError for a heat term whose pair set MPI does not handle yet (the terms are
+    known once the thermal engine has built them from the registry)."""
+    for term in engine.terms:
+        if term.target == "range":
+            continue
+        what = {
+            "external": "a Voronoi model (external pair set)",
+            "contacts": "a heat term on the contact lists outside the fused contact pass",
+            "particles": "a per-particle heat term",
+        }.get(term.target, f"a heat term on the pair set {term.target!r}")
+        raise _refuse(f"{term.key} = {term.choice.model!r}", what)

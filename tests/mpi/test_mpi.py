@@ -1,0 +1,399 @@
+"""Runs on several MPI ranks (docs/mpi.md): ``mpiexec -n P thermodem run`` against the serial run.
+
+The multi-rank runs are subprocesses started with the venv's own ``mpiexec`` (the ``mpich``
+wheel of the test extras). The reference is the serial run of the same case: the settled bed
+of tests/data (500 spheres, Hertz-Mindlin with EPSD rolling, walls, the contact conduction,
+a fixed-temperature bottom layer) over 1000 steps must agree on 2 and 4 ranks to 1e-10 of
+the domain size in positions and 1e-10 relative in temperatures, with the energy and heat
+ledgers equal to round-off. The pair sums of a particle are added in another order on
+several ranks, so the runs agree to round-off, not to the bit.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from mpi_cases import DATA, HEIGHT, SIDE, bed_case  # noqa: E402
+
+BIN = Path(sys.executable).parent
+MPIEXEC = BIN / "mpiexec"
+THERMODEM = BIN / "thermodem"
+STEPS = 1000
+DT = 5e-6
+
+
+def _have_mpi() -> bool:
+    try:
+        import mpi4py  # noqa: F401
+    except ImportError:
+        return False
+    return MPIEXEC.exists()
+
+
+needs_mpi = pytest.mark.skipif(
+    not _have_mpi(), reason="mpi4py and the mpich wheel (test extras) are not installed"
+)
+
+
+def _env(ranks: int) -> dict[str, str]:
+    env = dict(os.environ)
+    # more ranks than cores (the 4-rank runs on a 2-core machine): MPICH's busy polling
+    # would keep a descheduled rank's partner spinning; yield instead
+    if ranks > (os.cpu_count() or 1):
+        env["MPIR_CVAR_ENABLE_HEAVY_YIELD"] = "1"
+    for name in ("PMI_SIZE", "PMI_RANK", "OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"):
+        env.pop(name, None)  # (pytest itself may run under a launcher)
+    return env
+
+
+def _run(args: list[str], ranks: int = 1, timeout: float = 900) -> subprocess.CompletedProcess:
+    """``thermodem ARGS`` on ``ranks`` MPI ranks (1: the plain serial command)."""
+    cmd = [str(THERMODEM), *args]
+    if ranks > 1:
+        cmd = [str(MPIEXEC), "-n", str(ranks), *cmd]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=_env(ranks), start_new_session=True)  # fmt: skip
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)  # (the whole job: mpiexec and its ranks)
+        out, err = proc.communicate()
+        pytest.fail(f"{' '.join(cmd)} did not finish in {timeout} s:\n{out}\n{err}")
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+
+
+def _write_case(path: Path, case: dict) -> Path:
+    path.write_text(yaml.safe_dump(case))
+    return path
+
+
+def _box_case(tmp: Path, **output: float) -> Path:
+    case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=STEPS * DT)
+    case["output"] = {
+        "vtu": True,
+        "interval": 500 * DT,
+        "timeseries_interval": 100 * DT,
+        "checkpoint_interval": 500 * DT,
+        "checkpoint_keep": None,
+        **output,
+    }
+    return _write_case(tmp / "box.yaml", case)
+
+
+def _final(directory: Path, step: int = STEPS) -> dict[str, np.ndarray]:
+    from thermodem.io.checkpoint import read_checkpoint
+
+    state = read_checkpoint(directory / "checkpoints" / f"checkpoint_{step:09d}.h5").state
+    p = state["particles"]
+    order = np.argsort(p["global_id"])
+    return {k: np.asarray(v)[order] for k, v in p.items()}
+
+
+def _assert_same_state(serial: dict, parallel: dict) -> None:
+    np.testing.assert_array_equal(serial["global_id"], parallel["global_id"])
+    dx = np.abs(serial["position"] - parallel["position"]).max()
+    assert dx <= 1e-10 * SIDE, f"positions differ by {dx:.3g} m"
+    rel_t = np.abs(serial["temperature"] / parallel["temperature"] - 1.0).max()
+    assert rel_t <= 1e-10, f"temperatures differ by {rel_t:.3g} relative"
+
+
+def _assert_same_ledgers(serial_dir: Path, parallel_dir: Path) -> None:
+    """Every time-series column equal to round-off: relative to its own scale (the largest
+    magnitude of the column), the balance errors relative to the energies they balance."""
+    from thermodem.io.run_files import read_timeseries
+
+    a = read_timeseries(serial_dir / "timeseries.csv")
+    b = read_timeseries(parallel_dir / "timeseries.csv")
+    assert list(a) == list(b), "the columns differ"
+    np.testing.assert_array_equal(a["step"], b["step"])
+    scale = {
+        "energy_balance_error": np.abs(a["gravitational"]).max(),
+        "heat_balance_error": np.abs(a["thermal_energy"]).max(),
+    }
+    for name in a:
+        finite = np.isfinite(a[name])
+        np.testing.assert_array_equal(finite, np.isfinite(b[name]), err_msg=name)
+        np.testing.assert_array_equal(a[name][~finite], b[name][~finite], err_msg=name)
+        if not finite.any():
+            continue
+        ref = scale.get(name, np.abs(a[name][finite]).max())
+        if ref == 0.0:
+            np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+            continue
+        worst = np.abs(a[name][finite] - b[name][finite]).max() / ref
+        assert worst <= 1e-9, f"{name}: differs by {worst:.3g} of its scale"
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The settled bed over 1000 steps: serially and on 2 ranks (shared by the tests)."""
+    if not _have_mpi():
+        pytest.skip("mpi4py and the mpich wheel (test extras) are not installed")
+    tmp = tmp_path_factory.mktemp("mpi")
+    case = _box_case(tmp)
+    out = {"case": case}
+    for ranks in (1, 2):
+        directory = tmp / f"ranks{ranks}"
+        res = _run(["run", str(case), "-o", str(directory), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+        out[ranks] = directory
+    return out
+
+
+# ----------------------------------------------------------------------------- no MPI
+def test_plain_run_does_not_import_mpi4py(tmp_path: Path) -> None:
+    """Without mpiexec the run is the serial one: mpi4py is never imported."""
+    case = _write_case(tmp_path / "c.yaml", bed_case(DATA / "mpi_bed_box.txt", heat=None,
+                                                     end_time=5 * DT))  # fmt: skip
+    code = textwrap.dedent(f"""
+        import sys
+        from thermodem.cli import app
+        try:
+            app(["run", {str(case)!r}, "-o", {str(tmp_path / "out")!r}, "--no-progress"])
+        except SystemExit as exc:
+            assert not exc.code, exc.code
+        assert "mpi4py" not in sys.modules, "mpi4py was imported by a serial run"
+    """)
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=_env(1), timeout=600)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+
+
+@pytest.mark.parametrize(
+    ("change", "key"),
+    [
+        (lambda c: c["insertion"].append({"kind": "pour", "material": "glass", "rate": 100.0,
+                                          "interval": 0.01,
+                                          "distribution": {"kind": "mono", "radius": 1e-3},
+                                          "region": {"kind": "box", "lower": [0, 0, 0.04],
+                                                     "upper": [SIDE, SIDE, HEIGHT]}}),
+         "insertion.1.kind"),
+        (lambda c: c["thermal"].update(frozen_mechanics=True, time_step=1e-3),
+         "thermal.frozen_mechanics"),
+        (lambda c: c["thermal"].update(convection="ranz_marshall1952",
+                                       fluid={"temperature": 300.0}),
+         "thermal.convection"),
+        (lambda c: c["thermal"].update(indirect_conduction="vargas_mccarthy2002"),
+         "thermal.indirect_conduction"),
+        (lambda c: c["output"].update(contacts=True), "output.contacts"),
+    ],
+)  # fmt: skip
+def test_refused_under_mpi(change, key: str) -> None:  # noqa: ANN001
+    """What MPI does not support yet is refused before the run, naming the key."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.errors import ConfigError
+    from thermodem.mpi.support import check_case
+
+    case = bed_case(DATA / "mpi_bed_box.txt")
+    change(case)
+    with pytest.raises(ConfigError, match="MPI does not support it yet") as info:
+        check_case(case_from_dict(case))
+    assert key in str(info.value)
+
+
+def test_bisection_balances_and_tiles() -> None:
+    """Recursive bisection of 1000 points among P boxes: counts within one of N/P, boxes
+    tiling the domain, each point inside its box (comm None: one process)."""
+    from thermodem.mpi.decomposition import bisect, point_box_distance
+
+    rng = np.random.default_rng(5)
+    upper = np.array([3.0, 1.0, 0.5])
+    x = rng.random((1000, 3)) * upper
+    for size in (2, 3, 4, 5, 7, 8):
+        d = bisect(None, x, np.zeros(3), upper, size)
+        owner = d.owner(x)
+        counts = np.bincount(owner, minlength=size)
+        assert counts.max() - counts.min() <= 1, counts
+        assert np.isclose(np.prod(d.boxes[:, 1] - d.boxes[:, 0], axis=1).sum(), upper.prod())
+        for r in range(size):
+            inside = point_box_distance(x[owner == r], *d.boxes[r], upper, np.zeros(3, bool))
+            assert np.all(inside == 0.0)
+        moved = d.rotated(1).owner(x)
+        np.testing.assert_array_equal(moved, (owner + 1) % size)
+
+
+# ----------------------------------------------------------------------- several ranks
+@needs_mpi
+def test_settled_bed_matches_serial_on_2_ranks(runs: dict[str, Path]) -> None:
+    serial, parallel = runs[1], runs[2]
+    _assert_same_state(_final(serial), _final(parallel))
+    _assert_same_ledgers(serial, parallel)
+    # one checkpoint and one frame per output time, the frames with every particle once
+    from thermodem.io.vtk import read_vtu
+
+    names = sorted(p.name for p in (parallel / "checkpoints").iterdir())
+    assert names == [f"checkpoint_{k:09d}.h5" for k in (0, 500, 1000)]
+    frames = sorted((parallel / "vtk").glob("particles_*.vtu"))
+    assert [f.name for f in frames] == [f"particles_{k:09d}.vtu" for k in (0, 500, 1000)]
+    mesh = read_vtu(frames[-1])
+    np.testing.assert_array_equal(np.sort(mesh.point_data["global_id"]), np.arange(500))
+    log = (parallel / "run.log").read_text()
+    assert "MPI: 2 ranks" in log and "gathered in" in log
+
+
+@needs_mpi
+def test_settled_bed_matches_serial_on_4_ranks(runs: dict[str, Path], tmp_path: Path) -> None:
+    """Four ranks (oversubscribed on a 2-core machine)."""
+    res = _run(["run", str(runs["case"]), "-o", str(tmp_path / "r4"), "--no-progress"], 4)
+    assert res.returncode == 0, res.stderr
+    _assert_same_state(_final(runs[1]), _final(tmp_path / "r4"))
+    _assert_same_ledgers(runs[1], tmp_path / "r4")
+
+
+@needs_mpi
+def test_checkpoints_continue_on_another_rank_count(runs: dict[str, Path], tmp_path: Path) -> None:
+    """The checkpoint written by 2 ranks at step 500 continues serially (the gathered file has
+    the serial layout), and the serial run's directory continues on 2 ranks (`thermodem
+    restart DIR` from its step-500 checkpoint): both reach the uninterrupted run's state."""
+    reference = _final(runs[1])
+    checkpoint = runs[2] / "checkpoints" / "checkpoint_000000500.h5"
+    out = tmp_path / "from2on1"
+    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
+    assert res.returncode == 0, res.stderr
+    _assert_same_state(reference, _final(out))
+    directory = tmp_path / "serial_copy"
+    shutil.copytree(runs[1], directory)
+    (directory / "checkpoints" / f"checkpoint_{STEPS:09d}.h5").unlink()  # newest: step 500
+    res = _run(["restart", str(directory), "--no-progress"], 2)
+    assert res.returncode == 0, res.stderr
+    _assert_same_state(reference, _final(directory))
+    _assert_same_ledgers(runs[1], directory)
+
+
+@needs_mpi
+def test_periodic_bed_with_range_set_on_2_ranks(tmp_path: Path) -> None:
+    """Periodic x and y, Batchelor & O'Brien complete (separated pairs on the range set) and
+    a hot floor: 400 steps on 2 ranks against the serial run."""
+    case = bed_case(DATA / "mpi_bed_periodic.txt", periodic=True, heat="range",
+                    end_time=400 * DT)  # fmt: skip
+    case["output"] = {"vtu": False, "timeseries_interval": 100 * DT}
+    path = _write_case(tmp_path / "periodic.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"p{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    _assert_same_state(_final(tmp_path / "p1", 400), _final(tmp_path / "p2", 400))
+    _assert_same_ledgers(tmp_path / "p1", tmp_path / "p2")
+
+
+@needs_mpi
+def test_thermal_options_and_a_moving_plate_on_2_ranks(tmp_path: Path) -> None:
+    """A c(T) table, the resistance network with the conductance reuse (its columns in
+    the contact history), substeps 'auto', a heat flux into the
+    top layer and a plate pressing the bed down (the particles move: rebuilds, migration):
+    300 steps on 2 ranks against the serial run."""
+    steps = 300
+    case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=steps * DT)
+    glass = case["materials"]["glass"]
+    glass["specific_heat_table"] = [[300.0, 800.0], [400.0, 900.0]]
+    glass.update(microhardness=3e9, surface_roughness=1e-6, surface_slope=0.1,
+                 thermal_accommodation=0.8, youngs_modulus_real=7e10)  # fmt: skip
+    case["thermal"].update(direct_conduction="resistance_network", substeps="auto",
+                           conductance_force_tolerance=0.01)  # fmt: skip
+    case["thermal"]["heat_flux"] = [{"flux": 2e4, "select": {"region": {
+        "lower": [0, 0, 8e-3], "upper": [SIDE, SIDE, HEIGHT]}}}]  # fmt: skip
+    top = float(np.loadtxt(DATA / "mpi_bed_box.txt", skiprows=1)[:, 2].max()) + 1e-3
+    case["walls"].append({"kind": "plane", "point": [0, 0, top], "normal": [0, 0, -1],
+                          "velocity": [0, 0, -0.2], "material": "glass"})  # fmt: skip
+    case["neighbors"] = {"skin": 5e-5}  # (rebuilds every few steps)
+    case["output"] = {"vtu": False, "timeseries_interval": 50 * DT}
+    path = _write_case(tmp_path / "options.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"o{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    _assert_same_state(_final(tmp_path / "o1", steps), _final(tmp_path / "o2", steps))
+    _assert_same_ledgers(tmp_path / "o1", tmp_path / "o2")
+    log = (tmp_path / "o2" / "run.log").read_text()
+    assert "MPI: 2 ranks" in log
+
+
+MIGRATION_SCRIPT = """
+import sys, numpy as np, yaml
+from thermodem.config.load import case_from_dict
+from thermodem.mpi import make_simulation, under_mpi
+case = case_from_dict(yaml.safe_load(open(sys.argv[1])))
+case.neighbors.rebuild_every_step = True
+sim = make_simulation(case)
+if under_mpi():
+    sim.rotate_owners = True  # every box to the next rank at every rebuild
+sim.run(steps=int(sys.argv[3]))
+report = sim.report()
+particles = sim.particles
+if under_mpi():
+    from thermodem.mpi.gather import gathered_view
+    view = gathered_view(sim)
+    particles = view.particles if view is not None else None
+    migrated = sim.comm.allreduce(sim.migrated)
+else:
+    migrated = 0
+if particles is not None:
+    order = np.argsort(particles.global_id)
+    np.savez(sys.argv[2], position=particles.position[order],
+             temperature=particles.temperature[order], migrated=migrated,
+             **{k: np.array(v) for k, v in report.items()})
+"""
+
+
+@needs_mpi
+def test_migration_carries_the_whole_state(tmp_path: Path) -> None:
+    """Every particle changes rank at every step (rebuild every step, boxes handed on): the
+    contact and rolling histories, temperatures and accumulators travel with the particles,
+    so the run still matches the serial one."""
+    steps = 60
+    case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=steps * DT)
+    path = _write_case(tmp_path / "m.yaml", case)
+    script = tmp_path / "migrate.py"
+    script.write_text(MIGRATION_SCRIPT)
+    results = {}
+    for ranks in (1, 2):
+        cmd = [str(BIN / "python"), str(script), str(path), str(tmp_path / f"m{ranks}.npz"),
+               str(steps)]  # fmt: skip
+        if ranks > 1:
+            cmd = [str(MPIEXEC), "-n", str(ranks), *cmd]
+        res = subprocess.run(cmd, capture_output=True, text=True, env=_env(ranks), timeout=900)
+        assert res.returncode == 0, res.stderr
+        results[ranks] = np.load(tmp_path / f"m{ranks}.npz")
+    a, b = results[1], results[2]
+    assert int(b["migrated"]) >= 500 * steps  # every particle, at every step
+    assert np.abs(a["position"] - b["position"]).max() <= 1e-10 * SIDE
+    assert np.abs(a["temperature"] / b["temperature"] - 1).max() <= 1e-10
+    for key in ("dissipated_sliding_friction", "dissipated_rolling_friction", "elastic_rolling",
+                "elastic_tangential", "thermal_energy", "fixed_absorbed"):  # fmt: skip
+        assert abs(float(a[key]) - float(b[key])) <= 1e-9 * abs(float(a[key])), key
+
+
+@needs_mpi
+def test_failure_stops_every_rank_with_one_message(tmp_path: Path) -> None:
+    """A time step 60 times too large (the check overridden): a particle leaves the domain on
+    one rank; every rank stops, the message is printed once with the last good checkpoint,
+    and the state at the failure is gathered to failed.h5."""
+    case = bed_case(DATA / "mpi_bed_box.txt", heat=None, time_step=3e-4, end_time=0.06)
+    case["simulation"]["time_step_check"] = {"allow_unstable": True}
+    path = _write_case(tmp_path / "bad.yaml", case)
+    res = _run(["run", str(path), "-o", str(tmp_path / "bad"), "--no-progress"], 2, timeout=300)
+    assert res.returncode == 1, res.stderr
+    assert res.stderr.count("error:") == 1, res.stderr
+    assert "last good state:" in res.stderr and "left the domain" in res.stderr
+    assert (tmp_path / "bad" / "failed.h5").exists()
+
+
+@needs_mpi
+def test_unsupported_key_refused_by_mpiexec(tmp_path: Path) -> None:
+    case = bed_case(DATA / "mpi_bed_box.txt", end_time=10 * DT)
+    case["output"]["contacts"] = True
+    path = _write_case(tmp_path / "c.yaml", case)
+    res = _run(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"], 2, timeout=300)
+    assert res.returncode == 2
+    assert res.stderr.count("MPI does not support it yet") == 1, res.stderr
+    assert "output.contacts" in res.stderr
