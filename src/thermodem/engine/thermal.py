@@ -470,7 +470,7 @@ class ThermalEngine:
         sim = self.sim
         if self.field_provider.active:
             n = sim.particles.count
-            if self.fields.shape[1] != n:
+            if self.fields.shape != (field_kernels.NFIELDS, n):
                 self.fields = np.zeros((field_kernels.NFIELDS, n))
             self.field_provider.update(time, self.fields)
         if self.voronoi is not None:
