@@ -275,7 +275,7 @@ REUSE_WIDTH = 6
 CUTOFF_GUARD = 1e-12
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _reuse_row(model_id, p, ri, rj, dist, h, area, tolerance, row):
     """Store an evaluation H(dist) in the pair's reuse row (see ``external_pair_pass``)."""
     touch = ri + rj
@@ -446,18 +446,21 @@ def particle_pass(
     and radiation: one pass over the particles and their fields; each particle adds the
     first term, then the second, as two passes would)."""
     n = temperature.shape[0]
+    nterms = 2 if column2 >= 0 else 1
     nchunks = (n + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
     for c in prange(nchunks):
         for i in range(c * PARTICLE_CHUNK, min(n, (c + 1) * PARTICLE_CHUNK)):
             t_i = temperature[i]
             r_i = radius[i]
-            q, g = particle_term(evaluator, model_id, table[type_id[i]], t_i, r_i, fields, i)
-            by_mechanism[i, column] += q
-            conductance_sum[i] += g
-            if column2 >= 0:
-                q, g = particle_term(evaluator2, model_id2, table2[type_id[i]], t_i, r_i,
-                                     fields, i)  # fmt: skip
-                by_mechanism[i, column2] += q
+            # one call site of the (inlined) dispatchers: two would double the compile time
+            for k in range(nterms):
+                first = k == 0
+                ev = evaluator if first else evaluator2
+                mid = model_id if first else model_id2
+                col = column if first else column2
+                row = table[type_id[i]] if first else table2[type_id[i]]
+                q, g = particle_term(ev, mid, row, t_i, r_i, fields, i)
+                by_mechanism[i, col] += q
                 conductance_sum[i] += g
 
 
