@@ -17,6 +17,15 @@ from thermodem.engine.simulation import Simulation
 EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.yaml"))
 
 
+#: What the heat-transfer examples of issues 11 and 13 must show after their first steps: the
+#: mechanism that moves their heat, with its sign (heat into the particles), in the ledger.
+EXPECTED_HEAT = {
+    "voronoi_bed": ("heat_in_wall_indirect_conduction", 1.0),  # walls -> bed through the gas
+    "gas_cooled_bed": ("heat_in_convection", -1.0),  # bed -> the gas of the grid field
+    "radiating_bed": ("heat_in_radiation", -1.0),  # hot bed -> the cooler walls in view
+}
+
+
 @pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_runs_a_few_steps(path: Path) -> None:
     case = load_case(path)
@@ -25,6 +34,16 @@ def test_example_runs_a_few_steps(path: Path) -> None:
     sim.run(steps=steps)
     assert sim.particles.count > 0
     assert np.isfinite(sim.particles.position).all()
+    th = sim.thermal
+    if th is not None:
+        assert abs(th.balance_error()) <= 1e-12 * th.initial_energy
+    if path.stem in EXPECTED_HEAT:
+        key, sign = EXPECTED_HEAT[path.stem]
+        assert sign * th.cumulative[key] > 0.0, (key, th.cumulative[key])
+        # the mean temperature moves the same way
+        mean = float(np.mean(sim.particles.temperature))
+        start = case.simulation.initial_temperature
+        assert sign * (mean - start) > 0.0
 
 
 def test_cli_run_writes_pvd_that_meshio_opens(tmp_path: Path) -> None:

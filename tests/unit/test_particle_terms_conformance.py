@@ -32,30 +32,30 @@ def _params(spec: registry.ModelSpec):  # noqa: ANN202
 
 
 def _random_fields(rng: np.random.Generator, n: int = 6) -> np.ndarray:
-    f = np.zeros((n, fk.NFIELDS))
-    f[:, fk.F_POROSITY] = rng.uniform(0.3, 1.0, n)
-    f[:, fk.F_FLUID_TEMPERATURE] = rng.uniform(250, 1500, n)
-    f[:, fk.F_RELATIVE_SPEED] = 10 ** rng.uniform(-3, 1.5, n)
-    f[:, fk.F_FLUID_CONDUCTIVITY] = rng.uniform(0.01, 0.7, n)
-    f[:, fk.F_FLUID_DENSITY] = rng.uniform(0.1, 1000, n)
-    f[:, fk.F_FLUID_SPECIFIC_HEAT] = rng.uniform(500, 5000, n)
-    f[:, fk.F_FLUID_VISCOSITY] = 10 ** rng.uniform(-5.5, -2.5, n)
-    f[:, fk.F_SURFACE_VISCOSITY] = f[:, fk.F_FLUID_VISCOSITY] / rng.uniform(1, 3, n)
+    f = np.zeros((fk.NFIELDS, n))
+    f[fk.F_POROSITY] = rng.uniform(0.3, 1.0, n)
+    f[fk.F_FLUID_TEMPERATURE] = rng.uniform(250, 1500, n)
+    f[fk.F_RELATIVE_SPEED] = 10 ** rng.uniform(-3, 1.5, n)
+    f[fk.F_FLUID_CONDUCTIVITY] = rng.uniform(0.01, 0.7, n)
+    f[fk.F_FLUID_DENSITY] = rng.uniform(0.1, 1000, n)
+    f[fk.F_FLUID_SPECIFIC_HEAT] = rng.uniform(500, 5000, n)
+    f[fk.F_FLUID_VISCOSITY] = 10 ** rng.uniform(-5.5, -2.5, n)
+    f[fk.F_SURFACE_VISCOSITY] = f[fk.F_FLUID_VISCOSITY] / rng.uniform(1, 3, n)
     fk.prandtl_columns(f)
-    f[:, fk.F_NEIGHBOURS] = rng.integers(0, 20, n)
-    f[:, fk.F_NEIGHBOUR_TEMPERATURE] = f[:, fk.F_NEIGHBOURS] * rng.uniform(300, 1500, n)
-    area = rng.uniform(0, 1e-5, n) * (f[:, fk.F_NEIGHBOURS] > 0)
-    f[:, fk.F_NEIGHBOUR_AREA] = area
-    f[:, fk.F_NEIGHBOUR_EMISSION] = area * rng.uniform(300, 1500, n) ** 4
-    f[:, fk.F_WALL_VIEW] = rng.uniform(0, 1, n) * (rng.uniform(size=n) < 0.5)
-    f[:, fk.F_WALL_EMISSION] = f[:, fk.F_WALL_VIEW] * rng.uniform(300, 1500, n) ** 4
+    f[fk.F_NEIGHBOURS] = rng.integers(0, 20, n)
+    f[fk.F_NEIGHBOUR_TEMPERATURE] = f[fk.F_NEIGHBOURS] * rng.uniform(300, 1500, n)
+    area = rng.uniform(0, 1e-5, n) * (f[fk.F_NEIGHBOURS] > 0)
+    f[fk.F_NEIGHBOUR_AREA] = area
+    f[fk.F_NEIGHBOUR_EMISSION] = area * rng.uniform(300, 1500, n) ** 4
+    f[fk.F_WALL_VIEW] = rng.uniform(0, 1, n) * (rng.uniform(size=n) < 0.5)
+    f[fk.F_WALL_EMISSION] = f[fk.F_WALL_VIEW] * rng.uniform(300, 1500, n) ** 4
     return f
 
 
 @pytest.mark.parametrize("family", list(FAMILIES))
 def test_none_is_id_zero_and_unknown_ids_give_nan(family: str) -> None:
     assert registry.get(family, "none").model_id == 0
-    f = np.zeros((1, fk.NFIELDS))
+    f = np.zeros((fk.NFIELDS, 1))
     q, g = particle_term(FAMILIES[family], 99, np.zeros(4), 300.0, 1e-3, f, 0)
     assert math.isnan(q) and math.isnan(g)
 
@@ -67,7 +67,7 @@ def test_dispatcher_agrees_with_kernel(spec: registry.ModelSpec) -> None:
     assert row.shape == (spec.width,)
     assert spec.target == "particles"
     f = _random_fields(rng)
-    for i in range(f.shape[0]):
+    for i in range(f.shape[1]):
         t = float(rng.uniform(250, 1500))
         r = float(10 ** rng.uniform(-4, -2))
         got = particle_term(FAMILIES[spec.family], spec.model_id, row, t, r, f, i)

@@ -307,3 +307,67 @@ def test_closure_face_area() -> None:
     for eps in (0.26, 0.4, 0.6):
         a_n = v.closure_face_area(1e-3, eps)
         assert math.sqrt(a_n / math.pi) == pytest.approx(0.560e-3 * (1 - eps) ** (-1 / 3), rel=1e-3)
+
+
+def test_curvature_premise_of_the_conductance_reuse() -> None:
+    """The bound of thermal.tessellation.conductance_gap_tolerance, 1.5 C tol² H, rests on
+    C = max w² |H''(d)| / H over pairs (w = |d - R_i - R_j| the surface gap or overlap, H''
+    by central differences at 1e-3 w, on one side of touching and of the cut-off): <= 5 for
+    model A and <= 45 for model B (its largest values where the face shrinks to the contact
+    and H -> 0); the elasticity w |H'| / H <= 2 and 20 (the bound without a slope)."""
+    rng = np.random.default_rng(2)
+    limits = {"a": (2.0, 5.0), "b": (20.0, 45.0)}
+    for model in ("a", "b"):
+        worst_e = worst_c = 0.0
+        for _ in range(1500):
+            r_i = 1e-3
+            r_j = r_i * (1.0 if rng.random() < 0.3 else rng.uniform(0.3, 3.0))
+            if rng.integers(2) == 0:
+                gap = 10 ** rng.uniform(-6, -0.01) * r_i
+            else:
+                gap = -(10 ** rng.uniform(-6, -1.5)) * min(r_i, r_j)
+            d = r_i + r_j + gap
+            a_n = area(3 * 10 ** rng.uniform(-1.5, 1.5) * min(r_i, r_j) ** 2)
+            k_i = K_F * 10 ** rng.uniform(0.01, 4.3)
+            k_j = k_i if rng.random() < 0.4 else K_F * 10 ** rng.uniform(0.01, 4.3)
+            if model == "a":
+                row, fn = row_a(k_i, k_j, cutoff=1.0), v.voronoi_a_conductance
+            else:
+                row, fn = row_b(k_i, k_j, cutoff=1.0), v.voronoi_b_conductance
+
+            def h(x: float) -> float:
+                return fn(row, r_i, r_j, x, geometric_rc(r_i, r_j, x), a_n)  # noqa: B023
+
+            h0 = h(d)
+            if h0 <= 0.0:
+                continue
+            w = abs(gap)
+            room = min(w, r_i + r_j + 0.5 * (r_i + r_j) - d)
+            e = min(1e-3 * w, 0.5 * room)
+            hp, hm = h(d + e), h(d - e)
+            worst_e = max(worst_e, w * abs(hp - hm) / (2 * e) / h0)
+            worst_c = max(worst_c, w * w * abs(hp - 2 * h0 + hm) / e**2 / h0)
+        assert worst_e <= limits[model][0] and worst_c <= limits[model][1], (model, worst_e,
+                                                                              worst_c)  # fmt: skip
+        assert worst_c > 0.2 * limits[model][1]  # the sample reaches the worst region
+
+
+def test_model_b_cutoff_and_touching_limits() -> None:
+    """The spec's cut-off remark ("a similar cut-off value should be set"): model B is zero
+    at and beyond cutoff × (R_i + R_j)/2 and at a wall beyond cutoff × R_i, positive just
+    before; at touching (R_c = 0, θ_c = 0) it is finite and continuous from both sides."""
+    r, a_n = 1e-3, area(4e-6)
+    row = row_b(1.0, 1.0, cutoff=1.0)
+    assert v.voronoi_b_conductance(row, r, r, 3 * r, 0.0, a_n) == 0.0
+    assert v.voronoi_b_conductance(row, r, r, 3 * r * (1 - 1e-9), 0.0, a_n) > 0.0
+    assert v.voronoi_b_conductance(row, r, math.inf, 2 * r, 0.0, a_n) == 0.0
+    assert v.voronoi_b_conductance(row, r, math.inf, 2 * r * (1 - 1e-9), 0.0, a_n) > 0.0
+    assert math.isnan(v.voronoi_b_conductance(row, r, r, 2.1 * r, 0.0, area(np.nan)))
+    for sizes in (v.SIZES_GENERAL, v.SIZES_MEAN_RADIUS):
+        rw = row_b(1.0, 3.0, sizes=sizes)
+        touch = v.voronoi_b_conductance(rw, r, r, 2 * r, 0.0, a_n)
+        apart = v.voronoi_b_conductance(rw, r, r, 2 * r * (1 + 1e-10), 0.0, a_n)
+        d_in = 2 * r * (1 - 1e-10)
+        inside = v.voronoi_b_conductance(rw, r, r, d_in, geometric_rc(r, r, d_in), a_n)
+        assert math.isfinite(touch) and touch > 0
+        assert apart == pytest.approx(touch, rel=1e-6) and inside == pytest.approx(touch, rel=1e-4)

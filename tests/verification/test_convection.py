@@ -94,16 +94,16 @@ TABLE = [
 
 def _fields_row(re: float, pr: float, eps: float, ratio: float) -> np.ndarray:
     """One particle's fields giving these numbers (R = 1 mm, ρ_f = 1, μ_f = 1e-5)."""
-    f = np.zeros((1, fk.NFIELDS))
+    f = np.zeros((fk.NFIELDS, 1))
     mu, k = 1e-5, 0.03
-    f[0, fk.F_FLUID_DENSITY] = 1.0
-    f[0, fk.F_FLUID_VISCOSITY] = mu
-    f[0, fk.F_SURFACE_VISCOSITY] = mu / ratio
-    f[0, fk.F_FLUID_CONDUCTIVITY] = k
-    f[0, fk.F_FLUID_SPECIFIC_HEAT] = pr * k / mu
-    f[0, fk.F_RELATIVE_SPEED] = re * mu / (2 * R)  # Re = ρ v 2R / μ
-    f[0, fk.F_POROSITY] = eps
-    f[0, fk.F_FLUID_TEMPERATURE] = 300.0
+    f[fk.F_FLUID_DENSITY, 0] = 1.0
+    f[fk.F_FLUID_VISCOSITY, 0] = mu
+    f[fk.F_SURFACE_VISCOSITY, 0] = mu / ratio
+    f[fk.F_FLUID_CONDUCTIVITY, 0] = k
+    f[fk.F_FLUID_SPECIFIC_HEAT, 0] = pr * k / mu
+    f[fk.F_RELATIVE_SPEED, 0] = re * mu / (2 * R)  # Re = ρ v 2R / μ
+    f[fk.F_POROSITY, 0] = eps
+    f[fk.F_FLUID_TEMPERATURE, 0] = 300.0
     fk.prandtl_columns(f)
     return f
 
@@ -116,11 +116,11 @@ def test_nusselt_of_every_correlation_against_its_formula(model: str, params: tu
     formula = FORMULAS[(model, params)]
     for re, pr, eps, ratio in TABLE:
         f = _fields_row(re, pr, eps, ratio)
-        assert f[0, fk.F_PRANDTL] == pytest.approx(pr, rel=1e-14)
+        assert f[fk.F_PRANDTL, 0] == pytest.approx(pr, rel=1e-14)
         q, g = conv.convection_dispatch(spec.model_id, row, 350.0, R, f, 0)
         q_own, g_own = spec.kernel(row, 350.0, R, f, 0)
         assert (q, g) == (q_own, g_own)  # the dispatcher is the model's kernel
-        nu = g / (2 * math.pi * R * f[0, fk.F_FLUID_CONDUCTIVITY])  # G = h A = 2π R k Nu
+        nu = g / (2 * math.pi * R * f[fk.F_FLUID_CONDUCTIVITY, 0])  # G = h A = 2π R k Nu
         expected = formula(re, pr, eps, ratio)
         assert nu == pytest.approx(expected, rel=1e-12), (re, pr, eps, ratio)
         assert q == pytest.approx(g * (300.0 - 350.0), rel=1e-14)  # Q = h A (T_f − T)
@@ -145,7 +145,7 @@ def test_superficial_reynolds_uses_the_porosity() -> None:
     row = spec.pack(spec.params(reynolds_velocity="superficial"), resolve_pair(material, material))
     f = _fields_row(100.0, 0.7, 0.4, 1.0)
     g = conv.convection_dispatch(spec.model_id, row, 350.0, R, f, 0)[1]
-    nu = g / (2 * math.pi * R * f[0, fk.F_FLUID_CONDUCTIVITY])
+    nu = g / (2 * math.pi * R * f[fk.F_FLUID_CONDUCTIVITY, 0])
     assert nu == pytest.approx(nu_gunn(40.0, 0.7, 0.4, 1.0), rel=1e-12)  # Re = ε × 100
 
 
@@ -232,10 +232,10 @@ def test_relative_velocity_and_a_moving_particle(tmp_path: Path) -> None:
     case = _case(tmp_path, "ranz_marshall1952", {"temperature": 300.0, "velocity": [1, 2, 3]}, 1e-3)
     sim = Simulation(case_from_dict(case))
     th = sim.thermal
-    assert th.fields[0, fk.F_RELATIVE_SPEED] == pytest.approx(math.sqrt(14.0), rel=1e-14)
+    assert th.fields[fk.F_RELATIVE_SPEED, 0] == pytest.approx(math.sqrt(14.0), rel=1e-14)
     sim.particles.velocity[0] = [1.0, 0.0, -1.0]
     th.compute_rates(sim.time)
-    assert th.fields[0, fk.F_RELATIVE_SPEED] == pytest.approx(math.sqrt(0 + 4 + 16), rel=1e-14)
+    assert th.fields[fk.F_RELATIVE_SPEED, 0] == pytest.approx(math.sqrt(0 + 4 + 16), rel=1e-14)
     numbers = th.field_provider.numbers(th.fields)
     re = AIR_RHO * math.sqrt(20.0) * 2 * R / AIR["mu"]
     assert numbers["Re"][0] == pytest.approx(re, rel=1e-12)
@@ -287,7 +287,7 @@ def test_whitaker_viscosity_ratio_from_a_liquid_table(tmp_path: Path) -> None:
         t0=330.0,
     )
     sim = Simulation(case_from_dict(case))
-    f = sim.thermal.fields[0]
+    f = sim.thermal.fields[:, 0]
     mu_f = 1.4e-3 + (300 - 280) / 100 * (0.3e-3 - 1.4e-3)
     mu_s = 1.4e-3 + (330 - 280) / 100 * (0.3e-3 - 1.4e-3)
     k_f = 0.58 + 0.2 * 0.1

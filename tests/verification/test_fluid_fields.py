@@ -87,7 +87,7 @@ def test_grid_fluid_is_interpolated_trilinearly_at_the_particles(tmp_path: Path,
             )
         )
     f = sim.thermal.fields
-    tf = _gid(sim, f[:, fk.F_FLUID_TEMPERATURE])
+    tf = _gid(sim, f[fk.F_FLUID_TEMPERATURE])
     assert np.allclose(tf, temperature(*pos.T), rtol=1e-13, atol=0)
     # the stagnant model does not read the velocity: check it with a flowing correlation
     case = _case(
@@ -96,7 +96,7 @@ def test_grid_fluid_is_interpolated_trilinearly_at_the_particles(tmp_path: Path,
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # Re < 1 here
         sim = Simulation(case_from_dict(case))
-    speed = _gid(sim, sim.thermal.fields[:, fk.F_RELATIVE_SPEED])
+    speed = _gid(sim, sim.thermal.fields[fk.F_RELATIVE_SPEED])
     u = np.stack(velocity(*pos.T), axis=-1)
     assert np.allclose(speed, np.linalg.norm(u, axis=1), rtol=1e-13, atol=0)
 
@@ -108,7 +108,7 @@ def test_outside_the_grid_the_boundary_value_holds_with_one_warning(tmp_path: Pa
     case = _case(_write(tmp_path / "p.txt", pos), {"convection": "stagnant", "fluid": fluid})
     with pytest.warns(RuntimeWarning, match=r"1 particles outside the grid .* nearest point"):
         sim = Simulation(case_from_dict(case))
-    tf = _gid(sim, sim.thermal.fields[:, fk.F_FLUID_TEMPERATURE])
+    tf = _gid(sim, sim.thermal.fields[fk.F_FLUID_TEMPERATURE])
     assert tf[0] == pytest.approx(temperature(AXES[0][-1], AXES[1][1], AXES[2][2]), rel=1e-14)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
@@ -133,15 +133,15 @@ def test_fluid_temperature_table_and_expressions(tmp_path: Path) -> None:
     t = sim.time
     assert t == pytest.approx(0.03)
     f = sim.thermal.fields
-    assert np.allclose(f[:, fk.F_FLUID_TEMPERATURE], 300.0 + 100.0 * t / 0.05, rtol=1e-14)
+    assert np.allclose(f[fk.F_FLUID_TEMPERATURE], 300.0 + 100.0 * t / 0.05, rtol=1e-14)
     p = sim.particles.position
     u = np.column_stack([1 + 100 * p[:, 0], np.full(2, 0.5 * t), -p[:, 2] * 10])
-    assert np.allclose(f[:, fk.F_RELATIVE_SPEED], np.linalg.norm(u, axis=1), rtol=1e-14)
+    assert np.allclose(f[fk.F_RELATIVE_SPEED], np.linalg.norm(u, axis=1), rtol=1e-14)
     # an expression of position; one that turns negative stops the run, naming the particle
     fluid = {"temperature": "300 + 1e5 * x - 1e7 * x * t"}
     case = _case(_write(tmp_path / "p.txt", pos), {"convection": "stagnant", "fluid": fluid})
     sim = Simulation(case_from_dict(case))
-    tf = _gid(sim, sim.thermal.fields[:, fk.F_FLUID_TEMPERATURE])
+    tf = _gid(sim, sim.thermal.fields[fk.F_FLUID_TEMPERATURE])
     assert tf == pytest.approx(300 + 1e5 * pos[:, 0], rel=1e-14)
     with pytest.raises(SimulationError, match=r"gives -100.0 K at particle 1 .*t = 0.02 s"):
         for _ in range(3):
@@ -196,7 +196,7 @@ def test_cell_porosity_by_hand(tmp_path: Path) -> None:
     )
     case["materials"]["grain"]["emissivity"] = 0.9
     sim = Simulation(case_from_dict(case))
-    eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
     v = 4 / 3 * math.pi * (0.5 * s) ** 3
     assert eps[:3] == pytest.approx([1 - 3 * v / (4 * s) ** 3] * 3, rel=1e-14)
     assert eps[3] == pytest.approx(1 - v / (4 * s) ** 3, rel=1e-14)
@@ -204,7 +204,7 @@ def test_cell_porosity_by_hand(tmp_path: Path) -> None:
         {"kind": "plane", "point": [2 * s, 0, 0], "normal": [1, 0, 0], "material": "grain"}
     ]
     sim = Simulation(case_from_dict(case))
-    eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
     assert eps[:3] == pytest.approx([1 - 3 * v / (0.5 * (4 * s) ** 3)] * 3, rel=1e-14)
 
 
@@ -261,7 +261,7 @@ def test_shell_porosity_against_quadratures(tmp_path: Path) -> None:
     )
     case["materials"]["grain"]["emissivity"] = 0.9
     sim = Simulation(case_from_dict(case))
-    eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
     vs = 4 / 3 * math.pi * rs**3
     vp = 4 / 3 * math.pi * R**3
     assert eps[0] == pytest.approx(1 - 1 / 27, rel=1e-14)
@@ -272,21 +272,21 @@ def test_shell_porosity_against_quadratures(tmp_path: Path) -> None:
     walls = [{"kind": "plane", "point": [0, 0, -1.5 * R], "normal": [0, 0, 1], "material": "grain"}]
     case["walls"] = walls
     sim = Simulation(case_from_dict(case))
-    eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
     v_avail = _sphere_volume_beyond_planes(rs, [rs, 1.5 * R])
     assert eps[0] == pytest.approx(1 - vp / v_avail, rel=1e-10)
     # a second wall 1.2 R away in x: the overlap of the two caps (a quadrature in the kernel)
     second = {"kind": "plane", "point": [-1.2 * R, 0, 0], "normal": [1, 0, 0], "material": "grain"}
     case["walls"] = walls + [second]
     sim = Simulation(case_from_dict(case))
-    eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
     v_avail = _sphere_volume_beyond_planes(rs, [1.2 * R, 1.5 * R])
     assert 1 - eps[0] == pytest.approx(vp / v_avail, rel=1e-6)
     # a box corner, a third wall 1.0 R away in y: the triple overlap from quasi-random points
     third = {"kind": "plane", "point": [0, -1.0 * R, 0], "normal": [0, 1, 0], "material": "grain"}
     case["walls"] = walls + [second, third]
     sim = Simulation(case_from_dict(case))
-    eps = _gid(sim, sim.thermal.fields[:, fk.F_POROSITY])
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
     v_avail = _corner_volume(rs, 1.2 * R, 1.0 * R, 1.5 * R)
     assert 1 - eps[0] == pytest.approx(vp / v_avail, rel=2e-3)
 

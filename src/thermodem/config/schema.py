@@ -346,6 +346,7 @@ class Case(StrictModel):
                             f"allowed: {allowed}"
                         )
             self._check_conductance_reuse(th)
+            self._check_voronoi_reuse(th)
             self._probe_temperature_expressions(th)
             rule = th.initial_temperature
             if rule is not None and rule.kind == "per_material":
@@ -422,6 +423,26 @@ class Case(StrictModel):
                         f"walls.{k}.thermal.temperature: {exc} (a wall temperature [K] from "
                         "t = 0 to simulation.end_time)"
                     ) from None
+
+    def _check_voronoi_reuse(self, th: ThermalSettings) -> None:
+        """The Voronoi conductance reuse holds H for a pair geometry: a Voronoi model, and
+        constant conductivities."""
+        if th.tessellation is None or th.tessellation.conductance_gap_tolerance == 0.0:
+            return
+        tol = th.tessellation.conductance_gap_tolerance
+        key = "thermal.tessellation.conductance_gap_tolerance"
+        model = th.indirect_conduction.model
+        if model not in ("voronoi_a", "voronoi_b"):
+            raise ValueError(
+                f"{key}: {tol} reuses the conductances of the Voronoi models, but "
+                f"thermal.indirect_conduction is {model!r}: use voronoi_a or voronoi_b, or 0"
+            )
+        tabled = [n for n, m in self.materials.items() if m.thermal_conductivity_table]
+        if tabled:
+            raise ValueError(
+                f"{key}: {tol} needs constant thermal conductivities, but materials "
+                f"{', '.join(tabled)} have a thermal_conductivity_table: use 0"
+            )
 
     def _check_conductance_reuse(self, th: ThermalSettings) -> None:
         """The reuse holds a conductance for a given normal force: the model must depend on

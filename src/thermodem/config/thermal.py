@@ -216,6 +216,15 @@ class TessellationSettings(StrictModel):
         description="re-tessellate when a particle moved more than this × R_min since the "
         "last tessellation; null: never for that reason",
     )
+    conductance_gap_tolerance: float = Field(
+        default=0.0,
+        ge=0,
+        le=0.1,
+        description="reuse a Voronoi pair's conductance while its centre distance stays within "
+        "this × its surface gap (or overlap) of the last evaluation, on the same side of "
+        "touching and of the cut-off (secant in between); 0: evaluate every pair at every "
+        "thermal step",
+    )
 
 
 class ImplicitSettings(StrictModel):

@@ -1,8 +1,9 @@
 """Per-particle fields: the fluid at each particle, the local porosity, the neighbourhood.
 
-The per-particle heat terms (convection, radiation) read a field array ``fields`` (n,
-``NFIELDS``) whose columns are defined in ``kernels/fields.py``. :class:`FieldProvider` fills
-the columns the case's terms need, at every thermal step, before those terms run
+The per-particle heat terms (convection, radiation) read a field array ``fields``
+(``NFIELDS``, n: a row per field) whose rows are defined in ``kernels/fields.py``.
+:class:`FieldProvider` fills the rows the case's terms need, at every thermal step, before
+those terms run
 (``ThermalEngine.evaluate_terms``):
 
 - **fluid temperature** T_f and **velocity** u_f (``thermal.fluid``): uniform, a table of
@@ -48,6 +49,8 @@ from thermodem.engine.range_set import RangePairSet
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as fk
+from thermodem.kernels import heat_terms
+from thermodem.kernels import neighbourhood as nh
 from thermodem.models.thermal import convection as conv
 from thermodem.models.thermal import radiation as rad
 
@@ -60,12 +63,14 @@ if TYPE_CHECKING:
 GAS_CONSTANT = 8.314462618
 #: Prefix of the neighbourhood set's arrays in the engine's checkpoint.
 STATE_PREFIX = "fields__"
+#: Arrays of the neighbour listing of the continuum radiation models in checkpoints.
+MEMBER_ARRAYS = ("members_offsets", "members_border", "members_index")
 #: The correlation validity ranges are checked at every this many-th field update.
 RANGE_CHECK_INTERVAL = 10
 
 
 class PorosityProvider(Protocol):
-    """Fills ``fields[:, F_POROSITY]`` for the current particles (the Voronoi hook)."""
+    """Fills ``fields[F_POROSITY]`` for the current particles (the Voronoi hook)."""
 
     def update(self, sim: Simulation, fields: np.ndarray) -> None: ...
 
@@ -190,14 +195,23 @@ class FieldProvider:
             if self.radiation is not None and self.radiation.table.ndim == 2
             else np.zeros(1)
         )
-        self.radiation_mode = 0
-        if self.radiation is not None and self.radiation.choice.model == "krause2017":
-            self.radiation_mode = fk.NB_KRAUSE
-        elif self.radiation is not None and self.radiation.choice.model == "zhou2009":
-            self.radiation_mode = fk.NB_ZHOU
         self.lattice = fk.unit_ball_points()
         self.sums = np.zeros((0, 4))
-        self.weights = np.zeros((0, 4))
+        # the continuum radiation's neighbours of each particle (kernels/neighbourhood.py):
+        # listed from range-set build ``members_builds`` at the positions
+        # ``members_reference``, valid while no particle moved more than members_band / 2
+        self.members = nh.empty_members(0)
+        self.member_sums = tuple(np.zeros(0) for _ in range(4))
+        self.radiation_mode = 0
+        if self.radiation is not None and self.radiation.choice.model == "krause2017":
+            self.radiation_mode = nh.NB_KRAUSE
+        elif self.radiation is not None and self.radiation.choice.model == "zhou2009":
+            self.radiation_mode = nh.NB_ZHOU
+        self.members_builds = -1
+        self.members_reference = np.zeros((0, 3))
+        self.members_offset = 0.0
+        self.members_band = 0.0
+        self.members_listings = 0
         self.scratch = np.zeros((1, 4))
         # cell porosity (the grid is set up at the first evaluation: its default size)
         self.cell_size = 0.0
@@ -216,7 +230,7 @@ class FieldProvider:
         self.warned: list[str] = []
         self.updates = 0  # field updates so far (the range checks run on every 10th)
         self.numbers_buffer = np.zeros((0, len(conv.NUMBER_NAMES)))
-        self.velocity_buffer = np.zeros((1, 3))
+        self.velocity_buffer = np.zeros((3, 1))  # u_f: (3, n), or (3, 1) if uniform
         self.part = np.zeros(1)
         self._constants_for: np.ndarray | None = None
 
@@ -391,7 +405,7 @@ class FieldProvider:
                     time,
                     int(p.global_id[k]),
                 )
-            fields[:, fk.F_FLUID_TEMPERATURE] = values
+            fields[fk.F_FLUID_TEMPERATURE, :] = values
         else:
             _, axes, values, file = source
             outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values, fields,
@@ -404,25 +418,25 @@ class FieldProvider:
         kind = source[0]
         uniform = kind in ("uniform", "table")
         if kind == "uniform":
-            self.velocity_buffer[0] = source[1]
+            self.velocity_buffer[:, 0] = source[1]
         elif kind == "table":
             table = source[1]
             for a in range(3):
-                self.velocity_buffer[0, a] = np.interp(time, table[:, 0], table[:, 1 + a])
+                self.velocity_buffer[a, 0] = np.interp(time, table[:, 0], table[:, 1 + a])
         else:
-            if self.velocity_buffer.shape[0] != p.count:
-                self.velocity_buffer = np.zeros((p.count, 3))
+            if self.velocity_buffer.shape[1] != p.count:
+                self.velocity_buffer = np.zeros((3, p.count))
             if kind == "expression":
                 pos = p.position
                 for a in range(3):
-                    self.velocity_buffer[:, a] = source[1][a](time, pos[:, 0], pos[:, 1],
+                    self.velocity_buffer[a, :] = source[1][a](time, pos[:, 0], pos[:, 1],
                                                               pos[:, 2])  # fmt: skip
-                bad = ~np.isfinite(self.velocity_buffer).all(axis=1)
+                bad = ~np.isfinite(self.velocity_buffer).all(axis=0)
                 if bad.any():
                     k = int(np.argmax(bad))
                     raise SimulationError(
                         f"thermal.fluid.velocity: the expressions {list(source[2])} give "
-                        f"{self.velocity_buffer[k].tolist()} m/s at particle "
+                        f"{self.velocity_buffer[:, k].tolist()} m/s at particle "
                         f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s)",
                         self.sim.step_count,
                         time,
@@ -437,7 +451,7 @@ class FieldProvider:
 
     def fluid_velocity(self) -> np.ndarray:
         """u_f at the particles at the last update [m/s], (n, 3) (or (1, 3) if uniform)."""
-        return self.velocity_buffer.copy()
+        return self.velocity_buffer.T.copy()
 
     # ----------------------------------------------------------------- neighbourhood
     def _neighbourhood_gap(self) -> float:
@@ -457,26 +471,91 @@ class FieldProvider:
         if ns.due(sim):
             ns.build(sim, self._neighbourhood_gap(), 0.0)
         n = p.count
-        if self.sums.shape[0] != n:
-            self.sums = np.zeros((n, 4))
-            self.weights = np.zeros((n, 4))
-        args = (p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower, sim.upper,
-                sim.periodic, self.weights)  # fmt: skip
         if self.radiation_ratio > 0.0:
-            fk.neighbour_weights(p.radius, p.temperature, p.type_id, self.emissivity,
-                                 self.weights, self.sums)  # fmt: skip
-            fk.neighbourhood_pass(*args, self.radiation_mode, self.radiation_ratio, 0.0,
-                                  self.sums)  # fmt: skip
-            fk.neighbour_columns(self.sums, fields)
+            if (
+                ns.builds != self.members_builds
+                or self.members[0].shape[0] != n + 1
+                or self._listing_expired()
+            ):
+                self._list_members()
+            if self.member_sums[0].shape[0] != n:
+                self._member_constants()
+            area, emission, member_area, member_count = self.member_sums
+            if self.radiation_mode & nh.NB_KRAUSE:
+                nh.neighbourhood_weights(p.radius, p.temperature, p.type_id, self.emissivity,
+                                         area, emission)  # fmt: skip
+            nh.neighbourhood_sums(p.position, p.radius, p.temperature, *self.members, area,
+                                  emission, member_area, member_count, sim.lower, sim.upper,
+                                  sim.periodic, self.radiation_ratio, self.radiation_mode,
+                                  fields)  # fmt: skip
         if self.shell_ratio > 0.0:
+            if self.sums.shape[0] != n:
+                self.sums = np.zeros((n, 4))
             fk.zero_rows(self.sums)
-            fk.neighbourhood_pass(*args, fk.NB_SHELL, 0.0, self.shell_ratio, self.sums)
+            fk.shell_pass(p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower,
+                          sim.upper, sim.periodic, self.shell_ratio, self.sums)  # fmt: skip
             width = 4 * max(sim.wall_kind.shape[0], 1)
             if self.scratch.shape[0] < self._chunks() or self.scratch.shape[1] < width:
                 self.scratch = np.zeros((self._chunks(), width))
             fk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
                               self.shell_ratio, self.lattice, self.sums, self.scratch,
                               fields)  # fmt: skip
+
+    def _list_members(self) -> None:
+        """List each particle's neighbours in (or near) its sphere of radiative influence
+        from the neighbourhood set at the current positions (kernels/neighbourhood.py): the
+        band is a quarter of the set's skin (at least 1e-9 R_min), so a listing lasts until
+        the particles have moved an eighth of the skin, a quarter as long as the set itself
+        (the border entries, tested at every step, are ~7 % of the listed neighbours in a
+        packed bed)."""
+        sim = self.sim
+        p = sim.particles
+        ns = self.neighbourhood
+        n = p.count
+        band = max(0.25 * ns.skin, 1e-9 * float(p.radius.min()))
+        counts = np.zeros(n, np.int64)
+        nh.member_counts(p.position, p.radius, ns.i, ns.j, ns.count, sim.lower, sim.upper,
+                         sim.periodic, self.radiation_ratio, band, counts)  # fmt: skip
+        offsets = np.zeros(n + 1, np.int64)
+        np.cumsum(counts, out=offsets[1:])
+        border = np.zeros(n, np.int64)
+        index = np.zeros(int(offsets[-1]), np.int32)
+        nh.member_fill(p.position, p.radius, ns.i, ns.j, ns.count, sim.lower, sim.upper,
+                       sim.periodic, self.radiation_ratio, band, offsets, border,
+                       index)  # fmt: skip
+        self.members = (offsets, border, index)
+        self._member_constants()
+        self.members_builds = ns.builds
+        self.members_reference = p.position.copy()
+        self.members_offset = ns.moved  # the set's displacement at the listing
+        self.members_band = band
+        self.members_listings += 1
+
+    def _listing_expired(self) -> bool:
+        """Whether a particle may have moved more than band / 2 since the listing. First the
+        bound |x - x_list| <= |x - x_set| + |x_list - x_set| from the range set's own
+        displacement (found by its due() this step) and the one at the listing: no pass of
+        its own while a bed hardly moves; then, if the bound is too large, the displacement
+        since the listing itself (parallel, by chunks: the same for any thread count)."""
+        ns = self.neighbourhood
+        if 2.0 * (ns.moved + self.members_offset) <= self.members_band:
+            return False
+        sim = self.sim
+        moved = heat_terms.largest_displacement(sim.particles.position, self.members_reference,
+                                                sim.lower, sim.upper, sim.periodic,
+                                                self._part())  # fmt: skip
+        return 2.0 * float(moved) > self.members_band
+
+    def _member_constants(self) -> None:
+        """ε A / 2 of every particle and the members' count and Σ ε A / 2 of every row."""
+        p = self.sim.particles
+        n = p.count
+        area, emission = np.zeros(n), np.zeros(n)
+        nh.neighbourhood_weights(p.radius, p.temperature, p.type_id, self.emissivity, area,
+                                 emission)  # fmt: skip
+        member_area, member_count = np.zeros(n), np.zeros(n)
+        nh.member_constants(*self.members, area, member_area, member_count)
+        self.member_sums = (area, emission, member_area, member_count)
 
     # ------------------------------------------------------------------ cell porosity
     def _cell_grid(self, size: float) -> None:
@@ -564,6 +643,12 @@ class FieldProvider:
             sub = self.neighbourhood.state_dict()
             scalars["neighbourhood"] = sub["scalars"]
             arrays.update(sub["arrays"])
+        if self.radiation_ratio > 0.0:  # the listing fixes the order of the sums
+            scalars["members"] = [self.members_builds, self.members_band, self.members_listings,
+                                  self.members_offset]  # fmt: skip
+            for name, values in zip(MEMBER_ARRAYS, self.members, strict=True):
+                arrays[name] = values.copy()
+            arrays["members_reference"] = self.members_reference.copy()
         return {"scalars": scalars, "arrays": arrays}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -576,6 +661,17 @@ class FieldProvider:
             self.neighbourhood.load_state_dict(
                 {"scalars": scalars["neighbourhood"], "arrays": arrays}
             )
+        if self.radiation_ratio > 0.0 and "members" in scalars:
+            builds, band, listings, offset = scalars["members"]
+            self.members_builds, self.members_listings = int(builds), int(listings)
+            self.members_band, self.members_offset = float(band), float(offset)
+            self.members_reference = np.array(arrays["members_reference"], np.float64).reshape(
+                -1, 3
+            )
+            offsets, border, index = (arrays[name] for name in MEMBER_ARRAYS)
+            self.members = (np.array(offsets, np.int64), np.array(border, np.int64),
+                            np.array(index, np.int32))  # fmt: skip
+            self.member_sums = tuple(np.zeros(0) for _ in range(4))  # recomputed at first use
         self._constants_for = None
 
 

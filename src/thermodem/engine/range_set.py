@@ -60,6 +60,7 @@ class RangePairSet:
         self.wall_reference = np.zeros((0, 3))
         self.valid = False
         self.builds = 0
+        self.moved = 0.0  # largest displacement since the build, found by the last due() [m]
         self._part = np.zeros(1)
 
     @property
@@ -81,6 +82,7 @@ class RangePairSet:
         moved = heat_terms.largest_displacement(
             p.position, self.reference, sim.lower, sim.upper, sim.periodic, self._part
         )
+        self.moved = float(moved)
         wall_moved = 0.0
         if sim.wall_rows.shape[0]:
             shift = sim.wall_rows[:, wall_cols.COL_POINT : wall_cols.COL_POINT + 3]
@@ -98,6 +100,7 @@ class RangePairSet:
         )
         self.builds += 1
         self.valid = True
+        self.moved = 0.0
         self.reference = p.position.copy()
         self.wall_reference = sim.wall_rows[:, wall_cols.COL_POINT : wall_cols.COL_POINT + 3].copy()
         if n == 0:

@@ -111,6 +111,13 @@ class ThermalEngine:
         self.voronoi: VoronoiProvider | None = None
         self.external_wall_conductance = np.zeros(0)
         self.external_stamp = -1  # the external set's update count of the stored H (frozen)
+        # the Voronoi conductance reuse (thermal.tessellation.conductance_gap_tolerance): a
+        # row per pair of the external set (kernels/heat_terms.py, REUSE_*), valid for the
+        # set's update count ``external_reuse_stamp``; evaluations / pair-steps so far
+        self.external_reuse = np.zeros((0, passes.REUSE_WIDTH))
+        self.external_reuse_stamp = -1
+        self.external_evaluations = 0
+        self.external_pair_steps = 0
         for term in self.terms:
             if term.target == "external":
                 self._voronoi_term(term)
@@ -132,7 +139,7 @@ class ThermalEngine:
         #: per-particle fields read by per-particle terms (columns: kernels/fields.py), filled
         #: by the providers of engine/fields.py before the terms run (fluid, porosity, ...)
         self.field_provider = FieldProvider(sim, settings, self.terms)
-        self.fields = np.zeros((0, field_kernels.NFIELDS))
+        self.fields = np.zeros((field_kernels.NFIELDS, 0))  # a row per field
         self._empty = np.zeros(0)
         self.conductance_sum = np.zeros(0)
         #: cumulative ledger [J]: heat in through every boundary mechanism, heat absorbed by
@@ -464,8 +471,8 @@ class ThermalEngine:
         sim = self.sim
         if self.field_provider.active:
             n = sim.particles.count
-            if self.fields.shape[0] != n:
-                self.fields = np.zeros((n, field_kernels.NFIELDS))
+            if self.fields.shape != (field_kernels.NFIELDS, n):
+                self.fields = np.zeros((field_kernels.NFIELDS, n))
             self.field_provider.update(time, self.fields)
         if self.voronoi is not None:
             self.voronoi.update(self.fields)
@@ -474,13 +481,21 @@ class ThermalEngine:
             self.range_set.build(sim, *self._range_gaps())
             self.term_ready[:] = False
         frozen = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        fused = -1  # a per-particle term already evaluated with the one before it
         for index, term in enumerate(self.terms):
+            if index == fused:
+                continue
             if term.target == "range":
                 self._range_term(index, term, frozen)
             elif term.target == "contacts":
                 self._contact_term(index, term, frozen)
             elif term.target == "particles":
-                self._particle_term(term)
+                following = self.terms[index + 1] if index + 1 < len(self.terms) else None
+                if following is not None and following.target == "particles":
+                    fused = index + 1
+                    self._particle_term(term, following)
+                else:
+                    self._particle_term(term)
             elif term.target == "external":
                 self._external_term(index, term)
             else:  # pragma: no cover - the registry refuses other targets
@@ -527,11 +542,20 @@ class ThermalEngine:
         rows = max(ext.count // passes.PARTICLE_CHUNK, p.count // passes.WALL_CHUNK) + 1
         scratch = self._term_rows(rows)
         if not reuse:
-            passes.external_pair_pass(
+            tolerance = 0.0
+            settings = self.settings.tessellation
+            if term.evaluator == passes.EVAL_VORONOI and not frozen and settings is not None:
+                tolerance = float(settings.conductance_gap_tolerance)
+            if tolerance > 0.0 and (self.external_reuse_stamp != ext.updates
+                                    or self.external_reuse.shape[0] != ext.count):  # fmt: skip
+                self.external_reuse = np.full((ext.count, passes.REUSE_WIDTH), np.nan)
+                self.external_reuse_stamp = ext.updates
+            self.external_evaluations += passes.external_pair_pass(
                 p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
                 sim.periodic, term.evaluator, term.model_id, term.table, k_i, k_j, self.k_p,
-                scratch, h,
+                scratch, h, tolerance, self.external_reuse,
             )  # fmt: skip
+            self.external_pair_steps += ext.count
             self.external_stamp = ext.updates
         if term.evaluator == passes.EVAL_VORONOI and ext.wall_count:
             passes.external_wall_pass(
@@ -546,11 +570,15 @@ class ThermalEngine:
             p.heat_rate_by_mechanism, self.conductance_sum,
         )  # fmt: skip
 
-    def _particle_term(self, term: HeatTerm) -> None:
+    def _particle_term(self, term: HeatTerm, second: HeatTerm | None = None) -> None:
+        """A per-particle term, and the next one in the same pass if given."""
         p = self.sim.particles
+        other = second or term
         passes.particle_pass(
             p.temperature, p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
-            term.table, term.column, p.heat_rate_by_mechanism, self.conductance_sum,
+            term.table, term.column, other.evaluator, other.model_id, other.table,
+            -1 if second is None else second.column, p.heat_rate_by_mechanism,
+            self.conductance_sum,
         )  # fmt: skip
 
     def _stored(self, index: int, pairs: int, walls: int) -> tuple[np.ndarray, np.ndarray]:
@@ -830,6 +858,9 @@ class ThermalEngine:
             out["voronoi_pair_count"] = self.external.count
             out["tessellation_count"] = self.voronoi.count
             out["tessellation_seconds"] = self.voronoi.seconds
+            out["voronoi_evaluated_fraction"] = self.external_evaluations / max(
+                self.external_pair_steps, 1
+            )
         return out
 
     # ------------------------------------------------------------------------ checkpoints

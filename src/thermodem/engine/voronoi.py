@@ -511,12 +511,12 @@ def closure_inputs(pair_i, pair_j, wall_i, radius, fields, porosity_column, inpu
         i = pair_i[k]
         j = pair_j[k]
         inputs[k, INPUT_FACE_AREA] = 0.5 * (
-            closure_face_area(radius[i], fields[i, porosity_column])
-            + closure_face_area(radius[j], fields[j, porosity_column])
+            closure_face_area(radius[i], fields[porosity_column, i])
+            + closure_face_area(radius[j], fields[porosity_column, j])
         )
     for k in prange(wall_i.shape[0]):
         i = wall_i[k]
-        wall_inputs[k, INPUT_FACE_AREA] = closure_face_area(radius[i], fields[i, porosity_column])
+        wall_inputs[k, INPUT_FACE_AREA] = closure_face_area(radius[i], fields[porosity_column, i])
 
 
 class VoronoiProvider:
@@ -718,7 +718,7 @@ class TessellationPorosity:
             if self.own is None:
                 self.own = VoronoiProvider(sim, sim.case.thermal.tessellation, None)
             shared = self.own
-        fields[:, F_POROSITY] = shared.porosity()
+        fields[F_POROSITY, :] = shared.porosity()
 
 
 def _register_porosity() -> None:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
@@ -48,7 +49,11 @@ from thermodem.models.thermal.convection import convection_dispatch
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.radiation import radiation_dispatch
-from thermodem.models.thermal.voronoi import voronoi_dispatch
+from thermodem.models.thermal.voronoi import (
+    voronoi_cutoff_distance,
+    voronoi_dispatch,
+    voronoi_side,
+)
 
 #: Evaluators of pair terms: an indirect_conduction model, or the separated-pair part of a
 #: direct_conduction model with an interaction range.
@@ -260,36 +265,108 @@ def pair_csr(pair_i, pair_j, n, offsets, entries):
         fill[pair_j[k]] += 1
 
 
+#: Columns of the per-pair state of the Voronoi conductance reuse (``external_pair_pass``):
+#: the interval of centre distances where the last evaluation is reused, the distance,
+#: conductance and face area of that evaluation, and the slope dH/dd applied (the secant
+#: through the last two evaluations, or 0).
+REUSE_LOW, REUSE_HIGH, REUSE_DISTANCE, REUSE_CONDUCTANCE, REUSE_SLOPE, REUSE_AREA = range(6)
+REUSE_WIDTH = 6
+#: Relative guard of the reuse intervals at the cut-off distance (never reuse across it).
+CUTOFF_GUARD = 1e-12
+
+
+@njit(cache=True, error_model="numpy")
+def _reuse_row(model_id, p, ri, rj, dist, h, area, tolerance, row):
+    """Store an evaluation H(dist) in the pair's reuse row (see ``external_pair_pass``)."""
+    touch = ri + rj
+    side = voronoi_side(model_id, p, ri, rj, dist)
+    d_b = row[REUSE_DISTANCE]
+    w = abs(dist - touch)
+    delta = dist - d_b
+    slope = 0.0
+    window = tolerance * tolerance * w
+    if (
+        row[REUSE_AREA] == area
+        and side == voronoi_side(model_id, p, ri, rj, d_b)
+        and delta != 0.0
+        and abs(delta) <= 2.0 * tolerance * w
+    ):
+        slope = (h - row[REUSE_CONDUCTANCE]) / delta
+        window = tolerance * w
+    # the distances of this side of touching and of the cut-off (with a guard: the
+    # interval never holds a distance of the other side)
+    cut = voronoi_cutoff_distance(model_id, p, ri, rj)
+    if side == 0:
+        lo, hi = -np.inf, touch * (1.0 - 4e-16)
+    elif side == 1:
+        lo, hi = touch, cut * (1.0 - CUTOFF_GUARD)
+    else:
+        lo, hi = cut * (1.0 + CUTOFF_GUARD), np.inf
+    if lo <= dist <= hi:
+        row[REUSE_LOW] = max(dist - window, lo)
+        row[REUSE_HIGH] = min(dist + window, hi)
+    else:  # in a guard zone: evaluate again next time
+        row[REUSE_LOW] = np.inf
+        row[REUSE_HIGH] = -np.inf
+    row[REUSE_DISTANCE] = dist
+    row[REUSE_CONDUCTANCE] = h
+    row[REUSE_SLOPE] = slope
+    row[REUSE_AREA] = area
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def external_pair_pass(
     position, radius, type_id, pair_i, pair_j, inputs, lower, upper, periodic, evaluator,
-    model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance,
+    model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance, tolerance, reuse,
 ):  # fmt: skip
     """Conductance of every pair of an external pair set (``inputs``: a row per pair, read
-    by the models made for such sets; the gap-conduction models ignore it)."""
+    by the models made for such sets; the gap-conduction models ignore it). Returns the
+    number of pairs whose model was evaluated.
+
+    With ``tolerance`` > 0 (Voronoi models only; ``reuse``: a row per pair, NaN rows: no
+    evaluation yet) a pair keeps its last evaluation H_b at distance d_b while its face area
+    is unchanged and its distance d is within the row's interval: d_b ± tolerance × w,
+    w = |d_b - R_i - R_j| its surface gap (or overlap) then, clipped to d_b's side of touching
+    and of the cut-off; H = H_b + S (d - d_b) with S the secant slope through its last two
+    evaluations (when they were at most 2 tolerance w apart; without one S = 0 and the
+    interval is d_b ± tolerance² w). Otherwise the model is evaluated and the row updated.
+    docs/models/indirect_conduction-voronoi_a.md, "Conductance reuse"."""
     length = upper - lower
     npairs = pair_i.shape[0]
     nchunks = (npairs + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
+    evaluated = 0
     for c in prange(nchunks):
         srow = scratch[c]
+        count = 0
         for k in range(c * PARTICLE_CHUNK, min(npairs, (c + 1) * PARTICLE_CHUNK)):
             i = pair_i[k]
             j = pair_j[k]
             dist = pair_separation(position, i, j, length, periodic)[3]
+            if tolerance > 0.0:
+                row = reuse[k]
+                if row[REUSE_AREA] == inputs[k, 0] and row[REUSE_LOW] <= dist <= row[REUSE_HIGH]:
+                    out_conductance[k] = row[REUSE_CONDUCTANCE] + row[REUSE_SLOPE] * (
+                        dist - row[REUSE_DISTANCE]
+                    )
+                    continue
             ri = radius[i]
             rj = radius[j]
-            r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
             ki = kj = 0.0
             if k_col_i >= 0:
                 ki = k_particle[i]
                 kj = k_particle[j]
             p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+            r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+            count += 1
             if evaluator == EVAL_VORONOI:
-                out_conductance[k] = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
+                h = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
             else:
-                out_conductance[k] = term_conductance(
-                    evaluator, model_id, p, ri, rj, dist, r_c, 0.0
-                )
+                h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+            out_conductance[k] = h
+            if tolerance > 0.0:
+                _reuse_row(model_id, p, ri, rj, dist, h, inputs[k, 0], tolerance, reuse[k])
+        evaluated += count
+    return evaluated
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -361,19 +438,30 @@ def particle_term(evaluator, model_id, p, t_i, r_i, fields, i):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def particle_pass(
-    temperature, radius, type_id, fields, evaluator, model_id, table, column, by_mechanism,
-    conductance_sum,
+    temperature, radius, type_id, fields, evaluator, model_id, table, column, evaluator2,
+    model_id2, table2, column2, by_mechanism, conductance_sum,
 ):  # fmt: skip
-    """One per-particle term over every particle (``table``: a row per material)."""
+    """One per-particle term over every particle (``table``: a row per material), and a
+    second one in the same pass when ``column2`` >= 0 (two consecutive terms, e.g. convection
+    and radiation: one pass over the particles and their fields; each particle adds the
+    first term, then the second, as two passes would)."""
     n = temperature.shape[0]
+    nterms = 2 if column2 >= 0 else 1
     nchunks = (n + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
     for c in prange(nchunks):
         for i in range(c * PARTICLE_CHUNK, min(n, (c + 1) * PARTICLE_CHUNK)):
-            q, g = particle_term(
-                evaluator, model_id, table[type_id[i]], temperature[i], radius[i], fields, i
-            )
-            by_mechanism[i, column] += q
-            conductance_sum[i] += g
+            t_i = temperature[i]
+            r_i = radius[i]
+            # one call site of the (inlined) dispatchers: two would double the compile time
+            for k in range(nterms):
+                first = k == 0
+                ev = evaluator if first else evaluator2
+                mid = model_id if first else model_id2
+                col = column if first else column2
+                row = table[type_id[i]] if first else table2[type_id[i]]
+                q, g = particle_term(ev, mid, row, t_i, r_i, fields, i)
+                by_mechanism[i, col] += q
+                conductance_sum[i] += g
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

@@ -179,6 +179,13 @@ def pack_li_mason(params: LiMasonParams, pair: PairContext) -> np.ndarray:
 
 # ---------------------------------------------------------------------- Nusselt numbers
 @njit(cache=True, inline="always", error_model="numpy")
+def power(x, a):
+    """x^a for x >= 0, a > 0 as exp(a ln x): the same to a few ulp as x**a, and about a
+    third faster in these kernels (numba's pow); 0 for x = 0."""
+    return math.exp(a * math.log(x)) if x > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def nusselt_ranz_marshall(re, pr_cbrt):
     """Ranz & Marshall (1952): 2 + 0.6 Re^½ Pr^⅓."""
     return 2.0 + 0.6 * math.sqrt(re) * pr_cbrt
@@ -187,7 +194,7 @@ def nusselt_ranz_marshall(re, pr_cbrt):
 @njit(cache=True, inline="always", error_model="numpy")
 def nusselt_whitaker(re, pr, viscosity_ratio):
     """Whitaker (1972): 2 + (0.4 Re^½ + 0.06 Re^⅔) Pr^0.4 (μ_f/μ_fs)^¼."""
-    return 2.0 + (0.4 * math.sqrt(re) + 0.06 * re ** (2.0 / 3.0)) * pr**0.4 * math.sqrt(
+    return 2.0 + (0.4 * math.sqrt(re) + 0.06 * power(re, 2.0 / 3.0)) * power(pr, 0.4) * math.sqrt(
         math.sqrt(viscosity_ratio)
     )
 
@@ -195,7 +202,7 @@ def nusselt_whitaker(re, pr, viscosity_ratio):
 @njit(cache=True, inline="always", error_model="numpy")
 def nusselt_gunn(re, pr_cbrt, eps):
     """Gunn (1978): (7 - 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 - 2.4ε + 1.2ε²) Re^0.7 Pr^⅓."""
-    re02 = re**0.2
+    re02 = power(re, 0.2)
     re07 = re02 * math.sqrt(re)  # Re^0.7 = Re^0.2 Re^0.5
     a = 7.0 - 10.0 * eps + 5.0 * eps * eps
     b = 1.33 - 2.4 * eps + 1.2 * eps * eps
@@ -206,21 +213,21 @@ def nusselt_gunn(re, pr_cbrt, eps):
 def nusselt_li_mason(re, pr_cbrt, eps, m):
     """Li & Mason (2000): 2 + 0.6 ε^m Re^½ Pr^⅓ (Re < 200); 2 + ε^m (0.5 Re^½ + 0.02 Re^0.8)
     Pr^⅓ (Re < 1500); 2 + 4.5e-5 ε^m Re^1.8 (otherwise)."""
-    em = eps**m
+    em = power(eps, m)
     if re < 200.0:
         return 2.0 + 0.6 * em * math.sqrt(re) * pr_cbrt
     if re < 1500.0:
-        return 2.0 + em * (0.5 * math.sqrt(re) + 0.02 * re**0.8) * pr_cbrt
-    return 2.0 + 0.000045 * em * re**1.8
+        return 2.0 + em * (0.5 * math.sqrt(re) + 0.02 * power(re, 0.8)) * pr_cbrt
+    return 2.0 + 0.000045 * em * power(re, 1.8)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def reynolds(p, r_i, fields, i):
     """Re = ρ_f v 2R / μ_f, v = |u_f - v_p| (times ε with the column ``superficial`` = 1)."""
-    speed = fields[i, F_RELATIVE_SPEED]
+    speed = fields[F_RELATIVE_SPEED, i]
     if p[COL_SUPERFICIAL] != 0.0:
-        speed *= fields[i, F_POROSITY]
-    return fields[i, F_FLUID_DENSITY] * speed * 2.0 * r_i / fields[i, F_FLUID_VISCOSITY]
+        speed *= fields[F_POROSITY, i]
+    return fields[F_FLUID_DENSITY, i] * speed * 2.0 * r_i / fields[F_FLUID_VISCOSITY, i]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -228,16 +235,16 @@ def convection_nusselt(model_id, p, r_i, fields, i):
     """Nu of model ``model_id`` for particle i (NaN for an unknown id)."""
     if model_id == GUNN:
         re = reynolds(p, r_i, fields, i)
-        return nusselt_gunn(re, fields[i, F_PRANDTL_CBRT], fields[i, F_POROSITY])
+        return nusselt_gunn(re, fields[F_PRANDTL_CBRT, i], fields[F_POROSITY, i])
     if model_id == RANZ_MARSHALL:
-        return nusselt_ranz_marshall(reynolds(p, r_i, fields, i), fields[i, F_PRANDTL_CBRT])
+        return nusselt_ranz_marshall(reynolds(p, r_i, fields, i), fields[F_PRANDTL_CBRT, i])
     if model_id == WHITAKER:
-        ratio = fields[i, F_FLUID_VISCOSITY] / fields[i, F_SURFACE_VISCOSITY]
-        return nusselt_whitaker(reynolds(p, r_i, fields, i), fields[i, F_PRANDTL], ratio)
+        ratio = fields[F_FLUID_VISCOSITY, i] / fields[F_SURFACE_VISCOSITY, i]
+        return nusselt_whitaker(reynolds(p, r_i, fields, i), fields[F_PRANDTL, i], ratio)
     if model_id == LI_MASON:
         re = reynolds(p, r_i, fields, i)
         return nusselt_li_mason(
-            re, fields[i, F_PRANDTL_CBRT], fields[i, F_POROSITY], p[COL_EXPONENT]
+            re, fields[F_PRANDTL_CBRT, i], fields[F_POROSITY, i], p[COL_EXPONENT]
         )
     if model_id == STAGNANT:
         return p[COL_NUSSELT]
@@ -249,8 +256,8 @@ def convection_nusselt(model_id, p, r_i, fields, i):
 @njit(cache=True, inline="always", error_model="numpy")
 def _newton(nu, t_i, r_i, fields, i):
     """(Q, G) = (h A (T_f - T), h A), h A = 2π R k_f Nu."""
-    ha = 2.0 * math.pi * r_i * fields[i, F_FLUID_CONDUCTIVITY] * nu
-    return ha * (fields[i, F_FLUID_TEMPERATURE] - t_i), ha
+    ha = 2.0 * math.pi * r_i * fields[F_FLUID_CONDUCTIVITY, i] * nu
+    return ha * (fields[F_FLUID_TEMPERATURE, i] - t_i), ha
 
 
 @njit(cache=True, error_model="numpy")
@@ -306,21 +313,21 @@ def convection_numbers(
         p = table[type_id[i]]
         r = radius[i]
         out[i, N_RE] = reynolds(p, r, fields, i)
-        out[i, N_PR] = fields[i, F_PRANDTL]
+        out[i, N_PR] = fields[F_PRANDTL, i]
         out[i, N_NU] = convection_nusselt(model_id, p, r, fields, i) if with_nusselt else 0.0
-        out[i, N_VISCOSITY_RATIO] = fields[i, F_FLUID_VISCOSITY] / fields[i, F_SURFACE_VISCOSITY]
-        out[i, N_POROSITY] = fields[i, F_POROSITY]
+        out[i, N_VISCOSITY_RATIO] = fields[F_FLUID_VISCOSITY, i] / fields[F_SURFACE_VISCOSITY, i]
+        out[i, N_POROSITY] = fields[F_POROSITY, i]
         if beta_mode == 0:
             out[i, N_RA] = np.nan
         else:
-            tf = fields[i, F_FLUID_TEMPERATURE]
+            tf = fields[F_FLUID_TEMPERATURE, i]
             b = 1.0 / tf if beta_mode == 1 else beta
             d = 2.0 * r
-            rho = fields[i, F_FLUID_DENSITY]
+            rho = fields[F_FLUID_DENSITY, i]
             out[i, N_RA] = (
                 gravity * b * abs(temperature[i] - tf) * d * d * d * rho * rho
-                * fields[i, F_FLUID_SPECIFIC_HEAT]
-                / (fields[i, F_FLUID_VISCOSITY] * fields[i, F_FLUID_CONDUCTIVITY])
+                * fields[F_FLUID_SPECIFIC_HEAT, i]
+                / (fields[F_FLUID_VISCOSITY, i] * fields[F_FLUID_CONDUCTIVITY, i])
             )  # fmt: skip
 
 

@@ -164,11 +164,11 @@ def _exchange(coefficient, t_i, te4, environment, fields, i):
     """(Q, G) of a particle whose surface fraction ``environment`` sees an environment of
     T_e⁴ = te4 and whose fraction Σ F_iw sees the walls (fields): Q = ε A σ (environment
     (T_e⁴ − T⁴) + Σ F T_w⁴ − Σ F T⁴), G = 4 ε A σ T³ (environment + Σ F)."""
-    view = fields[i, F_WALL_VIEW]
+    view = fields[F_WALL_VIEW, i]
     env = environment * (1.0 - view)
     t2 = t_i * t_i
     t4 = t2 * t2
-    q = coefficient * (env * (te4 - t4) + (fields[i, F_WALL_EMISSION] - view * t4))
+    q = coefficient * (env * (te4 - t4) + (fields[F_WALL_EMISSION, i] - view * t4))
     return q, 4.0 * coefficient * t2 * t_i * (env + view)
 
 
@@ -181,9 +181,9 @@ def surroundings_radiation(p, t_i, r_i, fields, i):
     exposure = 1.0
     mode = p[SR_EXPOSURE]
     if mode == 1.0:
-        exposure = 1.0 if fields[i, F_POROSITY] >= p[SR_THRESHOLD] else 0.0
+        exposure = 1.0 if fields[F_POROSITY, i] >= p[SR_THRESHOLD] else 0.0
     elif mode == 2.0:
-        exposure = fields[i, F_POROSITY]
+        exposure = fields[F_POROSITY, i]
     return _exchange(coefficient, t_i, te2 * te2, exposure, fields, i)
 
 
@@ -241,12 +241,12 @@ def pack_krause(params: Krause2017Params, pair: PairContext) -> np.ndarray:
 def zhou2009_radiation(p, t_i, r_i, fields, i):
     """T_e = ε T_f + (1 − ε) mean T_j (T_f without neighbours); (Q, G) as surroundings."""
     coefficient = p[SR_EMISSIVITY] * 4.0 * math.pi * r_i * r_i * STEFAN_BOLTZMANN
-    count = fields[i, F_NEIGHBOURS]
-    t_f = fields[i, F_FLUID_TEMPERATURE]
+    count = fields[F_NEIGHBOURS, i]
+    t_f = fields[F_FLUID_TEMPERATURE, i]
     t_e = t_f
     if count > 0.0:
-        eps = fields[i, F_POROSITY]
-        t_e = eps * t_f + (1.0 - eps) * fields[i, F_NEIGHBOUR_TEMPERATURE] / count
+        eps = fields[F_POROSITY, i]
+        t_e = eps * t_f + (1.0 - eps) * fields[F_NEIGHBOUR_TEMPERATURE, i] / count
     te2 = t_e * t_e
     return _exchange(coefficient, t_i, te2 * te2, 1.0, fields, i)
 
@@ -255,9 +255,9 @@ def zhou2009_radiation(p, t_i, r_i, fields, i):
 def krause2017_radiation(p, t_i, r_i, fields, i):
     """T_e⁴ = Σ ε_j A_j T_j⁴ / Σ ε_j A_j over the sphere; (Q, G) as surroundings."""
     coefficient = p[SR_EMISSIVITY] * 4.0 * math.pi * r_i * r_i * STEFAN_BOLTZMANN
-    area = fields[i, F_NEIGHBOUR_AREA]
+    area = fields[F_NEIGHBOUR_AREA, i]
     if area > 0.0:
-        return _exchange(coefficient, t_i, fields[i, F_NEIGHBOUR_EMISSION] / area, 1.0, fields, i)
+        return _exchange(coefficient, t_i, fields[F_NEIGHBOUR_EMISSION, i] / area, 1.0, fields, i)
     t_e = p[KR_ENVIRONMENT]
     te2 = t_e * t_e
     return _exchange(coefficient, t_i, te2 * te2, 1.0 if t_e > 0.0 else 0.0, fields, i)

@@ -455,6 +455,28 @@ def voronoi_dispatch(model_id, p, r_i, r_j, dist, r_c, inputs):
     return np.nan
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def voronoi_cutoff_distance(model_id, p, r_i, r_j):
+    """The centre distance of the cut-off, R_i + R_j + cutoff_gap_ratio × (R_i + R_j)/2."""
+    ratio = p[A_CUTOFF] if model_id == VORONOI_A else p[B_CUTOFF]
+    return (r_i + r_j) * (1.0 + 0.5 * ratio)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def voronoi_side(model_id, p, r_i, r_j, dist):
+    """Where a pair at centre distance ``dist`` is relative to the two places where H(d) is
+    not smooth: 0 overlapping (d < R_i + R_j: a contact radius R_c > 0), 1 separated within
+    the cut-off, 2 at or beyond the cut-off (H = 0; the same test as the kernels). The
+    conductance reuse of ``thermal.tessellation.conductance_gap_tolerance`` never carries a
+    conductance across them (``kernels/heat_terms.py:external_pair_pass``)."""
+    if dist < r_i + r_j:
+        return 0
+    ratio = p[A_CUTOFF] if model_id == VORONOI_A else p[B_CUTOFF]
+    if _gap_beyond_cutoff(r_i, r_j, dist, ratio):
+        return 2
+    return 1
+
+
 # -------------------------------------------------------------- the porosity closure
 @njit(cache=True, inline="always", error_model="numpy")
 def closure_face_area(radius, porosity):
