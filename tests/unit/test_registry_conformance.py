@@ -224,6 +224,34 @@ spring = st.floats(-1e-3, 1e-3)
     s=st.tuples(spring, spring, spring),
     dt=st.floats(1e-8, 1e-3),
 )
+# subnormal caps found by hypothesis (the cap scale λ = cap/|F| was itself subnormal and lost
+# its relative precision: the force exceeded the cap by 1.3e-12 of it)
+@example(
+    "mindlin",
+    1.0,
+    4224587554.0,
+    1.0,
+    0.0,
+    0.0625,
+    0.0007386816197748466,
+    1.1125369292536007e-308,
+    (0.0, 0.0, 0.0),
+    (0.0, 0.0, 0.0003355735088290913),
+    1e-3,
+)
+@example(
+    "linear",
+    1.0,
+    1e5,
+    5e4,
+    0.0,
+    0.0625,
+    0.0009935677997822126,
+    2.2250738585e-313,
+    (0.0, 0.0, 1.0),
+    (0.0, 0.0, 0.0),
+    0.00013754590056443844,
+)
 def test_tangential_force_never_exceeds_coulomb(
     name, mu, youngs, ref_stiffness, normal_damping, eff_radius, overlap, normal_force, v, s, dt
 ):
@@ -247,7 +275,7 @@ def test_tangential_force_never_exceeds_coulomb(
     f_t = math.hypot(out[0], out[1], out[2])  # (squares of 1e-157 forces are subnormal)
     limit = pair.sliding_friction * max(normal_force, 0.0)
     # (+ a few units of the last place of subnormal numbers, 4.9e-324: a cap below ~2e-308
-    # is computed with an absolute, not a relative, precision)
+    # has an absolute, not a relative, precision)
     assert f_t <= limit * (1.0 + 1e-12) + 1e-322
     # energies of the step, recomputed here from the returned force and displacement
     force, s_new, k_t = np.array(out[:3]), np.array(out[3:6]), out[6]

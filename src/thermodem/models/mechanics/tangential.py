@@ -50,6 +50,8 @@ LINEAR_STIFFNESS_RATIO, LINEAR_FRICTION = 0, 1
 
 #: Squares below this lose precision (subnormal near 1e-308): compared by their roots.
 _TINY_SQUARE = 1e-280
+#: Below this a float64 is subnormal (fewer significant bits).
+_SMALLEST_NORMAL = 2.2250738585072014e-308
 
 
 @njit(cache=True, error_model="numpy")
@@ -80,14 +82,23 @@ def _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy
     if f_mag <= f_cap:
         return fx, fy, fz, tx, ty, tz, k_t, gamma_t * v2 * dt, 0.0
     lam = f_cap / f_mag if f_mag > 0.0 else 0.0
-    fx *= lam
-    fy *= lam
-    fz *= lam
     # new spring: spring + scaled dashpot = the limit, i.e. s = λ s1 (nothing held if k_t = 0)
     scale = lam if k_t > 0.0 else 0.0
-    nx = scale * tx
-    ny = scale * ty
-    nz = scale * tz
+    if lam >= _SMALLEST_NORMAL:
+        fx *= lam
+        fy *= lam
+        fz *= lam
+        nx = scale * tx
+        ny = scale * ty
+        nz = scale * tz
+    else:  # a subnormal λ has few significant bits: scale by the unit vector times the cap
+        fx = fx / f_mag * f_cap
+        fy = fy / f_mag * f_cap
+        fz = fz / f_mag * f_cap
+        kept = f_cap if k_t > 0.0 else 0.0
+        nx = tx / f_mag * kept
+        ny = ty / f_mag * kept
+        nz = tz / f_mag * kept
     g = lam * gamma_t  # the dashpot coefficient at the limit
     damping = g * (vtx * (nx - sx) + vty * (ny - sy) + vtz * (nz - sz))
     half_k = 0.5 * k_t
