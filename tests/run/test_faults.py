@@ -26,7 +26,7 @@ from typer.testing import CliRunner
 
 from thermodem.cli import app
 from thermodem.config.load import case_from_dict
-from thermodem.engine.runner import LOCK_FILE, _process_start, read_timeseries, run_case
+from thermodem.engine.runner import LOCK_FILE, process_start, read_timeseries, run_case
 from thermodem.engine.simulation import Simulation
 from thermodem.io.checkpoint import list_checkpoints, write_checkpoint
 from thermodem.io.vtk import read_vtu, write_particles_vtu, write_walls_vtu
@@ -148,7 +148,7 @@ def test_overwrite_of_a_directory_a_live_process_writes_is_refused(
     holder = subprocess.Popen(["sleep", "60"])
     try:
         lock = {"pid": holder.pid, "host": os.uname().nodename, "started": "now"}
-        lock["start"] = _process_start(holder.pid)
+        lock["start"] = process_start(holder.pid)
         (out / LOCK_FILE).write_text(json.dumps(lock))
         before = _snapshot(out)
         case = _case_file(tmp_path)

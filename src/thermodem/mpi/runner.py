@@ -351,11 +351,11 @@ def run_distributed(
     if root:
         try:
             check_completeness(case)
-            R._check_output_path(output)
+            R.check_output_path(output)
             if output.is_dir():
-                R._refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
+                R.refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
             R.prepare_output_dir(output, overwrite)
-            lock = R._RunLock(output)
+            lock = R.RunLock(output)
             lock.acquire()
             for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
                 (output / stale).unlink(missing_ok=True)
@@ -431,9 +431,9 @@ def restart_distributed(
                 raise ConfigError(
                     f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from"
                 )
-            R._refuse_if_busy(output, "restart")
-            ck = R._read_newest(checkpoints)
-            R._check_belongs(ck, output, R.Status.read(output))
+            R.refuse_if_busy(output, "restart")
+            ck = R.read_newest_checkpoint(checkpoints)
+            R.check_checkpoint_belongs(ck, output, R.Status.read(output))
             if end_time is not None and end_time < ck.time:
                 raise ConfigError(
                     f"--end-time: {end_time:g} s is before the time of the newest checkpoint, "
@@ -454,8 +454,8 @@ def restart_distributed(
     error = None
     if root:
         try:
-            series_repair = R._timeseries_repair(output / TIMESERIES_FILE)
-            lock = R._RunLock(output)
+            series_repair = R.timeseries_repair(output / TIMESERIES_FILE)
+            lock = R.RunLock(output)
             lock.acquire()
             if end_time is not None:
                 (output / "case.resolved.yaml").write_text(R.resolved_case_yaml(case))
