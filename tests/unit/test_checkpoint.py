@@ -286,7 +286,7 @@ def test_checkpoint_refuses_an_incompatible_case(tmp_path: Path) -> None:
     path = write_checkpoint(sim, tmp_path / "c.h5")
     other = drum_case()
     other["contact"]["rolling"] = "none"
-    with pytest.raises(ConfigError, match="history width"):
+    with pytest.raises(ConfigError, match="contact history layout"):
         Simulation.from_checkpoint(path, case=case_from_dict(other))
 
 

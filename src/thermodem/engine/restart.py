@@ -11,7 +11,8 @@ The state is a plain nested dict, which :mod:`thermodem.io.checkpoint` writes to
       "scalars":   {time, step_count, next_global_id, skin, moved, rebuild_count,
                     _needs_rebuild, initial_energy, max_overlap_ratio, contact_count,
                     ledger_cumulative, rng (the bit generator state), pourers (state dicts),
-                    material_names, history_width, pair_capacity, wall_pair_capacity},
+                    material_names, history_width, history_layout, pair_capacity,
+                    wall_pair_capacity},
       "particles": {every Particles array, in the current memory order},
       "pairs":     {i, j, history, dissipation, normal_force, state: the first `count` rows;
                     group_start: the slab groups of the list},
@@ -104,6 +105,7 @@ DERIVED: tuple[str, ...] = (
     "chunk_check",
     "_no_heat",
     "mechanisms",
+    "history_layout",
     # the thread count: the new process's request or choice (results do not depend on it)
     "requested_threads",
     "threads",
@@ -157,6 +159,7 @@ def capture(sim: Simulation) -> dict[str, Any]:
     scalars["pourers"] = [p.state_dict() for p in sim.pourers]
     scalars["material_names"] = list(sim.material_names)
     scalars["history_width"] = sim.pairs.history_width
+    scalars["history_layout"] = sim.history_layout.describe()
     scalars["pair_capacity"] = sim.pairs.capacity
     scalars["wall_pair_capacity"] = sim.walls.capacity
     scalars["pair_count"] = sim.pairs.count
@@ -204,6 +207,7 @@ STATE_SCALARS: tuple[str, ...] = (
     "pourers",
     "material_names",
     "history_width",
+    "history_layout",
     "pair_capacity",
     "wall_pair_capacity",
     "pair_count",
@@ -290,11 +294,16 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
     s = state["scalars"]
     if list(s["material_names"]) != list(sim.material_names):
         raise _mismatch("the list of materials", list(s["material_names"]), sim.material_names)
-    if int(s["history_width"]) != sim.pairs.history_width:
+    saved_layout = [[str(b), int(c), int(w)] for b, c, w in s["history_layout"]]
+    if int(s["history_width"]) != sim.pairs.history_width or saved_layout != [
+        [str(b), int(c), int(w)] for b, c, w in sim.history_layout.describe()
+    ]:
         raise _mismatch(
-            "the contact history width (rolling model, thermal.conductance_force_tolerance)",
-            int(s["history_width"]),
-            sim.pairs.history_width,
+            "the contact history layout (its blocks [name, first column, width] follow from "
+            "the contact models, thermal.conductance_force_tolerance and the heat generation "
+            "model)",
+            saved_layout,
+            sim.history_layout.describe(),
         )
     saved_rows = np.asarray(state["arrays"]["wall_rows"])
     if saved_rows.shape != sim.wall_rows.shape:

@@ -56,6 +56,7 @@ from thermodem.kernels.integrate import (
 )
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
 from thermodem.state.heat import HEAT_MECHANISMS
+from thermodem.state.history import HistoryLayout, layout_for
 from thermodem.state.pairs import PairBuffers
 from thermodem.state.particles import Particles
 
@@ -65,6 +66,20 @@ LEDGER_DISSIPATION = (
     "sliding_friction",
     "rolling_friction",
 )
+
+
+def history_layout_of(case: Case) -> HistoryLayout:
+    """The contact history columns of a case: the registered history widths of its normal,
+    tangential and rolling laws, and the conductance reuse's block when
+    ``thermal.conductance_force_tolerance`` > 0 (state/history.py)."""
+    models = case.contact
+    thermal = case.thermal
+    return layout_for(
+        models.normal.spec.history_width,
+        models.tangential.spec.history_width,
+        models.rolling.spec.history_width,
+        reuse=thermal is not None and thermal.conductance_force_tolerance > 0.0,
+    )
 
 
 class Simulation:
@@ -103,13 +118,8 @@ class Simulation:
         self.normal_table = pair_table(models.normal, case, self.material_names)
         self.tangential_table = pair_table(models.tangential, case, self.material_names)
         self.rolling_table = pair_table(models.rolling, case, self.material_names)
-        rolling_history = models.rolling.spec.history_width > 0
-        history_width = C.HISTORY_WIDTH_ROLLING if rolling_history else C.HISTORY_WIDTH_BASE
-        if case.thermal is not None and case.thermal.conductance_force_tolerance > 0.0:
-            # the conductance reuse's columns, last (kernels find them from the row's end;
-            # the base width plus them stays below the rolling width, which kernels test)
-            history_width += PP.REUSE_COLUMNS
-            assert C.HISTORY_WIDTH_BASE + PP.REUSE_COLUMNS < C.HISTORY_WIDTH_ROLLING
+        #: the columns of the contact history, allocated from the registry (state/history.py)
+        self.history_layout = history_layout_of(case)
         # domain and walls
         dom = case.domain
         self.lower = np.asarray(dom.lower, np.float64)
@@ -163,8 +173,8 @@ class Simulation:
         self.extra = float(nb.extra_distance)
         self.skin = nb.skin
         self.rebuild_every_step = nb.rebuild_every_step
-        self.pairs = PairBuffers(1024, history_width)
-        self.walls = PairBuffers(64, history_width)
+        self.pairs = PairBuffers(1024, self.history_layout.width)
+        self.walls = PairBuffers(64, self.history_layout.width)
         self.wall_row_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
         self.chunk_check = np.zeros((1, 3))
@@ -268,6 +278,7 @@ class Simulation:
         p = self.particles
         pb, wb = self.pairs, self.walls
         nid, tid, rid = self.model_ids
+        layout = self.history_layout.offsets
         th = self.thermal
         heat_due = (
             th is not None and not th.settings.frozen_mechanics and th.next_step <= self.step_count
@@ -275,10 +286,12 @@ class Simulation:
         if heat_due:
             # conduction evaluated in the contact pass, for the thermal step that follows
             th.prepare(self.time)
-            pair_pass, wall_pass = PP.passes_for(True, th.radius_id, th.conduction_id, th.override)
+            pair_pass, wall_pass = PP.passes_for(
+                True, th.radius_id, th.conduction_id, th.override, layout
+            )
         else:
             pair_heat, wall_heat = self._no_heat
-            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0)
+            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout)
         ngroups = pb.ngroups
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
@@ -296,14 +309,14 @@ class Simulation:
             p.type_id, pb.i, pb.j, pb.group_start, pb.history, self.lower, self.upper,
             self.periodic, self.extra, dt, nid, self.normal_table, tid, self.tangential_table,
             rid, self.rolling_table, p.force, p.torque, pb.dissipation, pb.normal_force,
-            pb.state, pb.ledger_rows(ngroups), *pair_heat,
+            pb.state, pb.ledger_rows(ngroups), *pair_heat, layout,
         )  # fmt: skip
         wall_pass(
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
             self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
             self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
-            wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat,
+            wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout,
         )  # fmt: skip
         if heat_due:  # the other heat terms of this state, so the rates are complete now
             th.after_contact_pass(self.time)

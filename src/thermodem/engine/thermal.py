@@ -89,7 +89,7 @@ class ThermalEngine:
         self.radius_table = self.contact.radius_table
         self.conduction_table = self.contact.direct_table
         # conductance reuse (0: the model is evaluated at every thermal step), see
-        # docs/models/conductance_reuse.md; the pair histories carry REUSE_COLUMNS more columns
+        # docs/models/conductance_reuse.md; the pair histories carry its block (state/history.py)
         self.tolerance = float(settings.conductance_force_tolerance)
         self._property_tables(case, names, particle_mats)
         self.specific_heat_by_type = np.zeros(len(names))
@@ -359,14 +359,15 @@ class ThermalEngine:
                 pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
                 self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
                 self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
-                self.tolerance,
+                sim.history_layout.reuse, self.tolerance,
             )  # fmt: skip
             kernels.conduction_wall_pass(
                 p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
                 wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
                 sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
                 self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w,
-                self.rhoc_w, self.scratch, self.wall_conductance, self.tolerance,
+                self.rhoc_w, self.scratch, self.wall_conductance, sim.history_layout.reuse,
+                self.tolerance,
             )  # fmt: skip
             self.conductance_ready = reuse
         passes.pair_heat_from_conductance(

@@ -351,7 +351,9 @@ def check_insertion_memory(case: Case) -> None:
     if not counts:
         return
     total_count = sum(n for _, n, _ in counts)
-    width = 10 if case.contact.rolling.spec.history_width > 0 else 6
+    from thermodem.engine.simulation import history_layout_of
+
+    width = history_layout_of(case).width
     memory = BASELINE_BYTES + total_count * bytes_per_particle(width, case.thermal is not None)
     total, _ = physical_memory()
     if math.isfinite(total) and memory > total:

@@ -23,18 +23,14 @@ from thermodem.models.mechanics.dispatch import (
     rolling_dispatch,
     tangential_dispatch,
 )
+from thermodem.state import history as history_layout
 
 CHUNK = 2048  # pairs per chunk of the heat-only pair passes
 
-# History columns of a contact (particle-particle or particle-wall).
-H_SPRING = 0  # 0:3 tangential spring displacement [m]
-H_SPRING_ENERGY = 3  # elastic energy of the tangential spring at the end of the last step [J]
-H_DURATION = 4  # time in contact [s]; 0 when not touching (first touching step counts dt)
-H_IMPACT_VELOCITY = 5  # normal approach speed at first contact [m/s]
-H_ROLL = 6  # 6:9 elastic rolling torque [N m] (only with a rolling spring model)
-H_ROLL_ENERGY = 9  # elastic energy of the rolling spring [J]
-HISTORY_WIDTH_BASE = 6
-HISTORY_WIDTH_ROLLING = 10
+# History columns: allocated per simulation from the registry (state/history.py); the
+# kernels take the offsets of the blocks (-1: absent). The contact's own columns are first.
+H_DURATION = history_layout.DURATION  # time in contact [s]; 0 when not touching
+H_IMPACT_VELOCITY = history_layout.IMPACT_VELOCITY  # normal approach speed at first contact
 
 # Ledger columns written per chunk.
 L_ELASTIC_NORMAL = 0
@@ -106,6 +102,8 @@ def contact_response(
     p_tangential,
     rolling_id,
     p_rolling,
+    h_spring,
+    h_roll,
     out_diss,
     out_normal_force,
     ledger_row,
@@ -115,7 +113,9 @@ def contact_response(
     Returns (F_n, F_t (3), rolling torque on i (3)); the force on i is -F_n n + F_t and the
     torque on i is R_i n x F_t plus the rolling torque. Writes the dissipated power per
     mechanism (out_diss[k]) and the normal force, updates the history row and adds energies to
-    the ledger row.
+    the ledger row. ``h_spring``, ``h_roll``: first history column of the tangential spring
+    (its energy follows the 3-vector) and of the rolling torque, -1 when the selected law keeps
+    none (state/history.py).
     """
     rate = vrx * nx + vry * ny + vrz * nz
     f_el, f_damp, k_ref, gamma_n, u_n = normal_dispatch(
@@ -126,7 +126,12 @@ def contact_response(
     vtx = vrx - rate * nx
     vty = vry - rate * ny
     vtz = vrz - rate * nz
-    sx, sy, sz = _rotate_into_plane(history, k, H_SPRING, nx, ny, nz)
+    if h_spring >= 0:
+        sx, sy, sz = _rotate_into_plane(history, k, h_spring, nx, ny, nz)
+    else:
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
     ftx, fty, ftz, sx, sy, sz, k_t, e_tdamp, e_slip = tangential_dispatch(
         tangential_id,
         p_tangential,
@@ -143,21 +148,17 @@ def contact_response(
         sz,
         dt,
     )
-    u_t_rotated = (
-        0.5
-        * k_t
-        * (
-            history[k, H_SPRING] ** 2
-            + history[k, H_SPRING + 1] ** 2
-            + history[k, H_SPRING + 2] ** 2
-        )
-    )
-    stiffness_work = u_t_rotated - history[k, H_SPRING_ENERGY]
-    u_t = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
-    history[k, H_SPRING] = sx
-    history[k, H_SPRING + 1] = sy
-    history[k, H_SPRING + 2] = sz
-    history[k, H_SPRING_ENERGY] = u_t
+    stiffness_work = 0.0
+    u_t = 0.0
+    if h_spring >= 0:
+        old_s2 = history[k, h_spring] ** 2 + history[k, h_spring + 1] ** 2
+        old_s2 += history[k, h_spring + 2] ** 2
+        stiffness_work = 0.5 * k_t * old_s2 - history[k, h_spring + 3]
+        u_t = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
+        history[k, h_spring] = sx
+        history[k, h_spring + 1] = sy
+        history[k, h_spring + 2] = sz
+        history[k, h_spring + 3] = u_t
     if history[k, H_DURATION] == 0.0:
         history[k, H_IMPACT_VELOCITY] = rate
     history[k, H_DURATION] += dt
@@ -166,9 +167,8 @@ def contact_response(
     wrx -= wn * nx
     wry -= wn * ny
     wrz -= wn * nz
-    has_roll_history = history.shape[1] >= HISTORY_WIDTH_ROLLING
-    if has_roll_history:
-        mx, my, mz = _rotate_into_plane(history, k, H_ROLL, nx, ny, nz)
+    if h_roll >= 0:
+        mx, my, mz = _rotate_into_plane(history, k, h_roll, nx, ny, nz)
     else:
         mx = 0.0
         my = 0.0
@@ -189,16 +189,16 @@ def contact_response(
         dt,
     )
     u_r = 0.0
-    if has_roll_history:
+    if h_roll >= 0:
         if k_r > 0.0:
-            old_m2 = history[k, H_ROLL] ** 2 + history[k, H_ROLL + 1] ** 2
-            old_m2 += history[k, H_ROLL + 2] ** 2
-            stiffness_work += 0.5 * old_m2 / k_r - history[k, H_ROLL_ENERGY]
+            old_m2 = history[k, h_roll] ** 2 + history[k, h_roll + 1] ** 2
+            old_m2 += history[k, h_roll + 2] ** 2
+            stiffness_work += 0.5 * old_m2 / k_r - history[k, h_roll + 3]
             u_r = 0.5 * (mx * mx + my * my + mz * mz) / k_r
-        history[k, H_ROLL] = mx
-        history[k, H_ROLL + 1] = my
-        history[k, H_ROLL + 2] = mz
-        history[k, H_ROLL_ENERGY] = u_r
+        history[k, h_roll] = mx
+        history[k, h_roll + 1] = my
+        history[k, h_roll + 2] = mz
+        history[k, h_roll + 3] = u_r
     p_ndamp = f_damp * rate
     out_diss[k, D_NORMAL_DAMPING] = p_ndamp
     inv_dt = 1.0 / dt if dt > 0.0 else 0.0
@@ -219,7 +219,7 @@ def contact_response(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _open_contact(k, history, out_diss, out_normal_force, out_state, ledger_row):
+def _open_contact(k, history, h_spring, h_roll, out_diss, out_normal_force, out_state, ledger_row):
     """Outputs of a pair that does not touch; a contact that just opened is cleared.
 
     The energy left in its springs when a contact opens is counted as friction (documented).
@@ -229,9 +229,10 @@ def _open_contact(k, history, out_diss, out_normal_force, out_state, ledger_row)
     if out_state[k] == STATE_NEAR or out_state[k] == STATE_FAR:
         return
     if history[k, H_DURATION] != 0.0:
-        ledger_row[L_SLIDING_FRICTION] += history[k, H_SPRING_ENERGY]
-        if history.shape[1] >= HISTORY_WIDTH_ROLLING:
-            ledger_row[L_ROLLING_FRICTION] += history[k, H_ROLL_ENERGY]
+        if h_spring >= 0:
+            ledger_row[L_SLIDING_FRICTION] += history[k, h_spring + 3]
+        if h_roll >= 0:
+            ledger_row[L_ROLLING_FRICTION] += history[k, h_roll + 3]
         for c in range(history.shape[1]):
             history[k, c] = 0.0
     for c in range(out_diss.shape[1]):

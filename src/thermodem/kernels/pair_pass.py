@@ -45,27 +45,24 @@ from thermodem.kernels.contact import (
 )
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.models import registry
+from thermodem.state import history as HL
 from thermodem.state.heat import M_DIRECT, M_WALL_DIRECT
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
 
 
-#: history columns of the conductance reuse (last in the row, present only when
-#: thermal.conductance_force_tolerance > 0): reference normal force (negative: no slope yet),
-#: conductance there, slope dH/dF_n of the secant through the last two evaluations
-REUSE_COLUMNS = 3
-
-
 @njit(cache=True, inline="always", error_model="numpy")
-def _reused_conductance(k, history, f_n, tolerance):
+def _reused_conductance(k, history, col, f_n, tolerance):
     """(H, True) from the stored evaluations of pair k when its normal force f_n > 0 is close
     to the last evaluated one, else (0, False): the conductance reuse of
-    ``thermal.conductance_force_tolerance`` (docs/models/conductance_reuse.md).
+    ``thermal.conductance_force_tolerance`` (docs/models/conductance_reuse.md). ``col``: the
+    first history column of the reuse block (reference normal force, negative while there is
+    no slope; conductance there; slope dH/dF_n of the secant through the last two
+    evaluations; state/history.py).
 
     With a slope: H = H_ref + S (f_n - F_ref) while |f_n - F_ref| <= tol F_ref. Without one
     (a single evaluation so far, or a jump): H = H_ref while |f_n - F_ref| <= tol² F_ref.
     """
-    col = history.shape[1] - REUSE_COLUMNS
     f_ref = history[k, col]
     df = f_n - abs(f_ref)
     if f_ref > 0.0:
@@ -77,10 +74,9 @@ def _reused_conductance(k, history, f_n, tolerance):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _store_evaluation(k, history, f_n, h, tolerance):
+def _store_evaluation(k, history, col, f_n, h, tolerance):
     """Keep the evaluation (f_n, H) of pair k, with the secant slope from the previous one when
     the two forces are within 2 tol f_n of each other (else: no slope)."""
-    col = history.shape[1] - REUSE_COLUMNS
     f_ref = abs(history[k, col])
     df = f_n - f_ref
     if f_ref > 0.0 and df != 0.0 and abs(df) <= 2.0 * tolerance * f_n:
@@ -94,13 +90,14 @@ def _store_evaluation(k, history, f_n, h, tolerance):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _conductance(
-    k, history, tolerance, ri, rj, dist, overlap, eff_mass, f_n, radius_id, p_radius,
+    k, history, reuse_col, tolerance, ri, rj, dist, overlap, eff_mass, f_n, radius_id, p_radius,
     conduction_id, p_conduction, override, ki, kj, ci, cj, srow,
 ):  # fmt: skip
-    """:func:`pair_conductance` of pair k, or its reuse (``tolerance`` > 0, touching pairs)."""
+    """:func:`pair_conductance` of pair k, or its reuse (``tolerance`` > 0, touching pairs;
+    ``reuse_col``: the reuse block's first history column, state/history.py)."""
     reuse = tolerance > 0.0 and f_n > 0.0
     if reuse:
-        h, found = _reused_conductance(k, history, f_n, tolerance)
+        h, found = _reused_conductance(k, history, reuse_col, f_n, tolerance)
         if found:
             return h
     h = pair_conductance(
@@ -109,7 +106,7 @@ def _conductance(
         override, ki, kj, ci, cj, srow,
     )  # fmt: skip
     if reuse:
-        _store_evaluation(k, history, f_n, h, tolerance)
+        _store_evaluation(k, history, reuse_col, f_n, h, tolerance)
     return h
 
 
@@ -117,7 +114,7 @@ def _conductance(
 def _pp_conductance(
     k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history, normal_force, radius_id,
     radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, srow,
-    tolerance,
+    reuse_col, tolerance,
 ):  # fmt: skip
     ti = type_id[i]
     tj = type_id[j]
@@ -129,9 +126,9 @@ def _pp_conductance(
             ci = rhoc_particle[i]
             cj = rhoc_particle[j]
     return _conductance(
-        k, history, tolerance, ri, rj, dist, overlap, eff_mass, normal_force[k], radius_id,
-        radius_table[ti, tj], conduction_id, conduction_table[ti, tj], override, ki, kj, ci,
-        cj, srow,
+        k, history, reuse_col, tolerance, ri, rj, dist, overlap, eff_mass, normal_force[k],
+        radius_id, radius_table[ti, tj], conduction_id, conduction_table[ti, tj], override, ki,
+        kj, ci, cj, srow,
     )  # fmt: skip
 
 
@@ -139,7 +136,7 @@ def _pp_conductance(
 def _pw_conductance(
     k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force, radius_id,
     radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall,
-    rhoc_wall, srow, tolerance,
+    rhoc_wall, srow, reuse_col, tolerance,
 ):  # fmt: skip
     ti = type_id[i]
     tw = wall_material[w]
@@ -151,9 +148,9 @@ def _pw_conductance(
             ci = rhoc_particle[i]
             cw = rhoc_wall[w]
     return _conductance(
-        k, history, tolerance, ri, math.inf, d, overlap, mass[i], normal_force[k], radius_id,
-        radius_table[ti, tw], conduction_id, conduction_table[ti, tw], override, ki, kw, ci,
-        cw, srow,
+        k, history, reuse_col, tolerance, ri, math.inf, d, overlap, mass[i], normal_force[k],
+        radius_id, radius_table[ti, tw], conduction_id, conduction_table[ti, tw], override, ki,
+        kw, ci, cw, srow,
     )  # fmt: skip
 
 
@@ -163,32 +160,43 @@ def reusable(conduction_id: int) -> bool:
     return any(m.model_id == conduction_id and m.conductance_from_force for m in specs)
 
 
-_PASSES: dict[tuple[bool, int, int, int], tuple] = {}
+_PASSES: dict[tuple, tuple] = {}
 
 
-def passes_for(heat_on: bool, radius_id: int, conduction_id: int, override: int) -> tuple:
-    """(particle pair pass, wall pair pass) for one model combination.
+def passes_for(
+    heat_on: bool, radius_id: int, conduction_id: int, override: int, layout: tuple[int, ...]
+) -> tuple:
+    """(particle pair pass, wall pair pass) for one model combination and history layout.
 
-    The heat switch, the contact radius and direct conduction model ids and the k(T)/ρc(T)
-    override are compile-time constants of the particle pair pass, so the compiler drops the
-    code of every other model: the generic loop with the model switches inside costs the
-    simple conduction models ~20 ns per particle more (docs/architecture.md, "Cost of the
-    generic model switch"). Its arguments keep their order and types; the model arguments
-    passed in are ignored. Each combination in use compiles once (~7 s on a 2-core machine)
-    and is then cached on disk (Numba keys closures on their constants) and in this process.
-    The wall pass, a few percent of the time, is one generic kernel for all combinations.
+    The heat switch, the contact radius and direct conduction model ids, the k(T)/ρc(T)
+    override and the history offsets ``layout`` (``HistoryLayout.offsets``: normal, spring,
+    roll, collision, reuse; -1 for an absent block; state/history.py) are compile-time
+    constants of the particle pair pass, so the compiler drops the code of every other model
+    and of absent history blocks: the generic loop with
+    the model switches inside costs the simple conduction models ~20 ns per particle more
+    (docs/architecture.md, "Cost of the generic model switch"). Its arguments keep their
+    order and types; the model and layout arguments passed in are ignored. Each combination in
+    use compiles once (~7 s on a 2-core machine) and is then cached on disk (Numba keys
+    closures on their constants) and in this process. The wall pass, a few percent of the
+    time, is one generic kernel for all combinations (the offsets are its arguments).
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
         key = (False, 0, 0, 0)
+    key = (*key, tuple(int(c) for c in layout))
     if key not in _PASSES:
         _PASSES[key] = (_compile_pair_pass(*key), wall_pair_pass)
     return _PASSES[key]
 
 
-def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
+def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int,  # noqa: N803
+                       LAYOUT: tuple[int, ...]):  # noqa: ANN202, N803  # fmt: skip
     """Define the particle pair pass with the model choice captured as constants."""
     REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
+    H_SPRING = LAYOUT[HL.SPRING]  # noqa: N806
+    H_ROLL = LAYOUT[HL.ROLL]  # noqa: N806
+    H_REUSE = LAYOUT[HL.REUSE]  # noqa: N806
+    REUSABLE = REUSABLE and H_REUSE >= 0  # noqa: N806
 
     @njit(cache=True, parallel=True, error_model="numpy")
     def particle_pair_pass(
@@ -233,6 +241,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         by_mechanism,
         conductance_sum,
         tolerance,
+        layout,
     ):
         """Contact forces of every listed particle pair, added to ``force`` and ``torque``
         (see module docstring; the caller sets them to their non-contact values first).
@@ -267,7 +276,10 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     overlap = ri + rj - dist
                     eff_mass = 0.0
                     if overlap <= 0.0 or dist == 0.0:
-                        _open_contact(k, history, out_diss, out_normal_force, out_state, row)
+                        _open_contact(
+                            k, history, H_SPRING, H_ROLL, out_diss, out_normal_force, out_state,
+                            row,
+                        )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                     else:
                         out_state[k] = STATE_TOUCHING
@@ -319,6 +331,8 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             tangential_table[ti, tj],
                             rolling_id,
                             rolling_table[ti, tj],
+                            H_SPRING,
+                            H_ROLL,
                             out_diss,
                             out_normal_force,
                             row,
@@ -353,7 +367,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
                             conduction_table, override, k_particle, rhoc_particle, srow,
-                            tolerance,
+                            H_REUSE, tolerance,
                         )  # fmt: skip
                         q_ij = h * (temperature[j] - temperature[i])
                         by_mechanism[i, M_DIRECT] += q_ij
@@ -409,6 +423,7 @@ def wall_pair_pass(
     by_mechanism,
     conductance_sum,
     tolerance,
+    layout,
 ):
     """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
     added to ``force`` and ``torque`` after the particle pairs.
@@ -416,7 +431,11 @@ def wall_pair_pass(
     Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
     ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
     the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
+    ``layout``: the history offsets (see :func:`passes_for`).
     """
+    h_spring = layout[HL.SPRING]
+    h_roll = layout[HL.ROLL]
+    h_reuse = layout[HL.REUSE]
     n = radius.shape[0]
     nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
     for c in prange(nchunks):
@@ -433,7 +452,9 @@ def wall_pair_pass(
             ri = radius[i]
             overlap = ri - d
             if overlap <= 0.0:
-                _open_contact(k, history, out_diss, out_normal_force, out_state, row)
+                _open_contact(
+                    k, history, h_spring, h_roll, out_diss, out_normal_force, out_state, row
+                )
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
             else:
                 out_state[k] = STATE_TOUCHING
@@ -484,6 +505,8 @@ def wall_pair_pass(
                     tangential_table[ti, tw],
                     rolling_id,
                     rolling_table[ti, tw],
+                    h_spring,
+                    h_roll,
                     out_diss,
                     out_normal_force,
                     row,
@@ -513,7 +536,7 @@ def wall_pair_pass(
                         k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
                         out_normal_force, radius_id, radius_table, conduction_id,
                         conduction_table, override, k_particle, rhoc_particle, k_wall,
-                        rhoc_wall, srow, tolerance,
+                        rhoc_wall, srow, h_reuse, tolerance,
                     )  # fmt: skip
                 by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
                 conductance_sum[i] += h

@@ -4,7 +4,8 @@ The arrays are indexed by pair; ``count`` of them are in use. History rows are c
 neighbour rebuilds by particle identity, in place (see
 :func:`thermodem.kernels.neighbors.move_rows`).
 
-Memory layout (bytes per pair slot, history width W = 6, or 10 with a rolling spring): ``i``,
+Memory layout (bytes per pair slot, history width W from the layout of
+:mod:`thermodem.state.history`: 6 for Hertz–Mindlin, 10 with a rolling spring): ``i``,
 ``j`` int32 (8), ``history`` float64 (8 W), ``dissipation`` float32 (16), ``normal_force`` (8),
 ``state`` int8 (1): 81 B with W = 6. Forces and torques are not stored per pair: the pair
 passes add them straight into the particles' arrays (:mod:`thermodem.kernels.slabs`). The
