@@ -34,7 +34,7 @@ def radius(model: str, p, r_i, r_j, overlap, f_n=0.0, t_contact=0.0, v=0.0, m=0.
     return spec.kernel(p, r_i, r_j, r_i + r_j - overlap, overlap, f_n, t_contact, v, m)
 
 
-ROW0 = np.zeros(registry.PARAM_WIDTH)
+ROW0 = np.zeros(max(s.width for s in registry.all_models()))
 
 
 # ------------------------------------------------------------------------------ geometry

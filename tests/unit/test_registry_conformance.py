@@ -73,7 +73,7 @@ def parameter_rows(spec: registry.ModelSpec, rng: np.random.Generator) -> list[n
         spec.pack(params, resolve_pair(random_material(rng), random_material(rng)))
         for _ in range(4)
     ]
-    rows += [10 ** rng.uniform(-3, 3, registry.PARAM_WIDTH) for _ in range(4)]
+    rows += [10 ** rng.uniform(-3, 3, spec.width) for _ in range(4)]
     return rows
 
 
@@ -155,7 +155,7 @@ def test_dispatcher_equals_model_kernel(spec):
 
 
 def test_normal_dispatcher_rejects_unknown_id():
-    p = np.ones(registry.PARAM_WIDTH)
+    p = np.ones(max(s.width for s in registry.all_models()))
     unknown = max(s.model_id for s in specs("normal")) + 1
     out = dispatch.normal_dispatch(unknown, p, 1e-6, 0.1, 1e-3, 1e-3)
     assert all(math.isnan(x) for x in out)
@@ -174,9 +174,9 @@ SETTINGS = settings(max_examples=200, deadline=None, suppress_health_check=[Heal
     eff_mass=st.floats(1e-9, 10.0),
 )
 def test_hertz_force_is_energy_derivative(e_star, eff_radius, rel_overlap, alpha, eff_mass):
-    p = np.zeros(registry.PARAM_WIDTH)
-    p[0] = e_star
-    p[1] = alpha
+    p = np.zeros(len(normal.HERTZ_COLUMNS))
+    p[normal.HERTZ_E_STAR] = e_star
+    p[normal.HERTZ_ALPHA] = alpha
     delta = rel_overlap * eff_radius
     f_el, f_damp, _, _, _ = normal.hertz_force(p, delta, 0.0, eff_radius, eff_mass)
     assert f_damp == 0.0
@@ -192,9 +192,9 @@ def test_hertz_force_is_energy_derivative(e_star, eff_radius, rel_overlap, alpha
 @SETTINGS
 @given(stiffness=st.floats(1.0, 1e9), delta=st.floats(1e-9, 1e-2), zeta=st.floats(0.0, 1.0))
 def test_linear_force_is_energy_derivative(stiffness, delta, zeta):
-    p = np.zeros(registry.PARAM_WIDTH)
-    p[0] = stiffness
-    p[1] = zeta
+    p = np.zeros(len(normal.LINEAR_COLUMNS))
+    p[normal.LINEAR_STIFFNESS] = stiffness
+    p[normal.LINEAR_DAMPING_RATIO] = zeta
     f_el = normal.linear_force(p, delta, 0.0, 1e-3, 1e-3)[0]
     assert f_el == pytest.approx(stiffness * delta, rel=1e-15)
     h = 1e-4 * delta

@@ -125,7 +125,7 @@ def test_every_family_has_none_with_id_zero_and_unknown_ids_give_nan():
         assert registry.get(family, "none").model_id == 0
         ids = [registry.get(family, n).model_id for n in registry.names(family)]
         assert sorted(ids) == list(range(len(ids)))
-    p = np.zeros(registry.PARAM_WIDTH)
+    p = np.zeros(max(s.width for s in registry.all_models()))
     unknown = len(registry.names("contact_radius"))
     assert math.isnan(contact_radius_dispatch(unknown, p, 1e-3, 1e-3, 2e-3, 1e-6, 1.0, 0, 0, 1e-5))
     unknown = len(registry.names("direct_conduction"))

@@ -54,6 +54,7 @@ from thermodem.kernels.integrate import (
     reset_forces,
     sum_rows,
 )
+from thermodem.models import registry
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
 from thermodem.state.heat import HEAT_MECHANISMS
 from thermodem.state.history import HistoryLayout, layout_for
@@ -131,8 +132,9 @@ class Simulation:
         self.wall_material = self.wall_rows[:, WL.COL_MATERIAL].astype(np.int32)
         self.wall_reference = self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3].copy()
         # thermal engine (absent = mechanics only)
-        z1, z3 = np.zeros(0), np.zeros((1, 1, 16))
-        z2 = np.zeros((1, 16))
+        width = max(spec.width for spec in registry.all_models())  # any row fits
+        z1, z3 = np.zeros(0), np.zeros((1, 1, width))
+        z2 = np.zeros((1, width))
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
         self._no_heat = (
             (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),

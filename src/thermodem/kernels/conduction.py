@@ -21,7 +21,13 @@ from numba.extending import overload
 
 from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
-from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch
+from thermodem.models.thermal.direct_conduction import (
+    K_I,
+    K_J,
+    RHOC_I,
+    RHOC_J,
+    direct_conduction_dispatch,
+)
 
 _INLINE: dict[tuple[str, int], Any] = {}
 
@@ -94,9 +100,9 @@ def pair_conductance(
 
     Every direct-conduction model of the spec is linear in T_j - T_i, so Q = H (T_j - T_i).
     The contact radius model is evaluated for touching pairs only (r_c = 0 otherwise). With
-    ``override`` > 0 the conductivity columns (0, 1) of the model's row are replaced by the
-    current k(T) of the two bodies, with ``override`` > 1 also the heat capacity columns (2, 3)
-    by ρ c(T); ``row`` is the scratch row used for that.
+    ``override`` > 0 the conductivity columns (``k_i``, ``k_j``) of the model's row are replaced
+    by the current k(T) of the two bodies, with ``override`` > 1 also the heat capacity columns
+    (``rhoc_i``, ``rhoc_j``) by ρ c(T); ``row`` is the scratch row used for that.
     """
     r_c = 0.0
     if overlap > 0.0:
@@ -105,11 +111,11 @@ def pair_conductance(
     if override > 0:
         for q in range(p_conduction.shape[0]):
             row[q] = p_conduction[q]
-        row[0] = k_i
-        row[1] = k_j
+        row[K_I] = k_i
+        row[K_J] = k_j
         if override > 1:
-            row[2] = rhoc_i
-            row[3] = rhoc_j
+            row[RHOC_I] = rhoc_i
+            row[RHOC_J] = rhoc_j
         p = row
     return rate_of(conduction_id, p, 0.0, 1.0, ri, rj, dist, overlap, r_c, f_n, duration, v_imp,
                    m_eff)  # fmt: skip

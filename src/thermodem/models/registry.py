@@ -43,10 +43,6 @@ FAMILIES: tuple[str, ...] = (
     "heat_source",
 )
 
-#: Width of a packed parameter row of a model that does not name its columns (the mechanics
-#: families; their rows are padded with zeros to this width).
-PARAM_WIDTH = 16
-
 #: Where a thermal term runs (see ``docs/architecture.md``, "Heat terms on pair sets"):
 #: ``contacts`` touching pairs of the contact list, ``range`` every pair whose surface gap is
 #: within the model's interaction range (touching pairs included), ``external`` a pair set
@@ -72,7 +68,7 @@ class ModelSpec:
     interaction_range: Callable[..., float] | None = None
     antisymmetric: bool = True
     uses_gas: tuple[str, ...] = ()
-    columns: tuple[str, ...] | None = None
+    columns: tuple[str, ...] = ()
     swap_pairs: tuple[tuple[int, int], ...] = ()
     target: str = "contacts"
     symmetric: bool = False
@@ -83,13 +79,13 @@ class ModelSpec:
 
     @property
     def width(self) -> int:
-        """Width of the packed parameter row: the named columns (at least 1; a model without
-        parameters packs one zero), or PARAM_WIDTH for a model that names no columns."""
-        return PARAM_WIDTH if self.columns is None else max(len(self.columns), 1)
+        """Width of the packed parameter row: its named columns (at least 1: a model without
+        parameters packs one zero)."""
+        return max(len(self.columns), 1)
 
     def column(self, name: str) -> int:
         """Index of the named column of the packed row (KeyError naming the columns)."""
-        if self.columns is None or name not in self.columns:
+        if name not in self.columns:
             raise KeyError(f"{self.family}.{self.name} has no column {name!r}: {self.columns}")
         return self.columns.index(name)
 
@@ -113,7 +109,7 @@ def register(
     interaction_range: Callable[..., float] | None = None,
     antisymmetric: bool = True,
     uses_gas: tuple[str, ...] = (),
-    columns: tuple[str, ...] | None = None,
+    columns: tuple[str, ...] = (),
     swap_pairs: tuple[tuple[int, int], ...] = (),
     target: str = "contacts",
     symmetric: bool = False,
@@ -150,7 +146,7 @@ def register(
     if target not in TARGETS:
         raise ValueError(f"{family}.{name}: target {target!r} is not one of {TARGETS}")
     for a, b in swap_pairs:
-        if columns is not None and not (0 <= a < len(columns) and 0 <= b < len(columns)):
+        if not (0 <= a < len(columns) and 0 <= b < len(columns)):
             raise ValueError(f"{family}.{name}: swap pair {(a, b)} outside columns {columns}")
     spec = ModelSpec(
         family=family,
@@ -167,7 +163,7 @@ def register(
         interaction_range=interaction_range,
         antisymmetric=antisymmetric,
         uses_gas=tuple(uses_gas),
-        columns=None if columns is None else tuple(columns),
+        columns=tuple(columns),
         swap_pairs=tuple((int(a), int(b)) for a, b in swap_pairs),
         target=target,
         symmetric=symmetric,
@@ -229,14 +225,3 @@ def packed(columns: tuple[str, ...], values: dict[str, float]) -> np.ndarray:
         raise ValueError(f"row of columns {columns}: missing {missing}, unknown {unknown}")
     row = np.array([float(values[c]) for c in columns], dtype=np.float64)
     return row if row.size else np.zeros(1)
-
-
-def pad_row(values: list[float] | tuple[float, ...] | np.ndarray) -> np.ndarray:
-    """A float64 parameter row of width PARAM_WIDTH from the first values (models without
-    named columns)."""
-    row = np.zeros(PARAM_WIDTH, dtype=np.float64)
-    values = np.asarray(values, dtype=np.float64)
-    if values.size > PARAM_WIDTH:
-        raise ValueError(f"parameter row of {values.size} values exceeds {PARAM_WIDTH}")
-    row[: values.size] = values
-    return row

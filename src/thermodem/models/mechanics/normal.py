@@ -28,11 +28,17 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
-from thermodem.models.registry import pad_row, register
+from thermodem.models.registry import packed, register
 from thermodem.state.materials import PairContext
 
 HERTZ = 1
 LINEAR = 2
+
+#: Parameter row columns (named; ``register(columns=...)`` sets the row width).
+HERTZ_COLUMNS = ("effective_youngs_modulus", "damping_factor")
+HERTZ_E_STAR, HERTZ_ALPHA = 0, 1
+LINEAR_COLUMNS = ("stiffness", "damping_ratio")
+LINEAR_STIFFNESS, LINEAR_DAMPING_RATIO = 0, 1
 
 
 # ----------------------------------------------------------------------------------- Hertz
@@ -129,13 +135,19 @@ def _alpha_of_restitution(restitution: float) -> float:
 
 
 def pack_hertz(params: HertzParams, pair: PairContext) -> np.ndarray:
-    return pad_row([pair.effective_youngs_modulus, hertz_alpha_of_restitution(pair.restitution)])
+    return packed(
+        HERTZ_COLUMNS,
+        {
+            "effective_youngs_modulus": pair.effective_youngs_modulus,
+            "damping_factor": hertz_alpha_of_restitution(pair.restitution),
+        },
+    )
 
 
 @njit(cache=True, error_model="numpy")
 def hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass):
-    e_star = p[0]
-    alpha = p[1]
+    e_star = p[HERTZ_E_STAR]
+    alpha = p[HERTZ_ALPHA]
     k_hz = 4.0 / 3.0 * e_star * math.sqrt(eff_radius)
     root = math.sqrt(overlap)
     secant = k_hz * root  # F_el / δ
@@ -168,13 +180,16 @@ def linear_damping_ratio(restitution: float) -> float:
 
 
 def pack_linear(params: LinearParams, pair: PairContext) -> np.ndarray:
-    return pad_row([params.stiffness, linear_damping_ratio(pair.restitution)])
+    return packed(
+        LINEAR_COLUMNS,
+        {"stiffness": params.stiffness, "damping_ratio": linear_damping_ratio(pair.restitution)},
+    )
 
 
 @njit(cache=True, error_model="numpy")
 def linear_force(p, overlap, overlap_rate, eff_radius, eff_mass):
-    k = p[0]
-    gamma = 2.0 * p[1] * math.sqrt(eff_mass * k)
+    k = p[LINEAR_STIFFNESS]
+    gamma = 2.0 * p[LINEAR_DAMPING_RATIO] * math.sqrt(eff_mass * k)
     return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
 
 
@@ -185,6 +200,7 @@ register(
     kernel=hertz_force,
     params=HertzParams,
     pack=pack_hertz,
+    columns=HERTZ_COLUMNS,
     summary="Hertz elastic force with Tsuji (1992) δ^1/4 damping calibrated to the restitution",
     reference="Hertz (1882); Tsuji, Tanaka & Ishida (1992) Powder Technol. 71, 239-250",
     requires=("youngs_modulus", "poisson_ratio", "restitution"),
@@ -196,6 +212,7 @@ register(
     kernel=linear_force,
     params=LinearParams,
     pack=pack_linear,
+    columns=LINEAR_COLUMNS,
     summary="linear spring-dashpot with the exact restitution-damping relation",
     reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
     requires=("restitution",),

@@ -23,12 +23,18 @@ from pydantic import Field
 
 from thermodem.config.base import StrictModel
 from thermodem.models.mechanics.tangential import _TINY_SQUARE
-from thermodem.models.registry import pad_row, register
+from thermodem.models.registry import packed, register
 from thermodem.state.materials import PairContext
 
 NONE = 0
 CONSTANT_TORQUE = 1
 EPSD = 2
+
+#: Parameter row columns (named; ``register(columns=...)`` sets the row width).
+CONSTANT_COLUMNS = ("rolling_friction", "angular_velocity_threshold")
+CONSTANT_MU_R, CONSTANT_THRESHOLD = 0, 1
+EPSD_COLUMNS = ("rolling_friction", "damping_ratio", "plastic_damping_factor")
+EPSD_MU_R, EPSD_DAMPING_RATIO, EPSD_PLASTIC_DAMPING = 0, 1, 2
 
 
 class NoneParams(StrictModel):
@@ -36,7 +42,7 @@ class NoneParams(StrictModel):
 
 
 def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
-    return pad_row([])
+    return packed((), {})
 
 
 @njit(cache=True, error_model="numpy")
@@ -60,7 +66,13 @@ class ConstantTorqueParams(StrictModel):
 
 
 def pack_constant(params: ConstantTorqueParams, pair: PairContext) -> np.ndarray:
-    return pad_row([pair.rolling_friction, params.angular_velocity_threshold])
+    return packed(
+        CONSTANT_COLUMNS,
+        {
+            "rolling_friction": pair.rolling_friction,
+            "angular_velocity_threshold": params.angular_velocity_threshold,
+        },
+    )
 
 
 @njit(cache=True, error_model="numpy")
@@ -68,9 +80,9 @@ def constant_torque(
     p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz, mx, my, mz, dt
 ):
     w = math.sqrt(wx * wx + wy * wy + wz * wz)
-    if w <= p[1] or normal_force <= 0.0:
+    if w <= p[CONSTANT_THRESHOLD] or normal_force <= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    mag = p[0] * eff_radius * normal_force
+    mag = p[CONSTANT_MU_R] * eff_radius * normal_force
     return -mag * wx / w, -mag * wy / w, -mag * wz / w, 0.0, 0.0, 0.0, 0.0, mag * w * dt
 
 
@@ -89,7 +101,14 @@ class EPSDParams(StrictModel):
 
 
 def pack_epsd(params: EPSDParams, pair: PairContext) -> np.ndarray:
-    return pad_row([pair.rolling_friction, params.damping_ratio, params.plastic_damping_factor])
+    return packed(
+        EPSD_COLUMNS,
+        {
+            "rolling_friction": pair.rolling_friction,
+            "damping_ratio": params.damping_ratio,
+            "plastic_damping_factor": params.plastic_damping_factor,
+        },
+    )
 
 
 @njit(cache=True, error_model="numpy")
@@ -99,9 +118,9 @@ def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz
     rotation: ½ (M0 + M) · (M1 - M) / k_r with M0, M1, M the stored, trial and capped torques
     (docs/architecture.md, "Work of the tangential force"; the rolling spring is the same
     algebra with M = -k_r θ)."""
-    mu_r = p[0]
+    mu_r = p[EPSD_MU_R]
     k_r = 2.25 * ref_stiffness * mu_r * mu_r * eff_radius * eff_radius
-    c_r = p[1] * 2.0 * math.sqrt(rolling_inertia * k_r)
+    c_r = p[EPSD_DAMPING_RATIO] * 2.0 * math.sqrt(rolling_inertia * k_r)
     m_lim = mu_r * eff_radius * max(normal_force, 0.0)
     w2 = wx * wx + wy * wy + wz * wz
     # elastic part: incremental rotation of the spring
@@ -120,7 +139,7 @@ def epsd(p, ref_stiffness, eff_radius, rolling_inertia, normal_force, wx, wy, wz
     nx = scale * tx
     ny = scale * ty
     nz = scale * tz
-    damp = p[2] * c_r
+    damp = p[EPSD_PLASTIC_DAMPING] * c_r
     dissipated = damp * w2 * dt
     if k_r > 0.0:
         dissipated += (
@@ -136,6 +155,7 @@ register(
     kernel=no_rolling,
     params=NoneParams,
     pack=pack_none,
+    columns=(),
     summary="no rolling resistance",
     reference="-",
 )
@@ -146,6 +166,7 @@ register(
     kernel=constant_torque,
     params=ConstantTorqueParams,
     pack=pack_constant,
+    columns=CONSTANT_COLUMNS,
     summary="constant directional torque μ_r R* F_n opposing relative rolling",
     reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model A); Zhou et al. (1999)",
     requires=("rolling_friction",),
@@ -157,6 +178,7 @@ register(
     kernel=epsd,
     params=EPSDParams,
     pack=pack_epsd,
+    columns=EPSD_COLUMNS,
     summary="elastic-plastic spring-dashpot rolling torque (model C)",
     reference="Ai et al. (2011) Powder Technol. 206, 269-282 (model C); Iwashita & Oda (1998)",
     requires=("rolling_friction",),

@@ -34,12 +34,18 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
-from thermodem.models.registry import pad_row, register
+from thermodem.models.registry import packed, register
 from thermodem.state.materials import PairContext
 
 NONE = 0
 MINDLIN = 1
 LINEAR = 2
+
+#: Parameter row columns (named; ``register(columns=...)`` sets the row width).
+MINDLIN_COLUMNS = ("effective_shear_modulus", "sliding_friction")
+MINDLIN_G_STAR, MINDLIN_FRICTION = 0, 1
+LINEAR_COLUMNS = ("stiffness_ratio", "sliding_friction")
+LINEAR_STIFFNESS_RATIO, LINEAR_FRICTION = 0, 1
 
 
 #: Squares below this lose precision (subnormal near 1e-308): compared by their roots.
@@ -103,7 +109,7 @@ class NoneParams(StrictModel):
 
 
 def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
-    return pad_row([])
+    return packed((), {})
 
 
 @njit(cache=True, error_model="numpy")
@@ -136,7 +142,13 @@ class MindlinParams(StrictModel):
 
 
 def pack_mindlin(params: MindlinParams, pair: PairContext) -> np.ndarray:
-    return pad_row([pair.effective_shear_modulus, pair.sliding_friction])
+    return packed(
+        MINDLIN_COLUMNS,
+        {
+            "effective_shear_modulus": pair.effective_shear_modulus,
+            "sliding_friction": pair.sliding_friction,
+        },
+    )
 
 
 @njit(cache=True, error_model="numpy")
@@ -155,9 +167,10 @@ def mindlin(
     sz,
     dt,
 ):
-    k_t = 8.0 * p[0] * math.sqrt(eff_radius * overlap)
+    k_t = 8.0 * p[MINDLIN_G_STAR] * math.sqrt(eff_radius * overlap)
     gamma_t = normal_damping * math.sqrt(k_t / ref_stiffness) if ref_stiffness > 0.0 else 0.0
-    return _spring_dashpot_capped(k_t, gamma_t, p[1], normal_force, vtx, vty, vtz, sx, sy, sz, dt)
+    mu = p[MINDLIN_FRICTION]
+    return _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy, sz, dt)
 
 
 # ---------------------------------------------------------------------------------- linear
@@ -173,7 +186,10 @@ class LinearTangentialParams(StrictModel):
 
 
 def pack_linear(params: LinearTangentialParams, pair: PairContext) -> np.ndarray:
-    return pad_row([params.stiffness_ratio, pair.sliding_friction])
+    return packed(
+        LINEAR_COLUMNS,
+        {"stiffness_ratio": params.stiffness_ratio, "sliding_friction": pair.sliding_friction},
+    )
 
 
 @njit(cache=True, error_model="numpy")
@@ -192,9 +208,11 @@ def linear_tangential(
     sz,
     dt,
 ):
-    k_t = p[0] * ref_stiffness
-    gamma_t = normal_damping * math.sqrt(p[0])
-    return _spring_dashpot_capped(k_t, gamma_t, p[1], normal_force, vtx, vty, vtz, sx, sy, sz, dt)
+    ratio = p[LINEAR_STIFFNESS_RATIO]
+    k_t = ratio * ref_stiffness
+    gamma_t = normal_damping * math.sqrt(ratio)
+    mu = p[LINEAR_FRICTION]
+    return _spring_dashpot_capped(k_t, gamma_t, mu, normal_force, vtx, vty, vtz, sx, sy, sz, dt)
 
 
 _COMMON = dict(history_width=3, history_flip=(True, True, True))
@@ -205,6 +223,7 @@ register(
     kernel=no_tangential,
     params=NoneParams,
     pack=pack_none,
+    columns=(),
     summary="no tangential force",
     reference="-",
     history_width=0,
@@ -217,6 +236,7 @@ register(
     kernel=mindlin,
     params=MindlinParams,
     pack=pack_mindlin,
+    columns=MINDLIN_COLUMNS,
     summary="Mindlin no-slip stiffness 8G*sqrt(R*δ), Coulomb cap, history rescaled",
     reference="Mindlin (1949) J. Appl. Mech. 16, 259-268; Di Renzo & Di Maio (2004)",
     requires=("youngs_modulus", "poisson_ratio", "sliding_friction"),
@@ -229,6 +249,7 @@ register(
     kernel=linear_tangential,
     params=LinearTangentialParams,
     pack=pack_linear,
+    columns=LINEAR_COLUMNS,
     summary="linear tangential spring k_t = r k_n, Coulomb cap, history rescaled",
     reference="Cundall & Strack (1979) Geotechnique 29, 47-65",
     requires=("sliding_friction",),

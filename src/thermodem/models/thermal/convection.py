@@ -63,6 +63,14 @@ WHITAKER = 3
 GUNN = 4
 LI_MASON = 5
 
+#: Parameter row columns (named; ``register(columns=...)`` sets the row width).
+STAGNANT_COLUMNS = ("nusselt",)
+COL_NUSSELT = 0
+REYNOLDS_COLUMNS = ("superficial",)  # Ranz–Marshall, Whitaker, Gunn
+COL_SUPERFICIAL = 0  # 1: Re from the superficial velocity ε |u_f - v_p|
+LI_MASON_COLUMNS = ("superficial", "exponent")
+COL_EXPONENT = 1
+
 #: Li & Mason (2000): the porosity exponent m of each regime.
 LI_MASON_EXPONENT = {"dilute": 3.50, "dense": 4.75}
 
@@ -146,7 +154,7 @@ class LiMasonParams(FlowParams):
 
 
 def _flow_row(params: FlowParams) -> np.ndarray:
-    return packed(("superficial",), {"superficial": RE_VELOCITY[params.reynolds_velocity]})
+    return packed(REYNOLDS_COLUMNS, {"superficial": RE_VELOCITY[params.reynolds_velocity]})
 
 
 def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
@@ -154,7 +162,7 @@ def pack_none(params: NoneParams, pair: PairContext) -> np.ndarray:
 
 
 def pack_stagnant(params: StagnantParams, pair: PairContext) -> np.ndarray:
-    return packed(("nusselt",), {"nusselt": params.nusselt})
+    return packed(STAGNANT_COLUMNS, {"nusselt": params.nusselt})
 
 
 def pack_flow(params: FlowParams, pair: PairContext) -> np.ndarray:
@@ -166,7 +174,7 @@ def pack_li_mason(params: LiMasonParams, pair: PairContext) -> np.ndarray:
         "superficial": RE_VELOCITY[params.reynolds_velocity],
         "exponent": LI_MASON_EXPONENT[params.regime],
     }
-    return packed(("superficial", "exponent"), values)
+    return packed(LI_MASON_COLUMNS, values)
 
 
 # ---------------------------------------------------------------------- Nusselt numbers
@@ -208,9 +216,9 @@ def nusselt_li_mason(re, pr_cbrt, eps, m):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def reynolds(p, r_i, fields, i):
-    """Re = ρ_f v 2R / μ_f, v = |u_f - v_p| (times ε with p[0] = 1: superficial)."""
+    """Re = ρ_f v 2R / μ_f, v = |u_f - v_p| (times ε with the column ``superficial`` = 1)."""
     speed = fields[i, F_RELATIVE_SPEED]
-    if p[0] != 0.0:
+    if p[COL_SUPERFICIAL] != 0.0:
         speed *= fields[i, F_POROSITY]
     return fields[i, F_FLUID_DENSITY] * speed * 2.0 * r_i / fields[i, F_FLUID_VISCOSITY]
 
@@ -228,9 +236,11 @@ def convection_nusselt(model_id, p, r_i, fields, i):
         return nusselt_whitaker(reynolds(p, r_i, fields, i), fields[i, F_PRANDTL], ratio)
     if model_id == LI_MASON:
         re = reynolds(p, r_i, fields, i)
-        return nusselt_li_mason(re, fields[i, F_PRANDTL_CBRT], fields[i, F_POROSITY], p[1])
+        return nusselt_li_mason(
+            re, fields[i, F_PRANDTL_CBRT], fields[i, F_POROSITY], p[COL_EXPONENT]
+        )
     if model_id == STAGNANT:
-        return p[0]
+        return p[COL_NUSSELT]
     if model_id == NONE:
         return 0.0
     return np.nan
@@ -349,7 +359,7 @@ register(
     pack=pack_stagnant,
     summary="stagnant fluid: Nu = 2, Q = 4π R k_f (T_f − T)",
     reference="spec 'Stagnant fluid around DEM particles'",
-    columns=("nusselt",),
+    columns=STAGNANT_COLUMNS,
 )
 register(
     **_COMMON,
@@ -360,7 +370,7 @@ register(
     pack=pack_flow,
     summary="Nu = 2 + 0.6 Re^½ Pr^⅓ (single sphere; Re 1–1e4, Pr 0.6–380)",
     reference="Ranz & Marshall (1952) Chem. Eng. Prog. 48:141-146, 173-180",
-    columns=("superficial",),
+    columns=REYNOLDS_COLUMNS,
 )
 register(
     **_COMMON,
@@ -371,7 +381,7 @@ register(
     pack=pack_flow,
     summary="Nu = 2 + (0.4 Re^½ + 0.06 Re^⅔) Pr^0.4 (μ_f/μ_fs)^¼ (Re 3.5–7.6e4, Pr 0.71–380)",
     reference="Whitaker (1972) AIChE J. 18:361-371",
-    columns=("superficial",),
+    columns=REYNOLDS_COLUMNS,
 )
 register(
     **_COMMON,
@@ -383,7 +393,7 @@ register(
     summary="Nu = (7 − 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 − 2.4ε + 1.2ε²) Re^0.7 Pr^⅓ "
     "(local porosity ε; Re < 1e5, Ra < 1e9)",
     reference="Gunn (1978) Int. J. Heat Mass Transfer 21:467-476",
-    columns=("superficial",),
+    columns=REYNOLDS_COLUMNS,
 )
 register(
     **_COMMON,
@@ -395,5 +405,5 @@ register(
     summary="Nu = 2 + ε^m (...) by Re regime (< 200, < 1500, ≥ 1500); m = 4.75 dense, 3.50 "
     "dilute (Pr 0.7–1, ε 0.35–1)",
     reference="Li & Mason (2000) Powder Technol. 112:273-282",
-    columns=("superficial", "exponent"),
+    columns=LI_MASON_COLUMNS,
 )

@@ -46,7 +46,7 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
-from thermodem.models.registry import pad_row, register
+from thermodem.models.registry import packed, register
 from thermodem.models.thermal.contact_radius import effective_radius, require
 from thermodem.models.thermal.erfcinv import (  # noqa: F401 (the first two: re-exported)
     erfcinv,
@@ -59,10 +59,40 @@ from thermodem.state.materials import PairContext, effective_youngs_modulus
 
 RESISTANCE_NETWORK = 9
 
-# Columns of the parameter row (PARAM_WIDTH = 16) that the positional list in pack does not
-# name: how P_0 is computed, and the factor of the overlap form.
-COL_P0_MODE = 12  # P0_FORCE or P0_OVERLAP
-COL_P0_OVERLAP_FACTOR = 13  # (2/π) E*_real (E*/E*_real)^{2/3} [Pa]: P_0 = factor δ / r_c
+#: Columns of the parameter row: the direct_conduction family's head (k_i, k_j, ρc_i, ρc_j;
+#: the k(T) override replaces them), then the network's own.
+COLUMNS = (
+    "k_i",
+    "k_j",
+    "rhoc_i",
+    "rhoc_j",
+    "e_star",  # E* of the simulation [Pa]
+    "zhou_correction",  # c = (E*/E*_real)^(1/5) [-]
+    "microhardness",  # H' of the pair [Pa]
+    "surface_roughness",  # σ of the pair [m]
+    "surface_slope",  # τ of the pair [-]
+    "k_gas",  # k_g [W/(m K)]
+    "gas_parameter",  # M [m]
+    "packing_constant",  # B / r_h [-]
+    "p0_mode",  # P0_FORCE or P0_OVERLAP
+    "p0_overlap_factor",  # (2/π) E*_real (E*/E*_real)^{2/3} [Pa]: P_0 = factor δ / r_c
+)
+(
+    COL_K_I,
+    COL_K_J,
+    _,
+    _,
+    COL_E_STAR,
+    COL_ZHOU_CORRECTION,
+    COL_MICROHARDNESS,
+    COL_SIGMA,
+    COL_TAU,
+    COL_K_GAS,
+    COL_GAS_PARAMETER,
+    COL_PACKING_CONSTANT,
+    COL_P0_MODE,
+    COL_P0_OVERLAP_FACTOR,
+) = range(len(COLUMNS))
 P0_FORCE = 0.0
 P0_OVERLAP = 1.0
 
@@ -216,14 +246,14 @@ def resistance_network_conductance(
 def resistance_network_rate(
     p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff
 ):
-    """Heat rate into i [W]. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M, B/r_h, P_0 mode,
-    P_0 overlap factor]."""
+    """Heat rate into i [W]; the row's columns are :data:`COLUMNS`."""
     if overlap <= 0.0:
         return 0.0
     p0_overlap = p[COL_P0_OVERLAP_FACTOR] if p[COL_P0_MODE] == P0_OVERLAP else 0.0
     h = network_conductance(
-        p[0], p[1], r_i, r_j, max(f_n, 0.0), p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11],
-        overlap, p0_overlap,
+        p[COL_K_I], p[COL_K_J], r_i, r_j, max(f_n, 0.0), p[COL_E_STAR], p[COL_ZHOU_CORRECTION],
+        p[COL_MICROHARDNESS], p[COL_SIGMA], p[COL_TAU], p[COL_K_GAS], p[COL_GAS_PARAMETER],
+        p[COL_PACKING_CONSTANT], overlap, p0_overlap,
     )  # fmt: skip
     return h * (t_j - t_i)
 
@@ -236,9 +266,7 @@ class ResistanceNetworkParams(StrictModel):
     ``packing_constant`` is B/r_h (the spec's B is a length; B = 0 for simple cubic packing,
     B/r_h in [0, 2)). The gas is the case's ``thermal.gas`` (``pair.gas``). Materials need
     thermal_conductivity, microhardness, surface_roughness, surface_slope and
-    thermal_accommodation; a wall material too. Row: [k_i, k_j, 0, 0, E*, c, H', σ, τ, k_g, M,
-    B/r_h, P_0 mode (column COL_P0_MODE = 12: P0_FORCE 0 or P0_OVERLAP 1), P_0 overlap factor
-    (COL_P0_OVERLAP_FACTOR = 13: (2/π) E*_real (E*/E*_real)^{2/3} [Pa])].
+    thermal_accommodation; a wall material too. The packed row's columns are :data:`COLUMNS`.
 
     ``maximum_pressure``: ``force`` P_0 = 3 F_n/(2π r_c²) (default; allows
     thermal.conductance_force_tolerance), ``overlap`` P_0 = 2 E*_real δ (E*/E*_real)^{2/3} /
@@ -282,23 +310,24 @@ def pack_resistance_network(params: ResistanceNetworkParams, pair: PairContext) 
     e_real = effective_youngs_modulus(mi, mj, real=True) if real else e_sim
     c = (e_sim / e_real) ** 0.2
     overlap_mode = params.maximum_pressure == "overlap"
-    return pad_row(
-        [
-            k_i,
-            k_j,
-            0.0,
-            0.0,
-            e_sim,
-            c,
-            2.0 * h_i * h_j / (h_i + h_j),
-            sigma,
-            tau,
-            pair.gas.thermal_conductivity,
-            gas_parameter(a_i, a_j, pair.gas),
-            params.packing_constant,
-            P0_OVERLAP if overlap_mode else P0_FORCE,  # COL_P0_MODE
-            2.0 / math.pi * e_real * (e_sim / e_real) ** (2.0 / 3.0),  # COL_P0_OVERLAP_FACTOR
-        ]
+    return packed(
+        COLUMNS,
+        {
+            "k_i": k_i,
+            "k_j": k_j,
+            "rhoc_i": 0.0,
+            "rhoc_j": 0.0,
+            "e_star": e_sim,
+            "zhou_correction": c,
+            "microhardness": 2.0 * h_i * h_j / (h_i + h_j),
+            "surface_roughness": sigma,
+            "surface_slope": tau,
+            "k_gas": pair.gas.thermal_conductivity,
+            "gas_parameter": gas_parameter(a_i, a_j, pair.gas),
+            "packing_constant": params.packing_constant,
+            "p0_mode": P0_OVERLAP if overlap_mode else P0_FORCE,
+            "p0_overlap_factor": 2.0 / math.pi * e_real * (e_sim / e_real) ** (2.0 / 3.0),
+        },
     )
 
 
@@ -320,6 +349,7 @@ register(
     kernel=resistance_network_rate,
     params=ResistanceNetworkParams,
     pack=pack_resistance_network,
+    columns=COLUMNS,
     summary="Beaulieu (2020) contact/microcontact/gas-gap/solid-layer resistance network",
     reference="Beaulieu (2020) PhD thesis, Polytechnique Montréal; Bahrami, Yovanovich & Culham "
     "(2006) Int. J. Heat Mass Transf. 49, 3691-3701; Batchelor & O'Brien (1977)",
