@@ -7,7 +7,9 @@
   smallest particles of each material pair (and particle–wall, m* = m, R* = R) at the
   characteristic impact speed v. Warn when a collision would last fewer than
   ``collision_warn_steps`` steps, refuse below ``collision_min_steps``.
-  For the linear spring the collision time is π sqrt(m*/k) / sqrt(1 - ζ²) instead.
+  For the linear spring the collision time is π sqrt(m*/k) / sqrt(1 - ζ²) instead, for
+  Walton & Braun's law (π/2) (sqrt(m*/k1) + sqrt(m*/k2)), k2 = k1/e² (its loading and
+  unloading half periods).
 
 ``allow_unstable: true`` turns refusals into warnings.
 """
@@ -80,6 +82,10 @@ def critical_times(
                 k = normal.params.stiffness
                 zeta = linear_damping_ratio(resolve_pair(ma, mb).restitution)
                 tc = math.pi * math.sqrt(m_eff / k) / math.sqrt(max(1.0 - zeta**2, 1e-12))
+            elif normal.model == "walton_braun":
+                k1 = normal.params.loading_stiffness
+                e = max(resolve_pair(ma, mb).restitution, 1e-6)
+                tc = 0.5 * math.pi * (math.sqrt(m_eff / k1) + e * math.sqrt(m_eff / k1))
             else:
                 tc = hertz_collision_time(m_eff, r_eff, effective_youngs_modulus(ma, mb), v)
             out["collision"] = min(out["collision"], tc)

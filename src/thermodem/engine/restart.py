@@ -14,7 +14,7 @@ The state is a plain nested dict, which :mod:`thermodem.io.checkpoint` writes to
                     material_names, history_width, history_layout, pair_capacity,
                     wall_pair_capacity},
       "particles": {every Particles array, in the current memory order},
-      "pairs":     {i, j, history, dissipation, normal_force, state: the first `count` rows;
+      "pairs":     {i, j, history, normal_force, state: the first `count` rows;
                     group_start: the slab groups of the list},
       "walls":     {the same for particle-wall pairs},
       "arrays":    {wall_row_start, reference, wall_reference, wall_rows, elastic},
@@ -67,7 +67,6 @@ PAIR_ARRAYS: tuple[str, ...] = (
     "i",
     "j",
     "history",
-    "dissipation",
     "normal_force",
     "state",
 )
@@ -104,6 +103,8 @@ DERIVED: tuple[str, ...] = (
     "callbacks",
     "chunk_check",
     "_no_heat",
+    "_no_generation",
+    "generation",
     "mechanisms",
     "history_layout",
     # the thread count: the new process's request or choice (results do not depend on it)

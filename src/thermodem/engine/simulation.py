@@ -56,7 +56,7 @@ from thermodem.kernels.integrate import (
 )
 from thermodem.models import registry
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
-from thermodem.state.heat import HEAT_MECHANISMS
+from thermodem.state.heat import GENERATION, HEAT_MECHANISMS
 from thermodem.state.history import HistoryLayout, layout_for
 from thermodem.state.pairs import PairBuffers
 from thermodem.state.particles import Particles
@@ -66,13 +66,23 @@ LEDGER_DISSIPATION = (
     "tangential_damping",
     "sliding_friction",
     "rolling_friction",
+    "plastic_deformation",
+)
+#: ledger columns of the dissipation mechanisms, in the order of LEDGER_DISSIPATION
+_DISSIPATION_COLUMNS = (
+    C.L_NORMAL_DAMPING,
+    C.L_TANGENTIAL_DAMPING,
+    C.L_SLIDING_FRICTION,
+    C.L_ROLLING_FRICTION,
+    C.L_PLASTIC_DEFORMATION,
 )
 
 
 def history_layout_of(case: Case) -> HistoryLayout:
     """The contact history columns of a case: the registered history widths of its normal,
-    tangential and rolling laws, and the conductance reuse's block when
-    ``thermal.conductance_force_tolerance`` > 0 (state/history.py)."""
+    tangential and rolling laws, the conductance reuse's block when
+    ``thermal.conductance_force_tolerance`` > 0, and the collision block of a heat generation
+    model that registers one (state/history.py)."""
     models = case.contact
     thermal = case.thermal
     return layout_for(
@@ -80,6 +90,7 @@ def history_layout_of(case: Case) -> HistoryLayout:
         models.tangential.spec.history_width,
         models.rolling.spec.history_width,
         reuse=thermal is not None and thermal.conductance_force_tolerance > 0.0,
+        collision=thermal is not None and thermal.heat_generation.spec.history_width > 0,
     )
 
 
@@ -136,19 +147,26 @@ class Simulation:
         z1, z3 = np.zeros(0), np.zeros((1, 1, width))
         z2 = np.zeros((1, width))
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
+        zm = np.zeros((1, len(HEAT_MECHANISMS)))
         self._no_heat = (
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, zm, z1, 0.0),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, zm, z1, 0.0),
         )
         self.thermal = None
         if case.thermal is not None:
             from thermodem.engine.thermal import ThermalEngine
 
             self.thermal = ThermalEngine(self, case.thermal)
+        # heat generation: per-particle accumulators of the dissipated energy (the contact
+        # passes add to them at every step; the thermal step turns them into heat)
+        self.generation = self.thermal is not None and self.thermal.generation.active
+        self._no_generation = (np.zeros((1, 0)), np.zeros(len(GENERATION)), np.zeros((1, 1, 2)))
         # particles
         self.mechanisms = len(HEAT_MECHANISMS) if self.thermal is not None else 0
         # constant external loads (engine/external_loads.py): two more particle arrays
-        self.particles = Particles.empty(self.mechanisms, external=bool(case.external_force))
+        self.particles = Particles.empty(
+            self.mechanisms, external=bool(case.external_force), generation=self.generation
+        )
         self.next_global_id = 0
         self.pourers: list[Pourer] = []
         if insert_particles:
@@ -186,6 +204,8 @@ class Simulation:
         self._needs_rebuild = True
         # ledger
         ledger_keys = ("stiffness_work", "wall_work", "external_work", "inserted_energy")
+        if self.generation:  # the kinetic energy lost in collisions, the walls' shares
+            ledger_keys += ("collision_energy_loss", *(f"wall_generation_{g}" for g in GENERATION))
         self.ledger_cumulative = dict.fromkeys((*LEDGER_DISSIPATION, *ledger_keys), 0.0)
         self.elastic = np.zeros(3)
         self.max_overlap_ratio = 0.0
@@ -248,6 +268,7 @@ class Simulation:
             temperature,
             mechanisms=self.mechanisms,
             external=bool(self.case.external_force),
+            generation=self.generation,
         )
         EL.assign(self.case, extra, self.material_index)
         if hasattr(self, "ledger_cumulative"):
@@ -289,11 +310,15 @@ class Simulation:
             # conduction evaluated in the contact pass, for the thermal step that follows
             th.prepare(self.time)
             pair_pass, wall_pass = PP.passes_for(
-                True, th.radius_id, th.conduction_id, th.override, layout
+                True, th.radius_id, th.conduction_id, th.override, layout, self.generation
             )
         else:
             pair_heat, wall_heat = self._no_heat
-            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout)
+            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, self.generation)
+        if self.generation:
+            gen = (True, p.generation_energy, th.generation.select, th.generation.partition)
+        else:
+            gen = (False, *self._no_generation)
         ngroups = pb.ngroups
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
@@ -310,15 +335,15 @@ class Simulation:
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, pb.i, pb.j, pb.group_start, pb.history, self.lower, self.upper,
             self.periodic, self.extra, dt, nid, self.normal_table, tid, self.tangential_table,
-            rid, self.rolling_table, p.force, p.torque, pb.dissipation, pb.normal_force,
-            pb.state, pb.ledger_rows(ngroups), *pair_heat, layout,
+            rid, self.rolling_table, p.force, p.torque, pb.normal_force, pb.state,
+            pb.ledger_rows(ngroups), *pair_heat, layout, *gen,
         )  # fmt: skip
         wall_pass(
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
             self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
-            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
-            wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout,
+            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.normal_force,
+            wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout, *gen,
         )  # fmt: skip
         if heat_due:  # the other heat terms of this state, so the rates are complete now
             th.after_contact_pass(self.time)
@@ -340,12 +365,14 @@ class Simulation:
         )
         if count_dissipation:
             cum = self.ledger_cumulative
-            cum["normal_damping"] += sums[C.L_NORMAL_DAMPING]
-            cum["tangential_damping"] += sums[C.L_TANGENTIAL_DAMPING]
-            cum["sliding_friction"] += sums[C.L_SLIDING_FRICTION]
-            cum["rolling_friction"] += sums[C.L_ROLLING_FRICTION]
+            for name, column in zip(LEDGER_DISSIPATION, _DISSIPATION_COLUMNS, strict=True):
+                cum[name] += sums[column]
             cum["stiffness_work"] += sums[C.L_STIFFNESS_WORK]
             cum["wall_work"] += sums[C.L_WALL_WORK]
+            if self.generation:
+                cum["collision_energy_loss"] += sums[C.L_COLLISION]
+                for g, name in enumerate(GENERATION):
+                    cum[f"wall_generation_{name}"] += sums[C.L_WALL_GENERATION + g]
 
     # -------------------------------------------------------------------------------- step
     def step(self) -> None:
@@ -485,6 +512,8 @@ class Simulation:
                 if k in LEDGER_DISSIPATION
             }
         )
+        if self.generation:  # kinetic energy lost in collisions (not a term of the balance)
+            out["collision_energy_loss"] = self.ledger_cumulative["collision_energy_loss"]
         out["stiffness_work"] = self.ledger_cumulative["stiffness_work"]
         out["wall_work"] = self.ledger_cumulative["wall_work"]
         out["external_work"] = self.ledger_cumulative.get("external_work", 0.0)

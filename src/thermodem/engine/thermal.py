@@ -37,12 +37,13 @@ from thermodem.engine.external_set import ExternalPairSet
 from thermodem.engine.fields import STATE_PREFIX as FIELDS_PREFIX
 from thermodem.engine.fields import FieldProvider
 from thermodem.engine.range_set import RangePairSet
-from thermodem.engine.terms import HeatTerm, build_terms
+from thermodem.engine.terms import HeatTerm, build_generation, build_terms
 from thermodem.engine.thermal_conditions import ThermalConditions
 from thermodem.engine.voronoi import INPUT_WIDTH, VoronoiProvider
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as field_kernels
+from thermodem.kernels import generation as generation_kernels
 from thermodem.kernels import heat_terms as passes
 from thermodem.kernels import thermal as kernels
 from thermodem.state import heat
@@ -51,7 +52,8 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
-SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty",
+SKIP = ("sim", "settings", "conditions", "contact", "terms", "generation", "range_set",
+        "external", "_empty",
         "_conditions_key", "field_provider", "fields", "voronoi", "external_wall_conductance",
         "external_stamp", "implicit", "record_conductances")  # fmt: skip
 #: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
@@ -84,6 +86,8 @@ class ThermalEngine:
         self.contact, self.terms = build_terms(
             case, names, meets, is_wall, lambda name: name in particle_mats
         )
+        #: heat generation by the mechanical dissipation (thermal.heat_generation)
+        self.generation = build_generation(case, names, meets, is_wall)
         self.radius_id = self.contact.radius_id
         self.conduction_id = self.contact.direct_id
         self.radius_table = self.contact.radius_table
@@ -167,6 +171,8 @@ class ThermalEngine:
             cols |= {t.column, t.wall_column} - {-1}
         if self.conditions.active:
             cols.add(heat.M_SOURCE)
+        if self.generation.active:
+            cols |= set(self.generation.columns)
         return sorted(cols)
 
     def _property_tables(self, case, names: list[str], particle_mats: set[str]) -> None:  # noqa: ANN001
@@ -406,9 +412,32 @@ class ThermalEngine:
             gap, wall_gap = max(gap, g), max(wall_gap, w)
         return gap, wall_gap
 
+    def thermal_dt(self) -> float:
+        """Length of the thermal step that the rates being evaluated are for [s]."""
+        if self.settings.frozen_mechanics:
+            return float(self.settings.time_step)
+        return self.substeps * self.sim.dt
+
+    def generation_rates(self) -> None:
+        """The heat generation columns: χ E / Δt_th from the particles' accumulated dissipated
+        energy E (kernels/generation.py); the thermal step clears E after using them."""
+        if not self.generation.active:
+            return
+        p = self.sim.particles
+        gen = self.generation
+        generation_kernels.generation_heat(p.generation_energy, gen.select,
+                                           gen.conversion_fraction, self.thermal_dt(),
+                                           p.heat_rate_by_mechanism)  # fmt: skip
+
+    def _generation_used(self) -> None:
+        """The thermal step applied the generated heat: clear the accumulators."""
+        if self.generation.active:
+            self.sim.particles.generation_energy[:] = 0.0
+
     def evaluate_terms(self, time: float) -> None:
         """Add the heat of every term other than the contact conduction (at this state and
-        ``time``; the per-particle fields are filled first)."""
+        ``time``; the per-particle fields are filled first), and the heat generation."""
+        self.generation_rates()
         if not self.terms:
             return
         sim = self.sim
@@ -623,6 +652,7 @@ class ThermalEngine:
         if self.implicit is not None:
             self.implicit.step(dt, time)
             self.thermal_steps += 1
+            self._generation_used()
             return
         sim = self.sim
         p = sim.particles
@@ -670,6 +700,7 @@ class ThermalEngine:
             self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
+        self._generation_used()
         if bad >= 0:
             gid = int(p.global_id[bad])
             raise SimulationError(
@@ -714,6 +745,34 @@ class ThermalEngine:
         return (self.thermal_energy() - self.initial_energy - self.boundary_heat()
                 + cum["fixed_absorbed"] - cum["inserted_heat"] - cum["fixed_reset"])  # fmt: skip
 
+    def generation_ledger(self) -> dict[str, float]:
+        """The heat generation ledger [J] per selected mechanism g: χ × the energy the
+        mechanics dissipated (``generated_<g>``: the mechanical ledger's ``dissipated_<g>``,
+        or the kinetic energy lost in collisions), the heat that went to walls with a fixed
+        temperature (``heat_to_walls_generation_<g>``), the heat accumulated in the particles
+        but not yet applied by a thermal step (``heat_pending_generation_<g>``); with the heat
+        into the particles (``heat_in_generation_<g>``, the heat ledger) they close:
+        ``generation_balance_error`` = Σ_g generated - in - walls - pending, round-off."""
+        sim = self.sim
+        gen = self.generation
+        chi = gen.conversion_fraction
+        cum = sim.ledger_cumulative
+        pending = sim.particles.generation_energy.sum(axis=0)
+        out: dict[str, float] = {}
+        error = 0.0
+        for g in gen.mechanisms:
+            name = heat.GENERATION[g]
+            source = "collision_energy_loss" if g == heat.G_COLLISION else name
+            generated = chi * cum[source]
+            walls = chi * cum[f"wall_generation_{name}"]
+            waiting = chi * float(pending[g])
+            out[f"generated_{name}"] = generated
+            out[f"heat_to_walls_generation_{name}"] = walls
+            out[f"heat_pending_generation_{name}"] = waiting
+            error += generated - walls - waiting - self.cumulative[f"heat_in_generation_{name}"]
+        out["generation_balance_error"] = error
+        return out
+
     def summary(self) -> dict[str, float]:
         """Temperature statistics, heat rates by mechanism [W] and the heat ledger [J].
 
@@ -738,6 +797,8 @@ class ThermalEngine:
                 out[name] = self.cumulative[name]
         out.update({k: v for k, v in self.cumulative.items() if not k.startswith("heat_in_")})
         out["heat_balance_error"] = self.balance_error()
+        if self.generation.active:
+            out.update(self.generation_ledger())
         out["thermal_limit"] = self.limit
         if self.range_set is not None:
             out["range_pair_count"] = self.range_set.count

@@ -48,7 +48,8 @@ if TYPE_CHECKING:
 
 FORMAT = "thermodem-checkpoint"
 FORMAT_VERSION = 3  # 2: pair lists with slab groups, no per-pair force rows; 3: the contact
-# history laid out from the registry (state/history.py), its layout among the scalars
+# history laid out from the registry (state/history.py), its layout among the scalars; no
+# per-pair dissipation rows; the particles' heat generation accumulators
 KINDS = ("checkpoint", "interrupted", "final", "failed")
 _NAME = re.compile(r"^checkpoint_(\d+)\.h5$")
 

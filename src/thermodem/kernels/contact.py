@@ -2,8 +2,9 @@
 
 :func:`contact_response` evaluates one touching contact, :func:`_open_contact` clears one that
 does not touch; the parallel passes that call them for every listed pair are in
-:mod:`thermodem.kernels.pair_pass`. This module also holds the column layouts of the contact
-history, the per-chunk ledger and the per-pair dissipation, and the pair states.
+:mod:`thermodem.kernels.pair_pass`. This module also holds the column layout of the per-chunk
+ledger, the pair states, and the deposit of a contact's dissipated energy into its particles'
+heat generation accumulators (:func:`deposit_pair`, :func:`deposit_wall`).
 
 Sign conventions: n is the unit vector from i to j; the relative velocity of i with respect to j
 at the contact point is v_rel = (v_i + ω_i × R_i n) - (v_j - ω_j × R_j n); the overlap rate is
@@ -24,6 +25,14 @@ from thermodem.models.mechanics.dispatch import (
     tangential_dispatch,
 )
 from thermodem.state import history as history_layout
+from thermodem.state.heat import (
+    G_NORMAL_DAMPING,
+    G_PLASTIC_DEFORMATION,
+    G_ROLLING_FRICTION,
+    G_SLIDING_FRICTION,
+    G_TANGENTIAL_DAMPING,
+    GENERATION,
+)
 
 CHUNK = 2048  # pairs per chunk of the heat-only pair passes
 
@@ -40,17 +49,16 @@ L_NORMAL_DAMPING = 3
 L_TANGENTIAL_DAMPING = 4
 L_SLIDING_FRICTION = 5
 L_ROLLING_FRICTION = 6
-L_STIFFNESS_WORK = 7
-L_WALL_WORK = 8
-L_MAX_OVERLAP_RATIO = 9
-L_TOUCHING = 10
-LEDGER_WIDTH = 11
-
-# Per-pair dissipated power columns.
-D_NORMAL_DAMPING = 0
-D_TANGENTIAL_DAMPING = 1
-D_SLIDING_FRICTION = 2
-D_ROLLING_FRICTION = 3
+L_PLASTIC_DEFORMATION = 7
+L_STIFFNESS_WORK = 8
+L_WALL_WORK = 9
+L_MAX_OVERLAP_RATIO = 10
+L_TOUCHING = 11
+#: kinetic energy lost by the pairs whose collision ended (heat generation of Al-Arkawazi 2017)
+L_COLLISION = 12
+#: the walls' share of the generated heat's energy, per mechanism of state/heat.GENERATION
+L_WALL_GENERATION = 13
+LEDGER_WIDTH = L_WALL_GENERATION + len(GENERATION)
 
 STATE_FAR = 0
 STATE_NEAR = 1
@@ -102,25 +110,29 @@ def contact_response(
     p_tangential,
     rolling_id,
     p_rolling,
+    h_normal,
     h_spring,
     h_roll,
-    out_diss,
     out_normal_force,
     ledger_row,
 ):
     """Forces of one touching contact (row k of the pair or wall-pair arrays).
 
-    Returns (F_n, F_t (3), rolling torque on i (3)); the force on i is -F_n n + F_t and the
-    torque on i is R_i n x F_t plus the rolling torque. Writes the dissipated power per
-    mechanism (out_diss[k]) and the normal force, updates the history row and adds energies to
-    the ledger row. ``h_spring``, ``h_roll``: first history column of the tangential spring
-    (its energy follows the 3-vector) and of the rolling torque, -1 when the selected law keeps
-    none (state/history.py).
+    Returns (F_n, F_t (3), rolling torque on i (3), and the energies dissipated in this step
+    by normal damping, tangential damping, sliding friction, rolling friction and plastic
+    deformation [J]); the force on i is -F_n n + F_t and the torque on i is R_i n x F_t plus
+    the rolling torque. Writes the normal force, updates the history row and adds energies to
+    the ledger row. ``h_normal``, ``h_spring``, ``h_roll``: first history column of the normal
+    law's value, the tangential spring (its energy follows the 3-vector) and the rolling
+    torque, -1 when the selected law keeps none (state/history.py).
     """
     rate = vrx * nx + vry * ny + vrz * nz
-    f_el, f_damp, k_ref, gamma_n, u_n = normal_dispatch(
-        normal_id, p_normal, overlap, rate, eff_radius, eff_mass
+    h0 = history[k, h_normal] if h_normal >= 0 else 0.0
+    f_el, f_damp, k_ref, gamma_n, u_n, h0, e_plastic = normal_dispatch(
+        normal_id, p_normal, overlap, rate, eff_radius, eff_mass, h0
     )
+    if h_normal >= 0:
+        history[k, h_normal] = h0
     f_n = f_el + f_damp
     # tangential relative velocity
     vtx = vrx - rate * nx
@@ -199,42 +211,110 @@ def contact_response(
         history[k, h_roll + 1] = my
         history[k, h_roll + 2] = mz
         history[k, h_roll + 3] = u_r
-    p_ndamp = f_damp * rate
-    out_diss[k, D_NORMAL_DAMPING] = p_ndamp
-    inv_dt = 1.0 / dt if dt > 0.0 else 0.0
-    out_diss[k, D_TANGENTIAL_DAMPING] = e_tdamp * inv_dt
-    out_diss[k, D_SLIDING_FRICTION] = e_slip * inv_dt
-    out_diss[k, D_ROLLING_FRICTION] = e_roll * inv_dt
+    e_ndamp = f_damp * rate * dt
     out_normal_force[k] = f_n
     ledger_row[L_ELASTIC_NORMAL] += u_n
     ledger_row[L_ELASTIC_TANGENTIAL] += u_t
     ledger_row[L_ELASTIC_ROLLING] += u_r
-    ledger_row[L_NORMAL_DAMPING] += p_ndamp * dt
+    ledger_row[L_NORMAL_DAMPING] += e_ndamp
     ledger_row[L_TANGENTIAL_DAMPING] += e_tdamp
     ledger_row[L_SLIDING_FRICTION] += e_slip
     ledger_row[L_ROLLING_FRICTION] += e_roll
+    ledger_row[L_PLASTIC_DEFORMATION] += e_plastic
     ledger_row[L_STIFFNESS_WORK] += stiffness_work
     ledger_row[L_TOUCHING] += 1.0
-    return f_n, ftx, fty, ftz, tx, ty, tz
+    return f_n, ftx, fty, ftz, tx, ty, tz, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _open_contact(k, history, h_spring, h_roll, out_diss, out_normal_force, out_state, ledger_row):
+def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, ledger_row):
     """Outputs of a pair that does not touch; a contact that just opened is cleared.
 
-    The energy left in its springs when a contact opens is counted as friction (documented).
-    A pair that did not touch at the previous pass already has zero outputs and history: no
-    writes (a rebuild marks every pair STATE_UNSET, so the outputs of a new list are written).
+    The energy left in its springs when a contact opens is counted as friction (documented);
+    returns it, (sliding, rolling) [J], for the heat generation. A pair that did not touch at
+    the previous pass already has zero outputs and history: no writes (a rebuild marks every
+    pair STATE_UNSET, so the outputs of a new list are written).
     """
     if out_state[k] == STATE_NEAR or out_state[k] == STATE_FAR:
-        return
+        return 0.0, 0.0
+    e_spring = 0.0
+    e_roll = 0.0
     if history[k, H_DURATION] != 0.0:
         if h_spring >= 0:
-            ledger_row[L_SLIDING_FRICTION] += history[k, h_spring + 3]
+            e_spring = history[k, h_spring + 3]
+            ledger_row[L_SLIDING_FRICTION] += e_spring
         if h_roll >= 0:
-            ledger_row[L_ROLLING_FRICTION] += history[k, h_roll + 3]
+            e_roll = history[k, h_roll + 3]
+            ledger_row[L_ROLLING_FRICTION] += e_roll
         for c in range(history.shape[1]):
             history[k, c] = 0.0
-    for c in range(out_diss.shape[1]):
-        out_diss[k, c] = 0.0
     out_normal_force[k] = 0.0
+    return e_spring, e_roll
+
+
+# ------------------------------------------------------------------- heat generation deposits
+@njit(cache=True, inline="always", error_model="numpy")
+def _deposit(energy, i, j, g, e, psi):
+    share = psi * e
+    energy[i, g] += share
+    energy[j, g] += e - share
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def deposit_pair(energy, i, j, select, psi, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
+    """Add a particle pair's dissipated energies of one step [J] to the two particles'
+    accumulators of the selected mechanisms (``select[g]`` != 0): ψ e to i, the rest to j
+    (``psi``: i's share of the friction heat and of the other heat, the heat generation row's
+    partition; models/thermal/heat_generation.py)."""
+    if select[G_SLIDING_FRICTION] != 0.0:
+        _deposit(energy, i, j, G_SLIDING_FRICTION, e_slip, psi[0])
+    if select[G_ROLLING_FRICTION] != 0.0:
+        _deposit(energy, i, j, G_ROLLING_FRICTION, e_roll, psi[0])
+    if select[G_NORMAL_DAMPING] != 0.0:
+        _deposit(energy, i, j, G_NORMAL_DAMPING, e_ndamp, psi[1])
+    if select[G_TANGENTIAL_DAMPING] != 0.0:
+        _deposit(energy, i, j, G_TANGENTIAL_DAMPING, e_tdamp, psi[1])
+    if select[G_PLASTIC_DEFORMATION] != 0.0:
+        _deposit(energy, i, j, G_PLASTIC_DEFORMATION, e_plastic, psi[1])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _deposit_wall(energy, i, g, e, psi, ledger_row):
+    share = psi * e
+    energy[i, g] += share
+    ledger_row[L_WALL_GENERATION + g] += e - share
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def deposit_wall(
+    energy, i, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic,
+    ledger_row,
+):  # fmt: skip
+    """The same for a particle-wall pair: the particle's share into its accumulators, the
+    wall's share into the ledger row (``psi_*`` = 1 for an adiabatic wall)."""
+    if select[G_SLIDING_FRICTION] != 0.0:
+        _deposit_wall(energy, i, G_SLIDING_FRICTION, e_slip, psi_friction, ledger_row)
+    if select[G_ROLLING_FRICTION] != 0.0:
+        _deposit_wall(energy, i, G_ROLLING_FRICTION, e_roll, psi_friction, ledger_row)
+    if select[G_NORMAL_DAMPING] != 0.0:
+        _deposit_wall(energy, i, G_NORMAL_DAMPING, e_ndamp, psi_other, ledger_row)
+    if select[G_TANGENTIAL_DAMPING] != 0.0:
+        _deposit_wall(energy, i, G_TANGENTIAL_DAMPING, e_tdamp, psi_other, ledger_row)
+    if select[G_PLASTIC_DEFORMATION] != 0.0:
+        _deposit_wall(energy, i, G_PLASTIC_DEFORMATION, e_plastic, psi_other, ledger_row)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def kinetic_energy(velocity, angular_velocity, mass, inertia, i):
+    """½ m |v|² + ½ I |ω|² of particle i [J]."""
+    v2 = velocity[i, 0] ** 2 + velocity[i, 1] ** 2 + velocity[i, 2] ** 2
+    w2 = angular_velocity[i, 0] ** 2 + angular_velocity[i, 1] ** 2
+    w2 += angular_velocity[i, 2] ** 2
+    return 0.5 * (mass[i] * v2 + inertia[i] * w2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def collision_loss(history, k, h_collision, kinetic_now):
+    """Kinetic energy the pair of row k lost since its collision started (the value kept at
+    the first touching pass), clipped at 0 (Al-Arkawazi 2017, ΔU; documented)."""
+    return max(history[k, h_collision] - kinetic_now, 0.0)

@@ -9,7 +9,8 @@ The particle pass runs over the slab groups of the list (:mod:`thermodem.kernels
 even groups in parallel, then the odd ones. Each pair adds its force and torque (and, when
 heat is due, its heat rate and conductance) straight into the arrays of its two particles,
 which no other group of the same parity touches, and writes its own per-pair rows
-(dissipated power per mechanism, normal force, state); each group writes its own ledger row.
+(normal force, state; with heat generation the dissipated energy per mechanism goes into the
+two particles' accumulators); each group writes its own ledger row.
 The wall pass runs over fixed chunks of particles and their wall pairs. Nothing is accumulated
 with atomics and every particle receives its contributions in an order fixed by the list, so
 the results do not depend on the number of threads.
@@ -35,18 +36,24 @@ from thermodem.kernels.conduction import pair_conductance
 from thermodem.kernels.contact import (
     H_DURATION,
     H_IMPACT_VELOCITY,
+    L_COLLISION,
     L_MAX_OVERLAP_RATIO,
+    L_WALL_GENERATION,
     L_WALL_WORK,
     STATE_FAR,
     STATE_NEAR,
     STATE_TOUCHING,
     _open_contact,
+    collision_loss,
     contact_response,
+    deposit_pair,
+    deposit_wall,
+    kinetic_energy,
 )
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.models import registry
 from thermodem.state import history as HL
-from thermodem.state.heat import M_DIRECT, M_WALL_DIRECT
+from thermodem.state.heat import G_COLLISION, M_DIRECT, M_WALL_DIRECT
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
 
@@ -164,37 +171,45 @@ _PASSES: dict[tuple, tuple] = {}
 
 
 def passes_for(
-    heat_on: bool, radius_id: int, conduction_id: int, override: int, layout: tuple[int, ...]
+    heat_on: bool,
+    radius_id: int,
+    conduction_id: int,
+    override: int,
+    layout: tuple[int, ...],
+    generation: bool = False,
 ) -> tuple:
     """(particle pair pass, wall pair pass) for one model combination and history layout.
 
     The heat switch, the contact radius and direct conduction model ids, the k(T)/ρc(T)
-    override and the history offsets ``layout`` (``HistoryLayout.offsets``: normal, spring,
-    roll, collision, reuse; -1 for an absent block; state/history.py) are compile-time
-    constants of the particle pair pass, so the compiler drops the code of every other model
-    and of absent history blocks: the generic loop with
-    the model switches inside costs the simple conduction models ~20 ns per particle more
-    (docs/architecture.md, "Cost of the generic model switch"). Its arguments keep their
-    order and types; the model and layout arguments passed in are ignored. Each combination in
-    use compiles once (~7 s on a 2-core machine) and is then cached on disk (Numba keys
-    closures on their constants) and in this process. The wall pass, a few percent of the
-    time, is one generic kernel for all combinations (the offsets are its arguments).
+    override, the history offsets ``layout`` (``HistoryLayout.offsets``: normal, spring,
+    roll, collision, reuse; -1 for an absent block; state/history.py) and the heat generation
+    switch are compile-time constants of the particle pair pass, so the compiler drops the
+    code of every other model, of absent history blocks and, without heat generation, of the
+    deposits into the generation accumulators: the generic loop with the model switches
+    inside costs the simple conduction models ~20 ns per particle more (docs/architecture.md,
+    "Cost of the generic model switch"). Its arguments keep their order and types; the model,
+    layout and generation arguments passed in are ignored. Each combination in use compiles
+    once (~7 s on a 2-core machine) and is then cached on disk (Numba keys closures on their
+    constants) and in this process. The wall pass, a few percent of the time, is one generic
+    kernel for all combinations (the offsets and the generation switch are its arguments).
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
         key = (False, 0, 0, 0)
-    key = (*key, tuple(int(c) for c in layout))
+    key = (*key, tuple(int(c) for c in layout), bool(generation))
     if key not in _PASSES:
         _PASSES[key] = (_compile_pair_pass(*key), wall_pair_pass)
     return _PASSES[key]
 
 
 def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int,  # noqa: N803
-                       LAYOUT: tuple[int, ...]):  # noqa: ANN202, N803  # fmt: skip
+                       LAYOUT: tuple[int, ...], GENERATION: bool):  # noqa: ANN202, N803  # fmt: skip
     """Define the particle pair pass with the model choice captured as constants."""
     REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
+    H_NORMAL = LAYOUT[HL.NORMAL]  # noqa: N806
     H_SPRING = LAYOUT[HL.SPRING]  # noqa: N806
     H_ROLL = LAYOUT[HL.ROLL]  # noqa: N806
+    H_COLLISION = LAYOUT[HL.COLLISION] if GENERATION else -1  # noqa: N806
     H_REUSE = LAYOUT[HL.REUSE]  # noqa: N806
     REUSABLE = REUSABLE and H_REUSE >= 0  # noqa: N806
 
@@ -224,7 +239,6 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         rolling_table,
         force,
         torque,
-        out_diss,
         out_normal_force,
         out_state,
         chunk_ledger,
@@ -242,9 +256,19 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         conductance_sum,
         tolerance,
         layout,
+        generation,
+        gen_energy,
+        gen_select,
+        gen_partition,
     ):
         """Contact forces of every listed particle pair, added to ``force`` and ``torque``
         (see module docstring; the caller sets them to their non-contact values first).
+
+        With heat generation (the ``generation`` constant of :func:`passes_for`) each contact
+        adds the energy it dissipates in this step, per mechanism selected by
+        ``gen_select``, to the accumulators ``gen_energy`` of its two particles, shared by
+        ``gen_partition[type_i, type_j]`` (i's share of friction and other heat), and a
+        collision that ends adds the kinetic energy the pair lost (with a collision block).
 
         With ``heat_on`` the same pass evaluates the conduction of every touching pair (see
         :func:`thermodem.kernels.conduction.pair_conductance`) with the temperatures of this
@@ -276,10 +300,26 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     overlap = ri + rj - dist
                     eff_mass = 0.0
                     if overlap <= 0.0 or dist == 0.0:
-                        _open_contact(
-                            k, history, H_SPRING, H_ROLL, out_diss, out_normal_force, out_state,
-                            row,
-                        )  # fmt: skip
+                        if GENERATION and H_COLLISION >= 0 and history[k, H_DURATION] != 0.0:
+                            # a collision ends: the kinetic energy the pair lost
+                            lost = collision_loss(
+                                history, k, H_COLLISION,
+                                kinetic_energy(velocity, angular_velocity, mass, inertia, i)
+                                + kinetic_energy(velocity, angular_velocity, mass, inertia, j),
+                            )  # fmt: skip
+                            row[L_COLLISION] += lost
+                            if gen_select[G_COLLISION] != 0.0:
+                                psi = gen_partition[type_id[i], type_id[j], 1] * lost
+                                gen_energy[i, G_COLLISION] += psi
+                                gen_energy[j, G_COLLISION] += lost - psi
+                        e_spring, e_rspring = _open_contact(
+                            k, history, H_SPRING, H_ROLL, out_normal_force, out_state, row
+                        )
+                        if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
+                            deposit_pair(
+                                gen_energy, i, j, gen_select, gen_partition[type_id[i], type_id[j]],
+                                0.0, 0.0, e_spring, e_rspring, 0.0,
+                            )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                     else:
                         out_state[k] = STATE_TOUCHING
@@ -308,7 +348,25 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             rolling_inertia = ii * ij / (ii + ij)
                         ti = type_id[i]
                         tj = type_id[j]
-                        f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
+                        if GENERATION and H_COLLISION >= 0 and history[k, H_DURATION] == 0.0:
+                            # a collision starts: the pair's kinetic energy now
+                            history[k, H_COLLISION] = kinetic_energy(
+                                velocity, angular_velocity, mass, inertia, i
+                            ) + kinetic_energy(velocity, angular_velocity, mass, inertia, j)
+                        (
+                            f_n,
+                            ftx,
+                            fty,
+                            ftz,
+                            tx,
+                            ty,
+                            tz,
+                            e_ndamp,
+                            e_tdamp,
+                            e_slip,
+                            e_roll,
+                            e_plastic,
+                        ) = contact_response(
                             k,
                             history,
                             nx,
@@ -331,12 +389,17 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             tangential_table[ti, tj],
                             rolling_id,
                             rolling_table[ti, tj],
+                            H_NORMAL,
                             H_SPRING,
                             H_ROLL,
-                            out_diss,
                             out_normal_force,
                             row,
                         )
+                        if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
+                            deposit_pair(
+                                gen_energy, i, j, gen_select, gen_partition[ti, tj], e_ndamp,
+                                e_tdamp, e_slip, e_roll, e_plastic,
+                            )  # fmt: skip
                         # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
                         fx = -f_n * nx + ftx
                         fy = -f_n * ny + fty
@@ -404,7 +467,6 @@ def wall_pair_pass(
     rolling_table,
     force,
     torque,
-    out_diss,
     out_normal_force,
     out_state,
     chunk_ledger,
@@ -424,6 +486,10 @@ def wall_pair_pass(
     conductance_sum,
     tolerance,
     layout,
+    generation,
+    gen_energy,
+    gen_select,
+    gen_partition,
 ):
     """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
     added to ``force`` and ``torque`` after the particle pairs.
@@ -431,10 +497,15 @@ def wall_pair_pass(
     Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
     ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
     the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
-    ``layout``: the history offsets (see :func:`passes_for`).
+    ``layout``: the history offsets (see :func:`passes_for`). With ``generation`` the
+    dissipated energies go to the particle's accumulators, its share ``gen_partition[type,
+    wall material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
+    wall's share to the chunk's ledger row.
     """
+    h_normal = layout[HL.NORMAL]
     h_spring = layout[HL.SPRING]
     h_roll = layout[HL.ROLL]
+    h_collision = layout[HL.COLLISION] if generation else -1
     h_reuse = layout[HL.REUSE]
     n = radius.shape[0]
     nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
@@ -451,10 +522,28 @@ def wall_pair_pass(
             d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
             ri = radius[i]
             overlap = ri - d
+            psi_f = psi_o = 1.0  # the particle's share (adiabatic wall: all of it)
+            if generation and wrow[COL_THERMAL_KIND] != 0.0:
+                psi_f = gen_partition[type_id[i], wall_material[w], 0]
+                psi_o = gen_partition[type_id[i], wall_material[w], 1]
             if overlap <= 0.0:
-                _open_contact(
-                    k, history, h_spring, h_roll, out_diss, out_normal_force, out_state, row
+                if h_collision >= 0 and history[k, H_DURATION] != 0.0:
+                    lost = collision_loss(
+                        history, k, h_collision,
+                        kinetic_energy(velocity, angular_velocity, mass, inertia, i),
+                    )  # fmt: skip
+                    row[L_COLLISION] += lost
+                    if gen_select[G_COLLISION] != 0.0:
+                        gen_energy[i, G_COLLISION] += psi_o * lost
+                        row[L_WALL_GENERATION + G_COLLISION] += lost - psi_o * lost
+                e_spring, e_rspring = _open_contact(
+                    k, history, h_spring, h_roll, out_normal_force, out_state, row
                 )
+                if generation and (e_spring != 0.0 or e_rspring != 0.0):
+                    deposit_wall(
+                        gen_energy, i, gen_select, psi_f, psi_o, 0.0, 0.0, e_spring, e_rspring,
+                        0.0, row,
+                    )  # fmt: skip
                 out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
             else:
                 out_state[k] = STATE_TOUCHING
@@ -482,35 +571,46 @@ def wall_pair_pass(
                 ti = type_id[i]
                 tw = wall_material[w]
                 rolling_inertia = inertia[i] + mass[i] * ri * ri
-                f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
-                    k,
-                    history,
-                    nx,
-                    ny,
-                    nz,
-                    overlap,
-                    ri,
-                    mass[i],
-                    rolling_inertia,
-                    vrx,
-                    vry,
-                    vrz,
-                    wix - ax,
-                    wiy - ay,
-                    wiz - az,
-                    dt,
-                    normal_id,
-                    normal_table[ti, tw],
-                    tangential_id,
-                    tangential_table[ti, tw],
-                    rolling_id,
-                    rolling_table[ti, tw],
-                    h_spring,
-                    h_roll,
-                    out_diss,
-                    out_normal_force,
-                    row,
+                if h_collision >= 0 and history[k, H_DURATION] == 0.0:
+                    history[k, h_collision] = kinetic_energy(
+                        velocity, angular_velocity, mass, inertia, i
+                    )
+                (f_n, ftx, fty, ftz, tx, ty, tz, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic) = (
+                    contact_response(
+                        k,
+                        history,
+                        nx,
+                        ny,
+                        nz,
+                        overlap,
+                        ri,
+                        mass[i],
+                        rolling_inertia,
+                        vrx,
+                        vry,
+                        vrz,
+                        wix - ax,
+                        wiy - ay,
+                        wiz - az,
+                        dt,
+                        normal_id,
+                        normal_table[ti, tw],
+                        tangential_id,
+                        tangential_table[ti, tw],
+                        rolling_id,
+                        rolling_table[ti, tw],
+                        h_normal,
+                        h_spring,
+                        h_roll,
+                        out_normal_force,
+                        row,
+                    )
                 )
+                if generation and dt > 0.0:  # (none at the t = 0 evaluation)
+                    deposit_wall(
+                        gen_energy, i, gen_select, psi_f, psi_o, e_ndamp, e_tdamp, e_slip,
+                        e_roll, e_plastic, row,
+                    )  # fmt: skip
                 # work done by the wall on the particle this step
                 fx = -f_n * nx + ftx
                 fy = -f_n * ny + fty

@@ -76,6 +76,13 @@ class ModelSpec:
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
     uses_contact_radius: bool = True
     example_params: dict[str, Any] = field(default_factory=dict)
+    requires_of: Callable[[BaseModel], tuple[str, ...]] | None = None
+
+    def required(self, params: BaseModel) -> tuple[str, ...]:
+        """Material properties required with these parameter values: ``requires`` and what
+        ``requires_of(params)`` adds (a property that only some options read)."""
+        extra = self.requires_of(params) if self.requires_of is not None else ()
+        return tuple(dict.fromkeys((*self.requires, *extra)))
 
     @property
     def width(self) -> int:
@@ -117,6 +124,7 @@ def register(
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
     uses_contact_radius: bool = True,
     example_params: dict[str, Any] | None = None,
+    requires_of: Callable[[BaseModel], tuple[str, ...]] | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
 
@@ -129,7 +137,8 @@ def register(
     ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
     None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
     argument (the range pass then does not compute it); ``example_params`` parameters the
-    conformance tests use for a model without defaults.
+    conformance tests use for a model without defaults; ``requires_of(params)`` material
+    properties required only with some parameter values (a partition formula's inputs).
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -171,6 +180,7 @@ def register(
         conductance_reuse_refusal=conductance_reuse_refusal,
         uses_contact_radius=uses_contact_radius,
         example_params=dict(example_params or {}),
+        requires_of=requires_of,
     )
     models[name] = spec
     return spec
