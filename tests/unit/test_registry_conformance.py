@@ -341,3 +341,41 @@ def test_hertz_restitution_round_trip(e):
     alpha = hertz_alpha_of_restitution(e)
     assert alpha >= 0.0
     assert abs(hertz_restitution_of_alpha(alpha) - e) < 1e-9
+
+
+@SETTINGS
+@given(
+    k1=st.floats(1.0, 1e7),
+    e=st.floats(0.05, 1.0),
+    peak=st.floats(1e-7, 1e-3),
+    back=st.floats(0.0, 1.0),
+    again=st.floats(0.0, 2.0),
+)
+def test_walton_braun_work_is_stored_energy_plus_plastic_dissipation(k1, e, peak, back, again):
+    """Along a path load to δ_a, unload to a fraction of it, reload beyond it (steps small
+    enough to resolve the branches, with the branch points as step ends): the work of the
+    force (trapezoids: the law is piecewise linear) equals the change of the stored energy
+    plus the plastic dissipation, and a full load-unload cycle dissipates ½ k1 (1 - e²) δ_max²
+    (Walton & Braun 1986)."""
+    p = np.array([k1, e * e])
+    d0_of = lambda m: m * (1.0 - e * e)  # noqa: E731 (δ0 of a largest overlap m)
+    lows = (d0_of(peak) + back * (peak - d0_of(peak)), peak, peak * (1.0 + again))
+    points = [np.linspace(0.0, peak, 50)]
+    points.append(np.linspace(peak, lows[0], 50)[1:])
+    points.append(np.linspace(lows[0], peak, 50)[1:])  # reload along the unloading line
+    points.append(np.linspace(peak, lows[2], 50)[1:])  # and beyond: loading again
+    path = np.concatenate(points)
+    m = 0.0
+    work = plastic = 0.0
+    f_prev, u0 = 0.0, 0.0
+    for k, d in enumerate(path):
+        f, _, _, _, u, m, dp = normal.walton_braun_force(p, d, 0.0, 1e-3, 1e-3, m)
+        if k:
+            work += 0.5 * (f + f_prev) * (d - path[k - 1])
+        plastic += dp
+        f_prev = f
+    assert work == pytest.approx(u - u0 + plastic, rel=1e-9, abs=1e-18 * k1)
+    assert m == max(peak, lows[2])
+    cycle = normal.walton_braun_force(p, m, 0.0, 1e-3, 1e-3, m)[4]  # stored at the top
+    assert plastic == pytest.approx(0.5 * k1 * (1.0 - e * e) * m * m, rel=1e-12)
+    assert cycle == pytest.approx(0.5 * k1 * e * e * m * m, rel=1e-12)

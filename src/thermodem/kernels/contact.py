@@ -261,21 +261,23 @@ def _deposit(energy, i, j, g, e, psi):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def deposit_pair(energy, i, j, select, psi, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
+def deposit_pair(
+    energy, i, j, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
+):
     """Add a particle pair's dissipated energies of one step [J] to the two particles'
     accumulators of the selected mechanisms (``select[g]`` != 0): ψ e to i, the rest to j
-    (``psi``: i's share of the friction heat and of the other heat, the heat generation row's
-    partition; models/thermal/heat_generation.py)."""
+    (``psi_*``: i's share of the friction heat and of the other heat, the heat generation
+    row's partition; models/thermal/heat_generation.py)."""
     if select[G_SLIDING_FRICTION] != 0.0:
-        _deposit(energy, i, j, G_SLIDING_FRICTION, e_slip, psi[0])
+        _deposit(energy, i, j, G_SLIDING_FRICTION, e_slip, psi_friction)
     if select[G_ROLLING_FRICTION] != 0.0:
-        _deposit(energy, i, j, G_ROLLING_FRICTION, e_roll, psi[0])
+        _deposit(energy, i, j, G_ROLLING_FRICTION, e_roll, psi_friction)
     if select[G_NORMAL_DAMPING] != 0.0:
-        _deposit(energy, i, j, G_NORMAL_DAMPING, e_ndamp, psi[1])
+        _deposit(energy, i, j, G_NORMAL_DAMPING, e_ndamp, psi_other)
     if select[G_TANGENTIAL_DAMPING] != 0.0:
-        _deposit(energy, i, j, G_TANGENTIAL_DAMPING, e_tdamp, psi[1])
+        _deposit(energy, i, j, G_TANGENTIAL_DAMPING, e_tdamp, psi_other)
     if select[G_PLASTIC_DEFORMATION] != 0.0:
-        _deposit(energy, i, j, G_PLASTIC_DEFORMATION, e_plastic, psi[1])
+        _deposit(energy, i, j, G_PLASTIC_DEFORMATION, e_plastic, psi_other)
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -309,16 +309,18 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             )  # fmt: skip
                             row[L_COLLISION] += lost
                             if gen_select[G_COLLISION] != 0.0:
-                                psi = gen_partition[type_id[i], type_id[j], 1] * lost
-                                gen_energy[i, G_COLLISION] += psi
-                                gen_energy[j, G_COLLISION] += lost - psi
+                                share = gen_partition[type_id[i], type_id[j], 1] * lost
+                                gen_energy[i, G_COLLISION] += share
+                                gen_energy[j, G_COLLISION] += lost - share
                         e_spring, e_rspring = _open_contact(
                             k, history, H_SPRING, H_ROLL, out_normal_force, out_state, row
                         )
                         if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
+                            ti = type_id[i]
+                            tj = type_id[j]
                             deposit_pair(
-                                gen_energy, i, j, gen_select, gen_partition[type_id[i], type_id[j]],
-                                0.0, 0.0, e_spring, e_rspring, 0.0,
+                                gen_energy, i, j, gen_select, gen_partition[ti, tj, 0],
+                                gen_partition[ti, tj, 1], 0.0, 0.0, e_spring, e_rspring, 0.0,
                             )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                     else:
@@ -397,8 +399,9 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                         )
                         if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
                             deposit_pair(
-                                gen_energy, i, j, gen_select, gen_partition[ti, tj], e_ndamp,
-                                e_tdamp, e_slip, e_roll, e_plastic,
+                                gen_energy, i, j, gen_select, gen_partition[ti, tj, 0],
+                                gen_partition[ti, tj, 1], e_ndamp, e_tdamp, e_slip, e_roll,
+                                e_plastic,
                             )  # fmt: skip
                         # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
                         fx = -f_n * nx + ftx
