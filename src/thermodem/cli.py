@@ -326,7 +326,8 @@ def _unit(description: str) -> tuple[str, str]:
     m = re.search(r"\[([^\]]*)\]", description)
     if not m:
         return "", description
-    rest = (description[: m.start()] + description[m.end() :]).strip(" ,;")
+    rest = description[: m.start()] + description[m.end() :]
+    rest = re.sub(r"\s+([,;:)])", r"\1", re.sub(r"\s+", " ", rest)).strip(" ,;")
     return m.group(1), rest
 
 
@@ -337,6 +338,17 @@ _TARGET_TEXT = {
     "external": "an external pair set (e.g. Voronoi neighbours)",
     "particles": "single particles",
 }
+
+
+def _conducts_across_gaps(spec) -> bool:  # noqa: ANN001
+    """Whether the model conducts across a gap (its interaction range is > 0)."""
+    if spec.interaction_range is None:
+        return False
+    try:
+        params = spec.params(**spec.example_params)
+    except ValueError:
+        return True
+    return spec.interaction_range(params, 1.0, 1.0) > 0.0
 
 
 @app.command()
@@ -369,8 +381,10 @@ def models(
                 typer.echo(f"    reads thermal.gas: {', '.join(spec.uses_gas)}")
             if fam in _THERMAL_PAIR_FAMILIES and spec.name != "none":
                 where = _TARGET_TEXT[spec.target]
-                if spec.interaction_range is not None and spec.target == "contacts":
+                if _conducts_across_gaps(spec) and spec.target == "contacts":
                     where += "; pairs across a gap: the range pair set"
+                if spec.range_parameter:
+                    where += f"; its range is set by {spec.range_parameter}"
                 typer.echo(f"    runs on: {where}")
             if spec.conductance_from_force:
                 typer.echo(

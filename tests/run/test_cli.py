@@ -44,6 +44,39 @@ def test_models_lists_every_family_and_model_with_parameters() -> None:
     assert bad.exit_code == 2
 
 
+def test_models_lists_the_gas_conduction_models_with_every_parameter_and_its_unit() -> None:
+    """Every parameter of the models that conduct through the gas is listed; the numeric ones
+    with their unit; where each runs and which key sets its range."""
+    out = CliRunner().invoke(app, ["models", "indirect_conduction"]).output
+    lines = out.splitlines()
+    for spec in all_models():
+        if spec.family != "indirect_conduction" or spec.target == "external":
+            continue
+        start = lines.index(next(x for x in lines if x.startswith(f"  {spec.family}.{spec.name}:")))
+        block = []
+        for x in lines[start + 1 :]:
+            if not x.startswith("    "):
+                break
+            block.append(x)
+        if spec.name == "none":
+            assert block == ["    parameters: none", "    reference: -"]
+            continue
+        for name, field in spec.params.model_fields.items():
+            line = next(x for x in block if x.startswith(f"    {name}:"))
+            if field.annotation in (float, float | None):
+                assert line.startswith(f"    {name}: ["), line  # a unit
+            assert "  " not in line.strip(), line
+        runs = next(x for x in block if x.startswith("    runs on:"))
+        if spec.target == "range":
+            assert "range pair set" in runs and spec.range_parameter in runs
+        else:
+            assert runs == "    runs on: touching pairs (contact lists)", runs
+    assert "cutoff_gap_ratio: [-], default 1.0, > 0" in out
+    assert "min_separation: [m], default 2.75e-08, > 0" in out
+    assert "liquid_conductivity: [W/(m K)], default None, > 0" in out
+    assert "filling_angle: [rad], default 0.0, >= 0, < 1.5708" in out
+
+
 def test_validate_prints_estimates_and_a_loadable_resolved_case(tmp_path: Path) -> None:
     case = tmp_path / "c.yaml"
     case.write_text(SMALL)

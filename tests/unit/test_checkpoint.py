@@ -5,6 +5,7 @@ history, periodic axes, the thermal engine)."""
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ from thermodem.io.checkpoint import (
     read_checkpoint,
     write_checkpoint,
 )
+from thermodem.state.heat import M_INDIRECT
 
 EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.yaml"))
 
@@ -169,6 +171,20 @@ def range_thermal_case() -> dict:
     return case
 
 
+def indirect_case(indirect: dict) -> Callable[[], dict]:
+    """The periodic bed with an indirect_conduction model next to the contact conduction
+    (the range set's models; Vargas & McCarthy on the touching pairs)."""
+
+    def make() -> dict:
+        case = periodic_thermal_case()
+        for material in case["materials"].values():
+            material["thermal_accommodation"] = 0.8
+        case["thermal"].update(indirect_conduction=indirect, substeps=2, range_skin=5e-5)
+        return case
+
+    return make
+
+
 def implicit_thermal_case() -> dict:
     """The range-set bed frozen, Crank-Nicolson (engine/implicit.py): the restarted run
     recomputes the start-of-step rates that the uninterrupted one kept from its last step."""
@@ -202,6 +218,16 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         (periodic_thermal_case, 101, 400),
         (reuse_thermal_case, 101, 400),
         (range_thermal_case, 101, 400),
+        (indirect_case({"model": "batchelor_obrien_separated"}), 101, 300),
+        (indirect_case({"model": "rong_horio1999", "contact_term": True}), 101, 300),
+        (indirect_case({"model": "musser2011"}), 101, 300),
+        (
+            indirect_case(
+                {"model": "vargas_mccarthy2002", "filling_angle": 0.2, "liquid_conductivity": 0.6}
+            ),
+            101,
+            300,
+        ),  # fmt: skip
         (implicit_thermal_case, 7, 15),
     ],
     ids=[
@@ -209,6 +235,10 @@ def _assert_same(a: Simulation, b: Simulation) -> None:
         "periodic-thermal",
         "periodic-conductance-reuse",
         "periodic-range-set",
+        "periodic-bob-separated",
+        "periodic-rong-horio",
+        "periodic-musser",
+        "periodic-vargas-mccarthy",
         "frozen-crank-nicolson",
     ],
 )
@@ -223,6 +253,9 @@ def test_restart_is_bit_identical(tmp_path: Path, make, stop: int, total: int) -
         assert np.ptp(reference.particles.temperature) > 0.0
     else:
         assert reference.contact_count > 0
+    if case.thermal is not None and case.thermal.indirect_conduction.model != "none":
+        # the gas carries heat between the particles
+        assert np.abs(reference.particles.heat_rate_by_mechanism[:, M_INDIRECT]).max() > 0.0
 
     first = Simulation(case_from_dict(make()))
     first.run(steps=stop)

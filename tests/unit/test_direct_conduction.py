@@ -115,7 +115,10 @@ def test_bob_modified_series_network_by_hand():
     w = (eta - 1) / 99
     h_t = (1 - w) * 0.17 * eta**2 + w * (2 * eta / PI - 2 * math.log(eta))
     h_bob = 2 * PI * r_eff * k_f * (h_t + math.log((k_p / k_f) ** 2))
-    for option, r_bar in [(2.0, 2.0 * r_eff), ("dai2019", 1.3121 * (k_p / k_f) ** -0.19 * r_i)]:
+    for option, r_bar in [
+        (2.0, 2.0 * r_eff),
+        ("dai2019_correlation", 1.3121 * (k_p / k_f) ** -0.19 * r_i),
+    ]:
         p = row("batchelor_obrien_modified", k_f=k_f, cylinder_radius=option)
         h_i, h_j = 2.0 * PI * r_bar**2 / r_i, 6.0 * PI * r_bar**2 / r_j
         expected = 10.0 / (1 / h_i + 1 / h_j + 1 / h_bob)
@@ -130,6 +133,106 @@ def test_bob_modified_series_network_by_hand():
         h_i = 2.0 * PI * r_bar_w**2 / r_i
         q = rate("batchelor_obrien_modified", p, 300.0, 310.0, r_i, INF, 1e-6, r_c)
         assert q == pytest.approx(10.0 / (1 / h_i + 1 / h_bob_w), rel=1e-12)
+
+
+SEP_KF = 0.1  # k_p = 1000 (K_HIGH), k_pf = 1e4, k_pf² = 1e8; R* = 0.5 mm: λ = 1e11 d_s
+
+
+def bob_separated_by_hand(gap, ratio, regime="dai2019", r_eff=R_EFF, k_p=1000.0, k_f=SEP_KF):
+    """2π R* k_f X(λ) of the spec's two formulas and the regime rules, written out here."""
+    lam = (k_p / k_f) ** 2 * gap / (2 * r_eff)
+    near = math.log((k_p / k_f) ** 2)
+    far = math.log(1 + (ratio * r_eff) ** 2 / (2 * r_eff * gap))
+    if regime == "moscardini2018":
+        x = near if lam < 0.1 else far
+    elif regime == "minimum" or 0.01 <= lam <= 100:
+        x = min(near, far)
+    else:
+        x = near if lam < 0.01 else far
+    return 2 * PI * r_eff * k_f * x
+
+
+@pytest.mark.parametrize("model", ["batchelor_obrien_complete", "batchelor_obrien_modified"])
+@pytest.mark.parametrize("regime", ["dai2019", "moscardini2018", "minimum"])
+@pytest.mark.parametrize(
+    "cylinder", [0.1, 25.0, "kanuparthi2008", "yun_evans2010", "moscardini2018", "dai2019"]
+)
+def test_bob_separated_part_regimes_and_named_cylinders(model, regime, cylinder):
+    """The separated-pair part of complete (and, through its series network, modified): the
+    spec's λ rules exactly, also for thin and wide cylinders where the minimum alone is not
+    Dai et al.'s rule (r̄ = 0.1 R* keeps the near form up to λ = 0.01; r̄ = 25 R* the far
+    form from λ = 100), and the spec's named cylinders 1.00 / 1.00 / 1.42 / 2.00 R*."""
+    ratio = {"kanuparthi2008": 1.0, "yun_evans2010": 1.0, "moscardini2018": 1.42,
+             "dai2019": 2.0}.get(cylinder, cylinder)  # fmt: skip
+    p = row(model, K_HIGH, K_HIGH, k_f=SEP_KF, regime=regime, cylinder_radius=cylinder)
+    assert p[dc.BOB_CYLINDER_RATIO] == ratio
+    r_bar = ratio * R_EFF
+    h_inner = 0.5 * (1000.0 * PI * r_bar**2 / 1e-3)  # two particles k π r̄² / R in series
+    for lam in (0.009, 0.05, 0.2, 50.0, 150.0):
+        gap = lam / 1e11
+        h = bob_separated_by_hand(gap, ratio, regime)
+        if model == "batchelor_obrien_modified":
+            h = 1.0 / (1.0 / h_inner + 1.0 / h)
+        q = rate(model, p, 300.0, 301.0, 1e-3, 1e-3, -gap, 0.0)
+        assert q == pytest.approx(h, rel=1e-12), lam
+    if regime == "dai2019" and cylinder == 0.1:  # the λ < 0.01 rule, not the minimum
+        gap = 0.009 / 1e11
+        assert bob_separated_by_hand(gap, 0.1, "minimum") < bob_separated_by_hand(gap, 0.1)
+
+
+def test_bob_modified_separated_series_by_hand():
+    """Yun & Evans' network for a separated pair: the particles' inner resistances in series
+    with Batchelor & O'Brien's separated conductance (spec 2.4, 'the resistance of the
+    interaction type'); unequal radii and materials, and a wall (isothermal: no H_j)."""
+    k_f, r_i, r_j, gap = 0.05, 1e-3, 2e-3, 2e-6
+    r_eff = r_i * r_j / (r_i + r_j)
+    k_p = 3.0  # harmonic mean of 2 and 6
+    for option in (1.42, "dai2019_correlation"):
+        p = row("batchelor_obrien_modified", k_f=k_f, cylinder_radius=option)
+        r_bar = 1.42 * r_eff if option == 1.42 else 1.3121 * (k_p / k_f) ** -0.19 * r_i
+        h_bob = bob_separated_by_hand(gap, r_bar / r_eff, r_eff=r_eff, k_p=k_p, k_f=k_f)
+        h_i, h_j = 2.0 * PI * r_bar**2 / r_i, 6.0 * PI * r_bar**2 / r_j
+        q = rate("batchelor_obrien_modified", p, 300.0, 310.0, r_i, r_j, -gap, 0.0)
+        assert q == pytest.approx(10.0 / (1 / h_i + 1 / h_j + 1 / h_bob), rel=1e-12)
+        pw = row("batchelor_obrien_modified", is_wall=True, k_f=k_f, cylinder_radius=option)
+        r_bar_w = 1.42 * r_i if option == 1.42 else 1.3121 * (k_p / k_f) ** -0.19 * r_i
+        h_bob_w = bob_separated_by_hand(gap, r_bar_w / r_i, r_eff=r_i, k_p=k_p, k_f=k_f)
+        h_i = 2.0 * PI * r_bar_w**2 / r_i
+        q = rate("batchelor_obrien_modified", pw, 300.0, 310.0, r_i, INF, -gap, 0.0)
+        assert q == pytest.approx(10.0 / (1 / h_i + 1 / h_bob_w), rel=1e-12)
+
+
+@pytest.mark.parametrize("model", ["batchelor_obrien_complete", "batchelor_obrien_modified"])
+@pytest.mark.parametrize("r_j", [1e-3, 3e-3, INF])
+def test_bob_gap_to_contact_limit(model, r_j):
+    """Gap -> 0 equals the touching value at δ -> 0 (the spec's separated formula tends to
+    2π R* k_f ln k_pf², the contact formula's value at η = 0): both sides of first contact,
+    with the geometric contact radius, agree to the size of the 0.17 η² term."""
+    p = row(model, MAT_A, MAT_B, is_wall=math.isinf(r_j))
+    for eps in (1e-12, 1e-14):
+        below = rate(model, p, 300.0, 301.0, 1e-3, r_j, -eps, 0.0)
+        above = rate(model, p, 300.0, 301.0, 1e-3, r_j, eps,
+                     geometric_contact_radius(1e-3, r_j, eps))  # fmt: skip
+        at = rate(model, p, 300.0, 301.0, 1e-3, r_j, 0.0, 0.0)
+        assert below == pytest.approx(at, rel=1e-13) and above == pytest.approx(at, rel=1e-6)
+        assert below > 0.0
+
+
+def test_bob_separated_part_bad_parameters():
+    """r̄ <= 0, a negative cut-off, unknown names: schema errors naming the key."""
+    from pydantic import ValidationError
+
+    for model in ("batchelor_obrien_complete", "batchelor_obrien_modified"):
+        params = registry.get("direct_conduction", model).params
+        for bad in ({"cylinder_radius": 0.0}, {"cylinder_radius": -2.0},
+                    {"cylinder_radius": math.inf}, {"cylinder_radius": "dai"},
+                    {"cutoff_gap_ratio": -0.5}, {"cutoff_gap_ratio": math.nan},
+                    {"regime": "linear"}):  # fmt: skip
+            with pytest.raises(ValidationError, match=next(iter(bad))):
+                params(**bad)
+    complete = registry.get("direct_conduction", "batchelor_obrien_complete").params
+    with pytest.raises(ValidationError, match="cylinder_radius"):
+        complete(cylinder_radius="dai2019_correlation")  # the modified model's option only
 
 
 def test_bob_pack_checks():
@@ -236,7 +339,7 @@ MODELS = [
     ("batchelor_obrien_complete", {}),
     ("batchelor_obrien_complete", {"blend": "hermite"}),
     ("batchelor_obrien_modified", {}),
-    ("batchelor_obrien_modified", {"cylinder_radius": "dai2019"}),
+    ("batchelor_obrien_modified", {"cylinder_radius": "dai2019_correlation"}),
     ("thermal_pipe", {}),
     ("quintana_ruiz_campello2020", {}),
     ("rojek2014", {}),

@@ -196,3 +196,31 @@ def test_docs_page_exists(spec):
     page = DOCS / f"{spec.family}-{spec.name}.md"
     assert page.is_file(), page
     assert spec.name in page.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("spec", [s for s in SPECS if s.family != "contact_radius"], ids=str)
+def test_no_model_conducts_beyond_the_pairs_its_pair_set_holds(spec):
+    """A model whose range the neighbour machinery does not cover cannot exist: a model that
+    is not evaluated on the range set (contacts target, no interaction range of its own)
+    gives exactly 0 for every separated pair, and a model with a range gives 0 beyond it
+    (its pairs within the range are all in the range set, tests/verification/
+    test_range_set.py). External-set models get their pairs from outside (Voronoi faces)."""
+    if spec.target == "external":
+        pytest.skip("pairs from the external set")
+    fn = spec.kernel
+    rng = np.random.default_rng(41)
+    on_range_set = spec.target == "range" or (
+        spec.family == "direct_conduction" and spec.interaction_range is not None
+    )
+    params = params_of(spec)
+    for wall in (False, True):
+        p = spec.pack(params, resolve_pair(MAT_I, MAT_J, is_wall=wall))
+        for _ in range(300):
+            x = random_inputs(rng, wall)
+            reach = spec.interaction_range(params, x["r_i"], x["r_j"]) if on_range_set else 0.0
+            gap = reach * (1.0 + rng.uniform(0.0, 2.0)) + rng.uniform(1e-12, 1e-4)
+            x["overlap"], x["r_c"] = -gap, 0.0
+            x["dist"] = x["r_i"] + gap if wall else x["r_i"] + x["r_j"] + gap
+            assert call(spec, fn, p, x) == 0.0, (spec.name, wall, x)
+    if not on_range_set and spec.interaction_range is not None:
+        assert spec.interaction_range(params, 1e-3, 1e-3) == 0.0

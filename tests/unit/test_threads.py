@@ -26,6 +26,7 @@ from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
 from thermodem.geometry.insertion import InsertedParticles, save_particle_file
 from thermodem.kernels import contact as C
+from thermodem.state.heat import M_INDIRECT
 
 R0 = 0.005
 SPACING = 1.99 * R0
@@ -100,11 +101,28 @@ def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulatio
             conductance_force_tolerance=0.0,
             range_skin=0.01 * R0,
         )
+    if heat in INDIRECT:  # an indirect_conduction model next to the contact conduction
+        case["neighbors"]["extra_distance"] = 0.0
+        case["thermal"].update(
+            direct_conduction="batchelor_obrien_simple",
+            indirect_conduction=INDIRECT[heat],
+            conductance_force_tolerance=0.0,
+            range_skin=0.01 * R0,
+        )
     sim = Simulation(case_from_dict(case), threads=threads)
     assert sim.threads == threads and sim.threads_reason == "as requested"
     seen: list[int] = []
     sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
     return sim, seen
+
+
+#: every indirect_conduction model that runs on the range set or the contact lists
+INDIRECT = {
+    "bob-separated": {"model": "batchelor_obrien_separated", "cutoff_gap_ratio": 0.4},
+    "rong-horio": {"model": "rong_horio1999", "layer_thickness_ratio": 0.2},
+    "musser": {"model": "musser2011", "layer_thickness_ratio": 0.2},
+    "vargas": {"model": "vargas_mccarthy2002", "filling_angle": 0.3, "liquid_conductivity": 0.6},
+}
 
 
 def by_gid(sim: Simulation, name: str) -> np.ndarray:
@@ -114,7 +132,9 @@ def by_gid(sim: Simulation, name: str) -> np.ndarray:
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
 @pytest.mark.parametrize(
-    "heat", ["", "reuse", "range"], ids=["mechanics", "conductance-reuse", "range-set"]
+    "heat",
+    ["", "reuse", "range", *INDIRECT],
+    ids=["mechanics", "conductance-reuse", "range-set", *INDIRECT],
 )
 def test_one_and_two_threads_bit_identical(tmp_path, heat):
     path = tmp_path / "bed.txt"
@@ -139,9 +159,11 @@ def test_one_and_two_threads_bit_identical(tmp_path, heat):
         names += ["generation_energy"]
         assert one.report()["heat_in_generation_sliding_friction"] > 0.0
         assert one.report() == two.report()
-    if heat == "range":
+    if heat == "range" or (heat in INDIRECT and heat != "vargas"):
         rs = one.thermal.range_set
         assert rs.count > 2 * C.CHUNK and rs.ngroups >= 8 and rs.builds > 1
+    if heat in INDIRECT:  # the gas carries heat
+        assert np.abs(one.particles.heat_rate_by_mechanism[:, M_INDIRECT]).max() > 0.0
     for name in names:
         a = by_gid(one, name)
         b = by_gid(two, name)

@@ -292,9 +292,10 @@ def format_error(err: dict[str, Any], data: Any) -> str:
     keys = _allowed_keys(where) or []
     if own and dotted and own.group(1).split(".")[0] in keys:
         return f"{dotted}.{msg}"
-    shown = (
-        "" if isinstance(value, dict | list) or repr(value) in msg else f" (got {_shown(value)})"
-    )
+    # the value, unless the message already quotes it ('..., got -1.0'; a bare 'greater than
+    # 0' does not: that 0 is the bound)
+    quoted = re.search(r"\bgot\b", msg) is not None and repr(value) in msg
+    shown = "" if isinstance(value, dict | list) or quoted else f" (got {_shown(value)})"
     return f"{dotted}: {msg}{shown}" if dotted else f"{msg}{shown}"
 
 

@@ -122,6 +122,9 @@ class ThermalEngine:
             if any(t.target == "range" for t in self.terms)
             else None
         )
+        if self.range_set is not None and self._radius_bound() > 0.0:
+            # before the run: the largest particles the insertions can bring (pours too)
+            self.check_ranges(self._radius_bound())
         # per-pair conductances of the contact conduction (heat-only passes, frozen reuse)
         self.pair_conductance = np.zeros(0)
         self.wall_conductance = np.zeros(0)
@@ -395,21 +398,62 @@ class ThermalEngine:
         p = self.sim.particles
         if p.count == 0:
             return 0.0, 0.0
-        r_max = float(p.radius.max())
-        extent = float(np.min(self.sim.upper - self.sim.lower))
+        return self.check_ranges(float(p.radius.max()))
+
+    def _radius_bound(self) -> float:
+        """Largest radius the case's insertion distributions can produce [m] (0 if none
+        is bounded; particle files and lists are checked once inserted)."""
+        bounds = [
+            getattr(getattr(e, "distribution", None), "max_radius_bound", None)
+            for e in self.sim.case.insertion
+        ]
+        return max([float(b) for b in bounds if b is not None] + [0.0])
+
+    def check_ranges(self, r_max: float) -> tuple[float, float]:
+        """The range set's largest conducting gaps of particle pairs and particle-wall pairs
+        for particles up to ``r_max`` [m]; a ConfigError naming the model's key and its range
+        parameter when a gap exceeds the domain, or when a periodic axis is too short for the
+        range set's cells (two cells of 2 r_max + gap + skin)."""
+        sim = self.sim
+        extent = float(np.min(sim.upper - sim.lower))
         gap = wall_gap = 0.0
+        widest = None
         for term in self.terms:
             if term.target != "range":
                 continue
             g, w = term.max_gap(r_max)
             if max(g, w) > extent:
                 raise ConfigError(
-                    f"{term.key} = {term.choice.model!r}: its largest conducting gap "
-                    f"{max(g, w):.6g} m (for particles of radius {r_max:.6g} m) exceeds the "
-                    f"domain's smallest extent {extent:.6g} m; check its range parameters "
-                    f"({term.params.model_dump()})"
+                    f"{_range_key(term)}: {term.choice.model!r} conducts across surface gaps up "
+                    f"to {max(g, w):.6g} m for particles of radius {r_max:.6g} m, more than the "
+                    f"domain's smallest extent {extent:.6g} m; allowed: "
+                    f"{_range_allowed(term, extent / max(g, w))}"
                 )
+            if widest is None or g > gap:
+                widest = term
             gap, wall_gap = max(gap, g), max(wall_gap, w)
+        if widest is None:
+            return gap, wall_gap
+        skin = self.settings.range_skin
+        if skin is None:  # the contact list's skin (its default: 0.2 R_max)
+            skin = getattr(sim, "skin", None) or sim.case.neighbors.skin or 0.2 * r_max
+        cell = 2.0 * r_max + gap + float(skin)
+        length = sim.upper - sim.lower
+        for a in range(3):
+            if sim.periodic[a] and length[a] < 2.0 * cell:
+                # the part of the cell the model's range can still take
+                room = 0.5 * float(length[a]) - 2.0 * r_max - float(skin)
+                raise ConfigError(
+                    f"{_range_key(widest)}: periodic axis {'xyz'[a]} of length "
+                    f"{length[a]:.6g} m is shorter than two cells of the range pair set "
+                    f"(2 R_max {2.0 * r_max:.6g} m + largest conducting gap {gap:.6g} m + "
+                    f"thermal.range_skin {float(skin):.6g} m each); allowed: "
+                    + (
+                        _range_allowed(widest, room / gap)
+                        if room > 0.0
+                        else "a longer periodic axis or a smaller thermal.range_skin"
+                    )
+                )
         return gap, wall_gap
 
     def thermal_dt(self) -> float:
@@ -888,3 +932,20 @@ class ThermalEngine:
         if field_scalars is not None and self.field_provider.active:
             self.field_provider.load_state_dict({"scalars": field_scalars, "arrays": field_arrays})
         self.conditions.invalidate()
+
+
+def _range_key(term: HeatTerm) -> str:
+    """'thermal.indirect_conduction.cutoff_gap_ratio = 100.0' (the key that sets the range)."""
+    name = term.spec.range_parameter
+    if name is None:
+        return f"{term.key} = {term.choice.model!r}"
+    return f"{term.key}.{name} = {getattr(term.params, name)!r}"
+
+
+def _range_allowed(term: HeatTerm, factor: float) -> str:
+    """What the range parameter may be: its value scaled by ``factor`` (ranges are
+    proportional to it)."""
+    name = term.spec.range_parameter
+    if name is None:
+        return "smaller range parameters or a larger domain"
+    return f"{name} below {getattr(term.params, name) * factor:.6g} (or a larger domain)"

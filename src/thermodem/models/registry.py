@@ -76,6 +76,7 @@ class ModelSpec:
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None
     uses_contact_radius: bool = True
     example_params: dict[str, Any] = field(default_factory=dict)
+    range_parameter: str | None = None
     requires_of: Callable[[BaseModel], tuple[str, ...]] | None = None
 
     def required(self, params: BaseModel) -> tuple[str, ...]:
@@ -124,6 +125,7 @@ def register(
     conductance_reuse_refusal: Callable[[BaseModel], str | None] | None = None,
     uses_contact_radius: bool = True,
     example_params: dict[str, Any] | None = None,
+    range_parameter: str | None = None,
     requires_of: Callable[[BaseModel], tuple[str, ...]] | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
@@ -137,8 +139,10 @@ def register(
     ``conductance_reuse_refusal(params)`` a reason to refuse it for some parameter values (or
     None); ``uses_contact_radius`` False for a pair-term kernel that ignores its ``r_c``
     argument (the range pass then does not compute it); ``example_params`` parameters the
-    conformance tests use for a model without defaults; ``requires_of(params)`` material
-    properties required only with some parameter values (a partition formula's inputs).
+    conformance tests use for a model without defaults; ``range_parameter`` the parameter
+    that sets ``interaction_range`` (in proportion), named by the range errors;
+    ``requires_of(params)`` material properties required only with some parameter values (a
+    partition formula's inputs).
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -180,8 +184,11 @@ def register(
         conductance_reuse_refusal=conductance_reuse_refusal,
         uses_contact_radius=uses_contact_radius,
         example_params=dict(example_params or {}),
+        range_parameter=range_parameter,
         requires_of=requires_of,
     )
+    if range_parameter is not None and range_parameter not in params.model_fields:
+        raise ValueError(f"{family}.{name}: range_parameter {range_parameter!r} is no parameter")
     models[name] = spec
     return spec
 

@@ -38,10 +38,20 @@ from typing import Literal
 
 import numpy as np
 from numba import njit
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.models.registry import packed, register
+from thermodem.models.thermal.batchelor_obrien import (
+    CYLINDER_HELP,
+    REGIMES,
+    CylinderName,
+    RegimeName,
+    check_cylinder,
+    cylinder_ratio,
+    gap_conductance,
+    regime_field,
+)
 from thermodem.models.thermal.contact_radius import (
     effective_radius,
     hertz_collision_time,
@@ -72,10 +82,10 @@ SWAP_PAIRS = ((0, 1), (2, 3))
 HEAD = ("k_i", "k_j", "rhoc_i", "rhoc_j")
 K_I, K_J, RHOC_I, RHOC_J = 0, 1, 2, 3
 #: Batchelor & O'Brien complete (and modified: one column more).
-BOB_COLUMNS = (*HEAD, "k_f", "blend", "cylinder_ratio", "cutoff_gap_ratio")
-BOB_K_F, BOB_BLEND, BOB_CYLINDER_RATIO, BOB_CUTOFF_RATIO = 4, 5, 6, 7
-BOB_MODIFIED_COLUMNS = (*BOB_COLUMNS, "dai2019_cylinder")
-BOB_DAI2019 = 8
+BOB_COLUMNS = (*HEAD, "k_f", "blend", "cylinder_ratio", "cutoff_gap_ratio", "regime")
+BOB_K_F, BOB_BLEND, BOB_CYLINDER_RATIO, BOB_CUTOFF_RATIO, BOB_REGIME = 4, 5, 6, 7, 8
+BOB_MODIFIED_COLUMNS = (*BOB_COLUMNS, "dai2019_correlation")
+BOB_DAI2019 = 9
 #: Collisional models (Sun & Chen, Zhou).
 COLLISIONAL_COLUMNS = (*HEAD, "e_star", "correction_factor", "static_model")
 COL_E_STAR, COL_CORRECTION, COL_STATIC_MODEL = 4, 5, 6
@@ -171,23 +181,21 @@ def bob_contact_h(eta, blend):
 
 
 @njit(cache=True, error_model="numpy")
-def bob_conductance(k_p, k_f, r_eff, r_c, overlap, blend, r_cyl, cutoff_gap):
+def bob_conductance(k_p, k_f, r_eff, r_c, overlap, blend, r_cyl, cutoff_gap, regime):
     """Batchelor & O'Brien (1977) conductance H [W/K] between two surfaces (spec 2.3).
 
     Contact (δ >= 0): 2π R* k_f (H̃_c + H̃_f + ln k_pf²), η = k_pf R_c/(2R*).
-    Separated (gap d_s = -δ < cutoff): 2π R* k_f min(ln k_pf², ln(1 + r̄²/(2 R* d_s))), which is
-    Dai et al. (2019)'s three-regime λ rule whenever 0.2 <= r̄/R* <= 20. 0 beyond the cut-off.
+    Separated (gap d_s = -δ < cutoff): 2π R* k_f X(λ), X = ln k_pf² or ln(1 + r̄²/(2 R* d_s))
+    by the λ rule ``regime`` (models/thermal/batchelor_obrien.py). 0 beyond the cut-off.
     """
     kpf = k_p / k_f
-    log_kpf2 = 2.0 * math.log(kpf)
     if overlap >= 0.0:
         eta = kpf * r_c / (2.0 * r_eff)
-        return 2.0 * math.pi * r_eff * k_f * (bob_contact_h(eta, blend) + log_kpf2)
+        return 2.0 * math.pi * r_eff * k_f * (bob_contact_h(eta, blend) + 2.0 * math.log(kpf))
     gap = -overlap
     if gap >= cutoff_gap:
         return 0.0
-    separated = math.log1p(r_cyl * r_cyl / (2.0 * r_eff * gap))
-    return 2.0 * math.pi * r_eff * k_f * min(log_kpf2, separated)
+    return gap_conductance(k_p, k_f, r_eff, gap, r_cyl / r_eff, regime)
 
 
 class BatchelorOBrienCompleteParams(StrictModel):
@@ -200,20 +208,28 @@ class BatchelorOBrienCompleteParams(StrictModel):
     batchelor_obrien_simple), k_pf = k_p/k_f must exceed 1. The 1 <= η <= 100 blend
     of the spec is not monotonic (see bob_contact_h); ``blend="hermite"`` is a monotonic one.
     Separated pairs conduct up to a gap ``cutoff_gap_ratio`` R* (Yun & Evans 2010: d_s < R̄),
-    through a cylinder of radius ``cylinder_radius`` R* (2.0: Dai et al. 2019; for equal
-    spheres R* = R/2, so 2.0 is a cylinder of the particle radius).
-    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*].
+    through a cylinder of radius ``cylinder_radius`` R* (a number, or a named choice of the
+    spec: dai2019 = 2.00, Dai et al. 2019; for equal spheres R* = R/2, so 2.00 is a cylinder of
+    the particle radius), with the λ rule ``regime`` (as batchelor_obrien_separated).
+    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime].
     """
 
     blend: Literal[tuple(_BLENDS)] = Field(
         default="spec_linear", description="H̃ for 1 <= η <= 100: spec's blend or monotonic"
     )
-    cylinder_radius: float = Field(
-        default=2.0, gt=0, description="r̄ / R* [-], conduction cylinder of separated pairs"
-    )
+    regime: RegimeName = regime_field()
+    cylinder_radius: float | CylinderName = Field(default=2.0, description=CYLINDER_HELP)
     cutoff_gap_ratio: float = Field(
-        default=1.0, ge=0, description="largest conducting gap d_s / R* [-] of separated pairs"
+        default=1.0,
+        ge=0,
+        allow_inf_nan=False,
+        description="largest conducting gap d_s / R* [-] of separated pairs",
     )
+
+    @field_validator("cylinder_radius")
+    @classmethod
+    def _cylinder(cls, v: float | str) -> float | str:
+        return check_cylinder(v)
 
 
 def _check_kpf(k_i: float, k_j: float, k_f: float, model: str) -> None:
@@ -231,8 +247,9 @@ def pack_bob_complete(params: BatchelorOBrienCompleteParams, pair: PairContext) 
     k_f = pair.gas.thermal_conductivity
     _check_kpf(k_i, k_j, k_f, model)
     values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
-                                        "cylinder_ratio": params.cylinder_radius,
-                                        "cutoff_gap_ratio": params.cutoff_gap_ratio}  # fmt: skip
+                                        "cylinder_ratio": cylinder_ratio(params.cylinder_radius),
+                                        "cutoff_gap_ratio": params.cutoff_gap_ratio,
+                                        "regime": REGIMES[params.regime]}  # fmt: skip
     return packed(BOB_COLUMNS, values)
 
 
@@ -248,24 +265,35 @@ def bob_complete_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact,
     k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
     r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
     cutoff = p[BOB_CUTOFF_RATIO] * r_eff
-    h = bob_conductance(k_p, p[BOB_K_F], r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff)
+    h = bob_conductance(
+        k_p, p[BOB_K_F], r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff, p[BOB_REGIME]
+    )
     return h * (t_j - t_i)
 
 
 # --------------------------------------------------------- Batchelor & O'Brien, modified
 class BatchelorOBrienModifiedParams(BatchelorOBrienCompleteParams):
     """Yun & Evans (2010) Comput. Geotech. 37, 991-998: BOB in series with the two particles'
-    inner resistances, H = (1/H_i + 1/H_j + 1/H_BOB)^-1, H_i = k_i π r̄² / R_i (spec 2.4).
+    inner resistances, H = (1/H_i + 1/H_j + 1/H_BOB)^-1, H_i = k_i π r̄² / R_i (spec 2.4),
+    for touching and separated pairs (the spec's "resistance of the interaction type").
 
     H_BOB is batchelor_obrien_complete's conductance (same parameters). ``cylinder_radius`` is
-    r̄/R* or ``"dai2019"``: r̄ = 1.3121 k_pf^-0.19 min(R_i, R_j) (Dai, Hanaor & Gan 2019, Int.
-    J. Therm. Sci. 142, 266-279; fitted for k_pf < 1e3). A wall is isothermal: 1/H_j is
-    dropped. Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, 1 if dai2019].
+    r̄/R*, a named choice of the spec (as complete), or ``"dai2019_correlation"``: r̄ = 1.3121
+    k_pf^-0.19 min(R_i, R_j) (Dai, Hanaor & Gan 2019, Int. J. Therm. Sci. 142, 266-279; fitted
+    for k_pf < 1e3). A wall is isothermal: 1/H_j is dropped.
+    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime, 1 if dai2019_correlation].
     """
 
-    cylinder_radius: float | Literal["dai2019"] = Field(
-        default=2.0, description="r̄ / R* [-] (> 0), or 'dai2019' for Dai et al.'s correlation"
+    cylinder_radius: float | CylinderName | Literal["dai2019_correlation"] = Field(
+        default=2.0,
+        description=CYLINDER_HELP + ", or dai2019_correlation: r̄ = 1.3121 k_pf^-0.19 "
+        "min(R_i, R_j) (Dai et al. 2019)",
     )
+
+    @field_validator("cylinder_radius")
+    @classmethod
+    def _cylinder(cls, v: float | str) -> float | str:
+        return check_cylinder(v, ("dai2019_correlation",))
 
 
 def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) -> np.ndarray:
@@ -273,14 +301,13 @@ def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) 
     k_i, k_j = _conductivities(pair, model)
     k_f = pair.gas.thermal_conductivity
     _check_kpf(k_i, k_j, k_f, model)
-    dai = params.cylinder_radius == "dai2019"
-    ratio = 0.0 if dai else float(params.cylinder_radius)
-    if not dai and ratio <= 0.0:
-        raise ValueError(f"{model}: cylinder_radius must be > 0 or 'dai2019', got {ratio}")
+    dai = params.cylinder_radius == "dai2019_correlation"
+    ratio = 0.0 if dai else cylinder_ratio(params.cylinder_radius)
     values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
                                         "cylinder_ratio": ratio,
                                         "cutoff_gap_ratio": params.cutoff_gap_ratio,
-                                        "dai2019_cylinder": 1.0 if dai else 0.0}  # fmt: skip
+                                        "regime": REGIMES[params.regime],
+                                        "dai2019_correlation": 1.0 if dai else 0.0}  # fmt: skip
     return packed(BOB_MODIFIED_COLUMNS, values)
 
 
@@ -294,7 +321,9 @@ def bob_modified_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact,
     else:
         r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
     cutoff = p[BOB_CUTOFF_RATIO] * r_eff
-    h_bob = bob_conductance(k_p, k_f, r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff)
+    h_bob = bob_conductance(
+        k_p, k_f, r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff, p[BOB_REGIME]
+    )
     if h_bob <= 0.0:
         return 0.0
     area = math.pi * r_cyl * r_cyl
@@ -580,6 +609,7 @@ _register(
     "Batchelor & O'Brien contact (η regimes) and separated-particle conduction",
     _BOB + "; Dai, Hanaor & Gan (2019); Moscardini et al. (2018)",
     pack_bob_complete, interaction_range=bob_interaction_range, columns=BOB_COLUMNS,
+    range_parameter="cutoff_gap_ratio",
     uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(
@@ -589,6 +619,7 @@ _register(
     "Yun & Evans (2010) Comput. Geotech. 37, 991-998; Dai, Hanaor & Gan (2019) Int. J. Therm. "
     "Sci. 142, 266-279",
     pack_bob_modified, interaction_range=bob_interaction_range, columns=BOB_MODIFIED_COLUMNS,
+    range_parameter="cutoff_gap_ratio",
     uses_gas=("thermal_conductivity",),
 )  # fmt: skip
 _register(

@@ -29,7 +29,6 @@ choices and their reasons: ``docs/models/indirect_conduction-*.md``.
 from __future__ import annotations
 
 import math
-from typing import Literal
 
 import numpy as np
 from numba import njit
@@ -37,6 +36,16 @@ from pydantic import Field, field_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.models.registry import packed, register
+from thermodem.models.thermal.batchelor_obrien import (
+    CYLINDER_HELP,
+    REGIMES,
+    CylinderName,
+    RegimeName,
+    check_cylinder,
+    cylinder_ratio,
+    gap_conductance,
+    regime_field,
+)
 from thermodem.models.thermal.contact_radius import effective_radius, require
 from thermodem.models.thermal.surrounding_layer import (
     MUSSER2011,
@@ -84,24 +93,6 @@ BOB_CUTOFF = 5
 BOB_COLUMNS = ("k_i", "k_j", "k_f", "regime", "cylinder_ratio", "cutoff_gap_ratio")
 BOB_SWAP_PAIRS = ((BOB_K_I, BOB_K_J),)
 
-REGIME_DAI2019 = 0
-REGIME_MOSCARDINI2018 = 1
-REGIME_MINIMUM = 2
-_REGIMES = {
-    "dai2019": REGIME_DAI2019,
-    "moscardini2018": REGIME_MOSCARDINI2018,
-    "minimum": REGIME_MINIMUM,
-}
-
-#: r̄ / R̄ of the named conduction cylinders (spec, "Particles separated").
-CYLINDER_RATIOS = {
-    "kanuparthi2008": 1.00,  # Kanuparthi et al. 2008
-    "yun_evans2010": 1.00,  # Yun & Evans 2010, calibrated for k_pf = 120
-    "moscardini2018": 1.42,  # Moscardini et al. 2018, calibrated for k_pf = 10
-    "dai2019": 2.00,  # Dai et al. 2019, calibrated for the modified BOB model
-}
-CylinderName = Literal["kanuparthi2008", "yun_evans2010", "moscardini2018", "dai2019"]
-
 
 class BatchelorOBrienSeparatedParams(StrictModel):
     """Batchelor & O'Brien (1977) Proc. R. Soc. Lond. A 355, 313-333, conduction through the
@@ -117,14 +108,8 @@ class BatchelorOBrienSeparatedParams(StrictModel):
     d - R_i. Row: [k_i, k_j, k_f, regime, r̄/R̄, d_s,max/R̄].
     """
 
-    regime: Literal[tuple(_REGIMES)] = Field(
-        default="dai2019", description="which λ formula where: dai2019, moscardini2018, minimum"
-    )
-    cylinder_radius: float | CylinderName = Field(
-        default="dai2019",
-        description="r̄ / R̄ [-] (> 0), or kanuparthi2008 / yun_evans2010 (1.00), "
-        "moscardini2018 (1.42), dai2019 (2.00)",
-    )
+    regime: RegimeName = regime_field()
+    cylinder_radius: float | CylinderName = Field(default="dai2019", description=CYLINDER_HELP)
     cutoff_gap_ratio: float = Field(
         default=1.0, gt=0, description="largest conducting gap d_s / R̄ [-] (Yun & Evans 2010)"
     )
@@ -132,18 +117,11 @@ class BatchelorOBrienSeparatedParams(StrictModel):
     @field_validator("cylinder_radius")
     @classmethod
     def _positive_ratio(cls, v: float | str) -> float | str:
-        if not isinstance(v, str) and not (v > 0.0 and math.isfinite(v)):
-            raise ValueError(
-                f"cylinder_radius must be a finite r̄/R̄ > 0 or one of "
-                f"{', '.join(CYLINDER_RATIOS)}, got {v!r}"
-            )
-        return v
+        return check_cylinder(v)
 
     def cylinder_ratio(self) -> float:
         """r̄ / R̄ [-] of the selected conduction cylinder."""
-        if isinstance(self.cylinder_radius, str):
-            return CYLINDER_RATIOS[self.cylinder_radius]
-        return float(self.cylinder_radius)
+        return cylinder_ratio(self.cylinder_radius)
 
 
 def pack_bob_separated(params: BatchelorOBrienSeparatedParams, pair: PairContext) -> np.ndarray:
@@ -158,7 +136,7 @@ def pack_bob_separated(params: BatchelorOBrienSeparatedParams, pair: PairContext
             f"k_p = 2 k_i k_j/(k_i + k_j) = {k_p:g} W/(m K), "
             f"thermal.gas.thermal_conductivity = {k_f:g} W/(m K)"
         )
-    values = [k_i, k_j, k_f, _REGIMES[params.regime], params.cylinder_ratio()]
+    values = [k_i, k_j, k_f, REGIMES[params.regime], params.cylinder_ratio()]
     return np.array([*values, params.cutoff_gap_ratio], dtype=np.float64)
 
 
@@ -168,25 +146,6 @@ def bob_separated_range(
     """Largest surface gap [m] at which H > 0: cutoff_gap_ratio × R̄ (wall: R̄ = R_i)."""
     r_eff = radius_i if math.isinf(radius_j) else radius_i * radius_j / (radius_i + radius_j)
     return params.cutoff_gap_ratio * r_eff
-
-
-@njit(cache=True, error_model="numpy")
-def bob_separated_factor(kpf, lam, r_cyl_ratio, gap_ratio, regime):
-    """X of H = 2π R̄ k_f X for λ = k_pf² d_s/(2R̄), r̄/R̄ and d_s/R̄ (spec, BOB separated).
-
-    near = ln k_pf² (λ ≪ 1), far = ln(1 + r̄²/(2 R̄ d_s)) = log1p((r̄/R̄)²/(2 d_s/R̄)).
-    """
-    near = 2.0 * math.log(kpf)
-    far = math.log1p(r_cyl_ratio * r_cyl_ratio / (2.0 * gap_ratio))
-    if regime == REGIME_MOSCARDINI2018:
-        return near if lam < 0.1 else far
-    if regime == REGIME_MINIMUM:
-        return min(near, far)
-    if lam < 0.01:
-        return near
-    if lam > 100.0:
-        return far
-    return min(near, far)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -202,11 +161,8 @@ def bob_separated_conductance(p, r_i, r_j, dist, r_c, f_n):
         return 0.0
     k_i = p[BOB_K_I]
     k_j = p[BOB_K_J]
-    k_f = p[BOB_K_F]
-    kpf = 2.0 * (k_i * k_j) / (k_i + k_j) / k_f
-    lam = kpf * kpf * gap_ratio * 0.5
-    x = bob_separated_factor(kpf, lam, p[BOB_CYLINDER], gap_ratio, p[BOB_REGIME])
-    return 2.0 * math.pi * r_eff * k_f * x
+    k_p = 2.0 * (k_i * k_j) / (k_i + k_j)
+    return gap_conductance(k_p, p[BOB_K_F], r_eff, gap, p[BOB_CYLINDER], p[BOB_REGIME])
 
 
 # ---------------------------------------------------------------------------- dispatcher
@@ -258,6 +214,7 @@ register(
     requires=("thermal_conductivity",),
     uses_gas=("thermal_conductivity",),
     interaction_range=bob_separated_range,
+    range_parameter="cutoff_gap_ratio",
     uses_contact_radius=False,
     antisymmetric=False,
     symmetric=True,

@@ -376,6 +376,7 @@ register(
     reference="Rong & Horio (1999) Proc. 2nd Int. Conf. CFD Miner. Process Ind., Melbourne, "
     "65-70" + _WALL + _PENG,
     interaction_range=rong_horio1999_range,
+    range_parameter="layer_thickness_ratio",
     columns=RH_COLUMNS,
     uses_contact_radius=False,
     **_COMMON,
@@ -389,6 +390,7 @@ register(
     summary="surrounding fluid layer, multi-sized: ∫ 2πr k_f / max(S, d_f(r)) dr, closed form",
     reference="Musser (2011) PhD thesis, West Virginia University" + _WALL + _PENG,
     interaction_range=musser2011_range,
+    range_parameter="layer_thickness_ratio",
     columns=MUSSER_COLUMNS,
     **_COMMON,
 )
