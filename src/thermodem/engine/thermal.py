@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermodem.config.thermal import ThermalSettings
+from thermodem.engine import generation
 from thermodem.engine.external_set import ExternalPairSet
 from thermodem.engine.fields import STATE_PREFIX as FIELDS_PREFIX
 from thermodem.engine.fields import FieldProvider
@@ -43,7 +44,6 @@ from thermodem.engine.voronoi import INPUT_WIDTH, VoronoiProvider
 from thermodem.errors import ConfigError, SimulationError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as field_kernels
-from thermodem.kernels import generation as generation_kernels
 from thermodem.kernels import heat_terms as passes
 from thermodem.kernels import thermal as kernels
 from thermodem.state import heat
@@ -463,20 +463,12 @@ class ThermalEngine:
         return self.substeps * self.sim.dt
 
     def generation_rates(self) -> None:
-        """The heat generation columns: χ E / Δt_th from the particles' accumulated dissipated
-        energy E (kernels/generation.py); the thermal step clears E after using them."""
-        if not self.generation.active:
-            return
-        p = self.sim.particles
-        gen = self.generation
-        generation_kernels.generation_heat(p.generation_energy, gen.select,
-                                           gen.conversion_fraction, self.thermal_dt(),
-                                           p.heat_rate_by_mechanism)  # fmt: skip
+        """The heat generation columns from the accumulated dissipated energy
+        (engine/generation.py); the thermal step clears the accumulators after using them."""
+        generation.rates(self)
 
     def _generation_used(self) -> None:
-        """The thermal step applied the generated heat: clear the accumulators."""
-        if self.generation.active:
-            self.sim.particles.generation_energy[:] = 0.0
+        generation.clear(self)
 
     def evaluate_terms(self, time: float) -> None:
         """Add the heat of every term other than the contact conduction (at this state and
@@ -789,34 +781,6 @@ class ThermalEngine:
         return (self.thermal_energy() - self.initial_energy - self.boundary_heat()
                 + cum["fixed_absorbed"] - cum["inserted_heat"] - cum["fixed_reset"])  # fmt: skip
 
-    def generation_ledger(self) -> dict[str, float]:
-        """The heat generation ledger [J] per selected mechanism g: χ × the energy the
-        mechanics dissipated (``generated_<g>``: the mechanical ledger's ``dissipated_<g>``,
-        or the kinetic energy lost in collisions), the heat that went to walls with a fixed
-        temperature (``heat_to_walls_generation_<g>``), the heat accumulated in the particles
-        but not yet applied by a thermal step (``heat_pending_generation_<g>``); with the heat
-        into the particles (``heat_in_generation_<g>``, the heat ledger) they close:
-        ``generation_balance_error`` = Σ_g generated - in - walls - pending, round-off."""
-        sim = self.sim
-        gen = self.generation
-        chi = gen.conversion_fraction
-        cum = sim.ledger_cumulative
-        pending = sim.particles.generation_energy.sum(axis=0)
-        out: dict[str, float] = {}
-        error = 0.0
-        for g in gen.mechanisms:
-            name = heat.GENERATION[g]
-            source = "collision_energy_loss" if g == heat.G_COLLISION else name
-            generated = chi * cum[source]
-            walls = chi * cum[f"wall_generation_{name}"]
-            waiting = chi * float(pending[g])
-            out[f"generated_{name}"] = generated
-            out[f"heat_to_walls_generation_{name}"] = walls
-            out[f"heat_pending_generation_{name}"] = waiting
-            error += generated - walls - waiting - self.cumulative[f"heat_in_generation_{name}"]
-        out["generation_balance_error"] = error
-        return out
-
     def summary(self) -> dict[str, float]:
         """Temperature statistics, heat rates by mechanism [W] and the heat ledger [J].
 
@@ -842,7 +806,7 @@ class ThermalEngine:
         out.update({k: v for k, v in self.cumulative.items() if not k.startswith("heat_in_")})
         out["heat_balance_error"] = self.balance_error()
         if self.generation.active:
-            out.update(self.generation_ledger())
+            out.update(generation.ledger(self))
         out["thermal_limit"] = self.limit
         if self.range_set is not None:
             out["range_pair_count"] = self.range_set.count

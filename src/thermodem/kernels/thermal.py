@@ -18,8 +18,8 @@ from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_THERMAL_KIND
 from thermodem.kernels.contact import CHUNK, STATE_TOUCHING
+from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
-from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance, reusable
 from thermodem.state.heat import M_SOURCE
 
 _CONDUCTION_PASSES: dict[tuple[int, int, int], Any] = {}
