@@ -12,7 +12,7 @@ with layer_thickness_ratio 0.25 and 0.5, i.e. gaps of 0.5 R̄ and 1.0 R̄). 500
 untimed steps, then the timed steps; throughput = N × steps / loop seconds.
 
     python bench/bench_shared_bed.py [--threads 1 2] [--steps 1000] [--warmup 500]
-        [--cases mechanics heat region material]
+        [--cases mechanics heat region material] [--rounds N] [--phases]
         [--indirect MODEL [--indirect-param KEY=VALUE ...]]
         [--substeps N] [--convection MODEL] [--porosity cell|shell|global]
         [--radiation MODEL] [--frozen DT] [--json]
@@ -26,8 +26,20 @@ the local porosity of ``--porosity`` (default cell), ``--radiation`` a radiation
 krause2017; emissivity 0.9), both per-particle terms on top of the heat cases (issue 13:
 ``--cases region --convection gunn1978 --radiation krause2017`` against ``--cases region``).
 
-Each (case, thread count) runs in a fresh process; prints particle-steps per second and the
-peak memory above the interpreter's baseline per particle.
+Each (case, thread count) runs in a fresh process; prints particle-steps per second (of the
+loop's wall time; ``cpu`` is the same figure from the process's CPU time, the steadier one for
+1 thread on a machine shared with other work), the peak memory above the interpreter's
+baseline per particle and the load average (``/proc/loadavg``, 1 min) before and after. With
+``--rounds N`` the cases are run N times interleaved (mechanics, region, material, mechanics,
+...); a summary gives per thread count the median throughput of each case, the heat overhead
+against mechanics (mechanics throughput / heat throughput - 1) and the 2-thread speed-ups.
+``--phases`` prints the per-phase timing of ``Simulation.step`` (``bench/step_phases.py``)
+for each run.
+
+The issue-17 target (heat on with fixed particles at most 15 % over mechanics, with the same
+2-thread speed-up as mechanics) is read from that summary:
+
+    python bench/bench_shared_bed.py --rounds 3 --steps 1000
 """
 
 from __future__ import annotations
@@ -52,7 +64,8 @@ HOT_Z = 1.5e-3
 
 def particle_files(tiny: bool = False) -> tuple[Path, Path, Path]:
     """(all, hot, cold) particle files converted from the shared bed (cached); ``tiny``: the
-    same for the first 400 particles (the kernels are loaded on it before the baseline)."""
+    same for every 125th particle, 400 over the bed's height, hot and cold ones (the kernels
+    are loaded on it before the baseline)."""
     from thermodem.geometry.insertion import InsertedParticles, save_particle_file
 
     CACHE.mkdir(parents=True, exist_ok=True)
@@ -62,7 +75,7 @@ def particle_files(tiny: bool = False) -> tuple[Path, Path, Path]:
         return paths
     data = np.loadtxt(BED, comments="#")
     if tiny:
-        data = data[:400]
+        data = data[::125]
     pos, rad = data[:, :3], data[:, 3]
     hot = pos[:, 2] < HOT_Z
     for path, sel in zip(paths, (np.ones(len(pos), bool), hot, ~hot), strict=True):
@@ -152,15 +165,30 @@ def case_dict(kind: str, indirect: dict | None, substeps: int, tiny: bool = Fals
     return case
 
 
+def load_average() -> float:
+    """The 1-minute load average of the machine."""
+    try:
+        return float(Path("/proc/loadavg").read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        return float("nan")
+
+
 def rss_bytes() -> int:
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
 def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | None,
-          substeps: int, terms: tuple = (None, "cell", None)) -> dict:  # fmt: skip
+          substeps: int, terms: tuple = (None, "cell", None),
+          phases: bool = False) -> dict:  # fmt: skip
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
+
+    if phases:
+        sys.path.insert(0, str(Path(__file__).parent))
+        import step_phases
+
+        step_phases.instrument()
 
     # baseline: interpreter, libraries and the compiled kernels, loaded on a tiny bed
     Simulation(case_from_dict(case_dict(kind, indirect, substeps, True, terms)),
@@ -169,9 +197,13 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
     sim = Simulation(case_from_dict(case_dict(kind, indirect, substeps, False, terms)),
                      threads=threads)  # fmt: skip
     sim.run(steps=warmup)
-    t0 = time.perf_counter()
+    if phases:
+        step_phases.reset()
+    load_before = load_average()
+    t0, c0 = time.perf_counter(), time.process_time()
     sim.run(steps=steps)
     elapsed = time.perf_counter() - t0
+    cpu = time.process_time() - c0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     n = sim.particles.count
     out = {
@@ -180,7 +212,11 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
         "n": n,
         "steps": steps,
         "particle_steps_per_s": n * steps / elapsed,
+        "cpu_particle_steps_per_s": n * steps / cpu,
         "seconds": elapsed,
+        "cpu_seconds": cpu,
+        "load_before": load_before,
+        "load_after": load_average(),
         "contacts_per_particle": 2 * sim.contact_count / n,
         "bytes_per_particle_above_baseline": (peak - baseline) / n,
     }
@@ -199,7 +235,32 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
             out["last_tessellation_seconds"] = vor.last_seconds
             out["voronoi_pairs_per_particle"] = sim.thermal.external.count / n
     out["seconds_per_step"] = elapsed / steps
+    if phases:
+        out["phases"] = step_phases.report(steps, n)
     return out
+
+
+def summary(results: list[dict]) -> list[str]:
+    """Median throughput per case and thread count, heat overheads and speed-ups."""
+    med: dict[tuple[str, int], float] = {}
+    for key in {(r["case"], r["threads"]) for r in results}:
+        med[key] = float(np.median([r["particle_steps_per_s"] for r in results
+                                    if (r["case"], r["threads"]) == key]))  # fmt: skip
+    lines = []
+    threads = sorted({t for _, t in med})
+    for t in threads:
+        mech = med.get(("mechanics", t))
+        for (case, tt), value in sorted(med.items()):
+            if tt != t:
+                continue
+            line = f"median {case:10s} {t} thread(s): {value / 1e6:6.2f} M particle-steps/s"
+            if mech and case != "mechanics":
+                line += f", heat overhead {mech / value - 1.0:+.1%} over mechanics"
+            one = med.get((case, 1))
+            if t > 1 and one:
+                line += f", speed-up {value / one:.2f}x over 1 thread"
+            lines.append(line)
+    return lines
 
 
 def main() -> None:
@@ -216,6 +277,8 @@ def main() -> None:
     ap.add_argument("--radiation", default=None, help="a radiation model")
     ap.add_argument("--frozen", type=float, default=0.0, help="frozen mechanics, thermal dt [s]")
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--rounds", type=int, default=1, help="interleaved repetitions")
+    ap.add_argument("--phases", action="store_true", help="per-phase timing of a step")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args()
     FROZEN["dt"] = args.frozen
@@ -229,50 +292,59 @@ def main() -> None:
         kind, threads = args.child.split(":")
         terms = (args.convection, args.porosity, args.radiation)
         result = timed(kind, int(threads), args.steps, args.warmup, indirect, args.substeps,
-                       terms)  # fmt: skip
+                       terms, args.phases)  # fmt: skip
         print(json.dumps(result))
         return
     particle_files()
     particle_files(tiny=True)
     results = []
-    for kind in args.cases:
-        for threads in args.threads:
-            cmd = [sys.executable, __file__, "--child", f"{kind}:{threads}",
-                   "--steps", str(args.steps), "--warmup", str(args.warmup),
-                   "--substeps", str(args.substeps)]  # fmt: skip
-            if args.indirect:
-                cmd += ["--indirect", args.indirect, "--indirect-param", *args.indirect_param]
-            if args.convection:
-                cmd += ["--convection", args.convection]
-            if args.radiation:
-                cmd += ["--radiation", args.radiation]
-            cmd += ["--porosity", args.porosity, "--frozen", str(args.frozen)]
-            proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
-            result = json.loads(proc.stdout.strip().splitlines()[-1])
-            results.append(result)
-            if not args.json:
-                extra = ""
-                if "range_pairs_per_particle" in result:
-                    extra = f", {result['range_pairs_per_particle']:.2f} range pairs/particle"
-                if "tessellations" in result:
-                    extra += (
-                        f", {result['tessellations']} tessellations "
-                        f"({result['tessellation_seconds']:.3g} s, last "
-                        f"{result['last_tessellation_seconds']:.3g} s), "
-                        f"{result['voronoi_pairs_per_particle']:.2f} Voronoi "
-                        f"pairs/particle, {1e3 * result['seconds_per_step']:.3g} ms/step"
-                    )
-                if "neighbourhood_pairs_per_particle" in result:
-                    extra += (f", {result['neighbourhood_pairs_per_particle']:.2f} "
-                              "neighbourhood pairs/particle")  # fmt: skip
-                print(
-                    f"{kind:10s} {threads} thread(s): "
-                    f"{result['particle_steps_per_s'] / 1e6:6.2f} M particle-steps/s, "
-                    f"{result['bytes_per_particle_above_baseline']:.0f} B/particle{extra}",
-                    flush=True,
+    runs = [(k, t) for _ in range(args.rounds) for k in args.cases for t in args.threads]
+    for kind, threads in runs:
+        cmd = [sys.executable, __file__, "--child", f"{kind}:{threads}",
+               "--steps", str(args.steps), "--warmup", str(args.warmup),
+               "--substeps", str(args.substeps)]  # fmt: skip
+        if args.indirect:
+            cmd += ["--indirect", args.indirect, "--indirect-param", *args.indirect_param]
+        if args.convection:
+            cmd += ["--convection", args.convection]
+        if args.radiation:
+            cmd += ["--radiation", args.radiation]
+        cmd += ["--porosity", args.porosity, "--frozen", str(args.frozen)]
+        if args.phases:
+            cmd += ["--phases"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        result = json.loads(proc.stdout.strip().splitlines()[-1])
+        results.append(result)
+        if not args.json:
+            extra = ""
+            if "range_pairs_per_particle" in result:
+                extra = f", {result['range_pairs_per_particle']:.2f} range pairs/particle"
+            if "tessellations" in result:
+                extra += (
+                    f", {result['tessellations']} tessellations "
+                    f"({result['tessellation_seconds']:.3g} s, last "
+                    f"{result['last_tessellation_seconds']:.3g} s), "
+                    f"{result['voronoi_pairs_per_particle']:.2f} Voronoi "
+                    f"pairs/particle, {1e3 * result['seconds_per_step']:.3g} ms/step"
                 )
+            if "neighbourhood_pairs_per_particle" in result:
+                extra += (f", {result['neighbourhood_pairs_per_particle']:.2f} "
+                          "neighbourhood pairs/particle")  # fmt: skip
+            print(
+                f"{kind:10s} {threads} thread(s): "
+                f"{result['particle_steps_per_s'] / 1e6:6.2f} M particle-steps/s "
+                f"(cpu {result['cpu_particle_steps_per_s'] / 1e6:.2f}), "
+                f"{result['bytes_per_particle_above_baseline']:.0f} B/particle{extra}, "
+                f"load {result['load_before']:.2f} -> {result['load_after']:.2f}",
+                flush=True,
+            )
+            if "phases" in result:
+                print(result["phases"], flush=True)
     if args.json:
         print(json.dumps(results, indent=1))
+    else:
+        for line in summary(results):
+            print(line)
 
 
 if __name__ == "__main__":

@@ -76,10 +76,10 @@ def _assert_failure_leaves_state(out: Path, message: str) -> None:
 def test_nan_injected_between_steps(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     original = Simulation.step
 
-    def step(self: Simulation) -> None:
+    def step(self: Simulation, complete: bool = True) -> None:
         if self.step_count == 150:
             self.particles.velocity[7, 1] = np.nan
-        original(self)
+        original(self, complete)
 
     monkeypatch.setattr(Simulation, "step", step)
     out = tmp_path / "out"

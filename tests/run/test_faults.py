@@ -107,6 +107,37 @@ def test_threads_above_the_core_count_are_clamped_with_a_message(tmp_path: Path)
     assert f"on {cores} thread(s)" in result.output  # the estimate uses the clamped count
 
 
+def test_a_refused_input_leaves_a_record_the_next_run_may_reuse(tmp_path: Path) -> None:
+    """The input is refused while the simulation is built (a particle file that is missing):
+    the directory keeps the refusal (run.log, status.json 'failed'), running the same command
+    again tells the same error (not 'exists and is not empty'), and once the case is fixed the
+    same command runs without --overwrite. A directory holding anything else is still refused."""
+    data = copy.deepcopy(BOX)
+    data["insertion"] = [{"kind": "file", "material": "glass", "path": "beads.txt"}]
+    case = _case_file(tmp_path, data)
+    out = tmp_path / "out"
+    for _ in range(2):
+        result = _invoke("run", str(case), "--output", str(out), "--no-progress")
+        assert result.exit_code == 2, result.output
+        assert "insertion.0.path: particle file" in result.output
+        assert "does not exist" in result.output and "not empty" not in result.output
+        assert json.loads((out / "status.json").read_text())["refused_input"] is True
+    (tmp_path / "beads.txt").write_text("x y z r\n0.005 0.005 0.005 0.001\n")
+    result = _invoke("run", str(case), "--output", str(out), "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert json.loads((out / "status.json").read_text())["status"] == "finished"
+    # a finished run's directory, or a refusal record beside a user's file, needs --overwrite
+    result = _invoke("run", str(case), "--output", str(out), "--no-progress")
+    assert result.exit_code == 2 and "exists and is not empty" in result.output
+    (tmp_path / "beads.txt").unlink()
+    other = tmp_path / "other"
+    assert _invoke("run", str(case), "--output", str(other)).exit_code == 2
+    (other / "notes.txt").write_text("mine")
+    result = _invoke("run", str(case), "--output", str(other), "--no-progress")
+    assert result.exit_code == 2 and "exists and is not empty" in result.output
+    assert (other / "notes.txt").read_text() == "mine"
+
+
 # ------------------------------------------------------------------------------- run.lock
 def test_overwrite_of_a_directory_a_live_process_writes_is_refused(
     tmp_path: Path, finished: Path

@@ -255,6 +255,9 @@ def test_export_csv_from_a_frame_and_a_checkpoint(tmp_path: Path) -> None:
     assert frame.output.startswith("# thermodem export: frame 2 of")  # 0, 0.005 s, the end
     for a, b in zip(rows, frame_rows, strict=True):
         assert a == b
+    # the default file of --frame -1 is named by the frame's own number
+    named = _run("export", str(out), "--frame", "-1")
+    assert named.exit_code == 0 and Path(named.output.strip()) == out / "particles_frame_2.csv"
     # a file that exists is not replaced without --overwrite
     target = tmp_path / "mine.csv"
     target.write_text("my notes\n")

@@ -395,9 +395,20 @@ def _replace(f, name: str, value) -> None:  # noqa: ANN001
         (lambda f: _replace(f, "pairs/history", np.zeros((0, 6))), "'history' has 0 rows"),
         (lambda f: _replace(f, "pairs/group_start", np.array([0, 5, 2])), "out of order"),
         (lambda f: f.__delitem__("thermal/arrays"), "it has no thermal/arrays"),
+        (lambda f: f["particles/type_id"].__setitem__(0, 5),
+         "particle 0 has material index 5, but there are 2 materials (glass, steel)"),
+        (lambda f: f["particles/global_id"].__setitem__(1, f["particles/global_id"][0]),
+         "is held by two particles"),
+        (lambda f: f["particles/global_id"].__setitem__(0, 10**6), "(next_global_id)"),
+        (lambda f: f["particles/temperature"].__setitem__(2, np.nan),
+         "particle array 'temperature': the value of particle 2"),
+        (lambda f: f["particles/position"].__setitem__((1, 0), np.inf),
+         "particle array 'position': the value of particle 1"),
+        (lambda f: f["particles/radius"].__setitem__(0, 0.0), "it must be finite and > 0"),
     ],
     ids=["attr", "group", "json", "yaml", "yaml-list", "scalar", "short", "pairs", "groups",
-         "thermal"],
+         "thermal", "type-id", "duplicate-id", "id-range", "nan-temperature", "inf-position",
+         "zero-radius"],
 )  # fmt: skip
 def test_damaged_checkpoints_are_refused_when_read(
     tmp_path: Path, good_checkpoint: Path, change, expected
@@ -408,3 +419,76 @@ def test_damaged_checkpoints_are_refused_when_read(
     with pytest.raises(ConfigError, match="damaged or incomplete") as err:
         read_checkpoint(bad)
     assert expected in str(err.value) and str(bad) in str(err.value)
+
+
+def test_a_failed_state_with_non_finite_values_is_still_readable(
+    tmp_path: Path, good_checkpoint: Path
+) -> None:
+    """failed.h5 holds the state that stopped a run (NaN included): readable for inspection
+    (export), never continued."""
+    import h5py
+
+    def failed(f) -> None:  # noqa: ANN001
+        f.attrs["kind"] = "failed"
+        f["particles/temperature"][0] = np.nan
+
+    bad = _damaged(good_checkpoint, tmp_path / "failed.h5", failed)
+    assert np.isnan(read_checkpoint(bad).state["particles"]["temperature"][0])
+    with pytest.raises(ConfigError, match="cannot be continued"):
+        Simulation.from_checkpoint(bad)
+    with h5py.File(bad) as f:
+        assert f.attrs["kind"] == "failed"
+
+
+def test_a_short_stored_conductance_array_is_refused(tmp_path: Path, good_checkpoint: Path) -> None:
+    """The stored per-pair conductances (frozen mechanics reuses them) must cover the pair
+    list: a short array would be read past its end by the heat-only pass."""
+    bad = _damaged(
+        good_checkpoint,
+        tmp_path / "bad.h5",
+        lambda f: _replace(f, "thermal/arrays/pair_conductance", np.zeros(3)),
+    )
+    with pytest.raises(ConfigError, match="thermal array 'pair_conductance' has shape"):
+        Simulation.from_checkpoint(bad)
+
+
+@pytest.mark.parametrize("frozen", [False, True], ids=["moving", "frozen"])
+def test_restart_with_a_changed_conductivity_uses_the_new_case(tmp_path: Path, frozen) -> None:
+    """``thermodem run CASE --restart CKPT`` with another thermal conductivity: the model
+    tables are the new case's (not the checkpoint's), and the conductances a frozen run kept
+    are evaluated again. Batchelor & O'Brien's H = 4 k r_c: every contact heat rate × 50."""
+    data = {
+        "simulation": {"time_step": 5.0e-6, "end_time": 1.0, "gravity": [0, 0, 0]},
+        "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
+        "materials": {"glass": dict(GLASS), "steel": dict(GLASS, thermal_conductivity=20.0)},
+        "walls": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1],
+                   "material": "steel", "thermal": {"kind": "fixed", "temperature": 350.0}}],
+        "insertion": [{"kind": "list", "material": "glass", "radius": 0.001,
+                       "positions": [[0.005, 0.005, 0.00099], [0.005, 0.005, 0.00297]],
+                       "temperatures": [300.0, 320.0]}],
+        "thermal": {"direct_conduction": "batchelor_obrien_simple", "contact_radius": "geometric"},
+    }  # fmt: skip
+    if frozen:
+        data["thermal"].update(frozen_mechanics=True, time_step=1e-3)
+    sim = Simulation(case_from_dict(data))
+    sim.run(steps=3)
+    path = write_checkpoint(sim, tmp_path / "c.h5")
+    if frozen:
+        assert sim.thermal.conductance_ready
+    faster = copy.deepcopy(data)
+    for material in faster["materials"].values():
+        material["thermal_conductivity"] *= 50.0
+    same = Simulation.from_checkpoint(path)
+    changed = Simulation.from_checkpoint(path, case=case_from_dict(faster))
+    fresh = Simulation(case_from_dict(faster))
+    assert np.array_equal(changed.thermal.conduction_table, fresh.thermal.conduction_table)
+    assert not np.array_equal(same.thermal.conduction_table, fresh.thermal.conduction_table)
+    same.run(steps=1)
+    changed.run(steps=1)
+    from thermodem.state import heat
+
+    for column in (heat.M_DIRECT, heat.M_WALL_DIRECT):
+        a = same.particles.heat_rate_by_mechanism[:, column]
+        b = changed.particles.heat_rate_by_mechanism[:, column]
+        assert np.any(a != 0.0)
+        assert b == pytest.approx(50.0 * a, rel=1e-12, abs=1e-300)

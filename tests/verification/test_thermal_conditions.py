@@ -594,3 +594,129 @@ def test_ledger_closes_when_particles_are_poured(tmp_path: Path) -> None:
     brought = 3 * mass(5e-4) * C * 400.0
     assert sim.thermal.thermal_energy() - u0 == pytest.approx(brought, rel=1e-12)
     assert abs(sim.thermal.balance_error()) < 1e-12 * u0
+
+
+def _brute_force(sim: Simulation) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fixed mask, bath temperatures and source powers of the case's selections evaluated at
+    the current positions entry by entry (the rule of docs/thermal-engine.md, written out)."""
+    p, th = sim.particles, sim.thermal.settings
+    n = p.count
+    fixed, bath, source = np.zeros(n, bool), np.zeros(n), np.zeros(n)
+    entries = [("fixed", f.temperature, f.select) for f in th.fixed_temperature]
+    entries += [("flux", h.flux, h.select) for h in th.heat_flux]
+    entries += [("volume", v.power_density, v.select) for v in th.volumetric_source]
+    for kind, value, sel in entries:
+        holds = np.ones(n, bool)
+        if sel.material is not None:
+            holds &= p.type_id == sim.material_index[sel.material]
+        if sel.ids is not None:
+            holds &= np.isin(p.global_id, sel.ids)
+        if sel.region is not None:
+            lo, hi = np.asarray(sel.region.lower), np.asarray(sel.region.upper)
+            holds &= np.all((p.position >= lo) & (p.position <= hi), axis=1)
+        if kind == "fixed":
+            fixed |= holds
+            bath[holds] = value
+        elif kind == "flux":
+            source[holds] += value * 4 * math.pi * p.radius[holds] ** 2
+        else:
+            source[holds] += value * 4 / 3 * math.pi * p.radius[holds] ** 3
+    return fixed, bath, source
+
+
+def test_selections_are_classified_at_builds_and_equal_a_brute_force_every_step(
+    tmp_path: Path,
+) -> None:
+    """Particles fly through region selections (one at a periodic face, where positions wrap)
+    for 400 steps: at every step the fixed particles, their bath temperatures and the sources
+    are those of the selections evaluated at the current positions, although the particles
+    are classified only at the neighbour-list builds and per step only the held particles
+    and those within half a skin of a region face are visited (issue 17 §5)."""
+    rng = np.random.default_rng(5)
+    n = 300
+    rows = [(*map(float, rng.uniform(-0.019, 0.019, 3)), 4e-4, 300.0) for _ in range(n)]
+    keep = []  # drop overlapping draws
+    for r in rows:
+        if all(np.linalg.norm(np.subtract(r[:3], q[:3])) > 1e-3 for q in keep):
+            keep.append(r)
+    path = _write(tmp_path / "gas.txt", keep, temperature=True)
+    slab = {"lower": [-0.03, -0.03, -0.004], "upper": [0.03, 0.03, 0.003]}
+    face = {"lower": [0.015, -0.03, -0.03], "upper": [0.03, 0.03, 0.03]}  # at the periodic x face
+    corner = {"lower": [-0.02, -0.02, -0.02], "upper": [-0.005, 0.0, 0.01]}
+    thermal = {
+        "fixed_temperature": [
+            {"select": {"region": slab}, "temperature": 400.0},
+            {"select": {"region": face, "material": "glass"}, "temperature": 350.0},
+            {"select": {"ids": [0, 1, 2]}, "temperature": 250.0},
+        ],
+        "heat_flux": [{"select": {"region": corner}, "flux": 300.0}],
+        "volumetric_source": [{"select": {"region": face}, "power_density": 2e4}],
+    }
+    case = _case([_file(path)], thermal)
+    case["domain"]["periodic"] = [True, True, True]
+    case["neighbors"] = {"skin": 4e-4}
+    sim = Simulation(case_from_dict(case))
+    v = rng.normal(0.0, 0.3, (sim.particles.count, 3))
+    v[:, 0] += np.where(rng.random(sim.particles.count) < 0.5, -2.0, 2.0)  # along periodic x
+    sim.particles.velocity[:] = v
+    listed = []
+
+    def check(s: Simulation) -> None:
+        fixed, bath, source = _brute_force(s)
+        th = s.thermal
+        assert np.array_equal(th.fixed, fixed)
+        assert np.array_equal(s.particles.temperature[fixed], bath[fixed])
+        np.testing.assert_allclose(th.source, source, rtol=1e-14, atol=0.0)
+        listed.append(th.conditions.listed.shape[0])
+
+    x0 = sim.particles.position[_order(sim), 0].copy()
+    sim.run(steps=400, callback=check)
+    assert len(listed) == 400
+    wrapped = np.abs(sim.particles.position[_order(sim), 0] - x0) > 0.02
+    assert wrapped.sum() > 10  # particles crossed the periodic face
+    assert sim.rebuild_count > 3
+    # classified at the builds (and once at the start), not at every step
+    assert sim.thermal.conditions.classifications <= sim.rebuild_count + 2
+    fixed_now = int(sim.thermal.fixed.sum())
+    assert 0 < fixed_now < sim.particles.count
+    assert np.mean(listed) < 0.6 * sim.particles.count
+
+
+def test_rates_left_to_the_next_update_give_the_same_run(tmp_path: Path) -> None:
+    """step(complete=False) leaves the source column and the total heat rates to the next
+    thermal update (one pass less per step): the run is bit-identical to one that forms them
+    at every step, and they are formed whenever they are read (complete_rates, run, report,
+    callbacks), equal to the sum of the mechanism columns."""
+    rows = [(0.0011 + 0.00195 * k, 0.0013, R - 1e-5, R, 300.0 + 10 * k) for k in range(4)]
+    path = _write(tmp_path / "p.txt", rows, temperature=True)
+    box = {"lower": [-0.01, -0.01, -0.01], "upper": [0.002, 0.01, 0.01]}
+    thermal = {
+        "fixed_temperature": [{"select": {"ids": [3]}, "temperature": 250.0}],
+        "heat_flux": [{"select": {"region": box}, "flux": 2000.0}],
+    }
+    walls = [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "steel",
+              "thermal": {"kind": "fixed", "temperature": 500.0}}]  # fmt: skip
+    every, lazy = _sim([_file(path)], thermal, walls), _sim([_file(path)], thermal, walls)
+    for sim in (every, lazy):
+        sim.particles.velocity[:, 0] = 0.05
+    for _ in range(40):
+        every.step()
+    lazy.step(complete=False)
+    assert lazy.thermal.rates_pending
+    lazy.complete_rates()
+    assert not lazy.thermal.rates_pending
+    seen = []
+
+    def check(s: Simulation) -> None:
+        p = s.particles
+        assert not s.thermal.rates_pending
+        columns = p.heat_rate_by_mechanism[:, s.thermal.sum_columns].sum(axis=1)
+        np.testing.assert_allclose(p.heat_rate, columns, rtol=1e-13, atol=1e-300)
+        seen.append(s.step_count)
+
+    lazy.run(steps=39, callback=check, every=10)
+    assert seen == [10, 20, 30, 40]
+    for name, arr in every.particles.arrays().items():
+        assert np.array_equal(arr, getattr(lazy.particles, name)), name
+    assert every.report() == lazy.report()
+    assert every.thermal.balance_error() == lazy.thermal.balance_error()

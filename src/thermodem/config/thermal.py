@@ -25,6 +25,7 @@ models; it is always present, with the defaults of air at 300 K and 101325 Pa.
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -401,6 +402,23 @@ class WallThermal(StrictModel):
     kind: Literal["adiabatic", "fixed"] = "adiabatic"
     temperature: float | list[tuple[float, float]] | str | None = None
 
+    @field_validator("temperature")
+    @classmethod
+    def _expression(cls, v: object) -> object:
+        """An expression is compiled here, so that its error names the key
+        ``walls.K.thermal.temperature``; ``"inf"``/``"nan"`` are told to be non-finite."""
+        if isinstance(v, str):
+            try:
+                number = float(v)
+            except ValueError:
+                number = None
+            if number is not None and not math.isfinite(number):
+                raise ValueError(f"Input should be a finite number (got {v!r})")
+            from thermodem.engine.expressions import compile_expression
+
+            compile_expression(v, ("t",))
+        return v
+
     @model_validator(mode="after")
     def _check(self) -> WallThermal:
         if self.kind == "fixed" and self.temperature is None:
@@ -417,8 +435,4 @@ class WallThermal(StrictModel):
                 raise ValueError("temperature table times must increase strictly")
             if any(not temp > 0 for _, temp in self.temperature):
                 raise ValueError("temperature table values must be > 0 K")
-        if isinstance(self.temperature, str):
-            from thermodem.engine.expressions import compile_expression
-
-            compile_expression(self.temperature, ("t",))
         return self

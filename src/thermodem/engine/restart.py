@@ -102,6 +102,7 @@ DERIVED: tuple[str, ...] = (
     "rebuild_every_step",
     "callbacks",
     "chunk_check",
+    "_complete",  # the argument of the step in progress
     "_no_heat",
     "_no_generation",
     "generation",
@@ -154,6 +155,7 @@ def _pair_state(buf: Any) -> dict[str, np.ndarray]:
 
 def capture(sim: Simulation) -> dict[str, Any]:
     """The complete restart state of ``sim`` (copies; the simulation can go on)."""
+    sim.complete_rates()  # the stored heat rates are complete (Simulation.step)
     scalars: dict[str, Any] = {name: _plain(getattr(sim, name)) for name in SCALARS}
     scalars["ledger_cumulative"] = {k: float(v) for k, v in sim.ledger_cumulative.items()}
     scalars["rng"] = sim.rng.bit_generator.state
@@ -289,6 +291,109 @@ def check_state(state: Any) -> None:
         raise ConfigError("thermal: the scalars or the arrays are missing")
 
 
+#: Thermal engine attributes made from the case (model ids and parameter tables, property
+#: tables, a column list, scratch sizes): written to checkpoints but never restored, so that a
+#: restart with a changed case (``thermodem run CASE --restart CKPT``) runs the new case's
+#: models. The first group is compared with the checkpoint's: when one differs, the stored
+#: conductances (frozen mechanics, conductance reuse) are dropped.
+THERMAL_FROM_CASE: tuple[str, ...] = (
+    "radius_id", "conduction_id", "radius_table", "conduction_table", "tolerance", "override",
+    "has_c_table", "k_t", "k_v", "k_n", "c_t", "c_v", "c_n", "density_by_type",
+    "specific_heat_by_type",
+)  # fmt: skip
+THERMAL_LAYOUT: tuple[str, ...] = ("boundary_columns", "scratch", "term_scratch", "euler_partials")
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        return a.shape == b.shape and bool(np.array_equal(a, b))
+    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return bool(a == b)
+
+
+def keep_derived_thermal(engine: Any, scalars: dict[str, Any], arrays: dict[str, Any]) -> bool:
+    """Remove the case-made entries (:data:`THERMAL_FROM_CASE`, :data:`THERMAL_LAYOUT`) from a
+    thermal state before it is loaded into ``engine`` (built from the case to continue); a
+    fixed ``thermal.substeps`` is the case's too. True when a model or property table differs
+    from the checkpoint's (the case changed)."""
+    changed = False
+    for name in (*THERMAL_FROM_CASE, *THERMAL_LAYOUT):
+        for group in (scalars, arrays):
+            if name in group:
+                saved = group.pop(name)
+                if name in THERMAL_FROM_CASE and not _same(saved, getattr(engine, name, None)):
+                    changed = True
+    if engine.settings.substeps != "auto":
+        scalars.pop("substeps", None)
+    return changed
+
+
+def check_thermal_arrays(engine: Any, arrays: dict[str, Any]) -> None:
+    """ConfigError for a thermal state array that cannot be this engine's: another dtype kind
+    or number of dimensions, other trailing dimensions, or fewer rows than the engine built
+    from the case allocates (the arrays grow with the pair lists; a short one is damaged)."""
+    for name, value in arrays.items():
+        current = getattr(engine, name, None)
+        if not isinstance(current, np.ndarray):
+            continue
+        saved = np.asarray(value)
+        if (
+            saved.dtype.kind != current.dtype.kind
+            or saved.ndim != current.ndim
+            or saved.shape[1:] != current.shape[1:]
+            or (saved.ndim and saved.shape[0] < current.shape[0])
+        ):
+            raise ConfigError(
+                f"thermal array {name!r} has shape {saved.shape} ({saved.dtype}), this case's "
+                f"thermal engine needs {current.shape[1:] or '()'} per row, at least "
+                f"{current.shape[0] if current.ndim else 0} rows ({current.dtype}); the "
+                "checkpoint is damaged or belongs to another case"
+            )
+
+
+def check_values(state: dict[str, Any]) -> None:
+    """ConfigError unless the particle values of a state that can be continued are possible:
+    material indices of the stored materials, unique global ids below the next id, positive
+    finite radii, masses and moments of inertia, finite positions, velocities, forces and
+    torques, finite positive temperatures (a failure is never stored as a continuable
+    checkpoint: the run stops before)."""
+    s, p = state["scalars"], state["particles"]
+    n_materials = len(s["material_names"])
+    type_id = np.asarray(p["type_id"])
+    if type_id.size and (type_id.min() < 0 or type_id.max() >= n_materials):
+        bad = int(np.nonzero((type_id < 0) | (type_id >= n_materials))[0][0])
+        raise ConfigError(
+            f"particle {bad} has material index {int(type_id[bad])}, but there are "
+            f"{n_materials} materials ({', '.join(map(str, s['material_names']))})"
+        )
+    gid = np.asarray(p["global_id"])
+    if gid.size:
+        unique, counts = np.unique(gid, return_counts=True)
+        if counts.max() > 1:
+            raise ConfigError(f"global id {int(unique[counts > 1][0])} is held by two particles")
+        if unique[0] < 0 or unique[-1] >= int(s["next_global_id"]):
+            raise ConfigError(
+                f"global ids {int(unique[0])}..{int(unique[-1])} are outside 0.."
+                f"{int(s['next_global_id']) - 1} (next_global_id)"
+            )
+    for name, positive in (
+        ("radius", True), ("mass", True), ("moment_of_inertia", True), ("temperature", True),
+        ("position", False), ("velocity", False), ("angular_velocity", False), ("force", False),
+        ("torque", False),
+    ):  # fmt: skip
+        values = np.asarray(p[name], dtype=float)
+        bad = ~np.isfinite(values) | ((values <= 0.0) if positive else False)
+        if bad.any():
+            row = int(np.nonzero(bad.reshape(bad.shape[0], -1).any(axis=1))[0][0])
+            what = "finite and > 0" if positive else "finite"
+            raise ConfigError(
+                f"particle array {name!r}: the value of particle {row} (global id "
+                f"{int(gid[row])}) is {values[row].tolist()}, it must be {what}"
+            )
+
+
 def restore(sim: Simulation, state: dict[str, Any]) -> None:
     """Load ``state`` (from :func:`capture`) into ``sim``, built from the same case."""
     check_state(state)
@@ -308,7 +413,8 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
         )
     saved_rows = np.asarray(state["arrays"]["wall_rows"])
     if saved_rows.shape != sim.wall_rows.shape:
-        raise _mismatch("the number of wall rows", saved_rows.shape[0], sim.wall_rows.shape[0])
+        raise _mismatch("the shape of the wall rows (walls, columns)", saved_rows.shape,
+                        sim.wall_rows.shape)  # fmt: skip
     if len(s["pourers"]) != len(sim.pourers):
         raise _mismatch("the number of pour entries", len(s["pourers"]), len(sim.pourers))
     names = {f.name for f in fields(Particles)}

@@ -262,7 +262,7 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
                 if stop.signum:
                     raise KeyboardInterrupt
                 in_step = True
-                sim.step()
+                sim.step(complete=False)  # the writers below complete the heat rates
                 in_step = False
                 k = sim.step_count
                 if k % run.series_every == 0:
@@ -274,6 +274,7 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
                     run.status.update(**_status_numbers(sim, run))
                 progress.update(sim)
                 if run.callback is not None and k % run.every == 0:
+                    sim.complete_rates()
                     run.callback(sim)
     except SimulationError as exc:
         raise _failed(sim, run, exc) from None
@@ -458,7 +459,7 @@ def run_case(
             return _drive(sim, run, fresh=True)
         except ConfigError as exc:
             runlog.file_only(f"error: {exc}")
-            status.update(status="failed", message=str(exc))
+            status.update(status="failed", message=str(exc), refused_input=True)
             raise
         finally:
             runlog.close()
@@ -729,8 +730,13 @@ def _restored(ckpt: Checkpoint, threads: int | None, case: Case) -> Simulation:
     """A simulation continuing from ``ckpt`` (ConfigError for a state that does not load)."""
     try:
         return Simulation.from_checkpoint(ckpt, threads=threads, case=case)
-    except ConfigError:
-        raise
+    except ConfigError as exc:
+        if str(ckpt.path) in str(exc):
+            raise
+        raise ConfigError(
+            f"checkpoint {ckpt.path}: {exc}; nothing was changed (a checkpoint continues "
+            "the case it was written with, or one with the same particles, walls and models)"
+        ) from None
     except (KeyError, IndexError, TypeError, ValueError) as exc:
         raise ConfigError(
             f"checkpoint {ckpt.path} cannot be restored ({type(exc).__name__}: {exc}); the file "

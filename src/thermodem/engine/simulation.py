@@ -20,7 +20,9 @@ Order inside one step (``Simulation.step``):
    into the particles by slab group (``thermodem.kernels.slabs``), dissipation per mechanism,
    history, ledger rows per group; when a thermal step follows, the same passes evaluate the
    contact conduction of the touching pairs, and the other heat terms are evaluated right
-   after them on the same state (so the heat rates are complete at the end of the step);
+   after them on the same state (so the heat rates by mechanism are complete at the end of
+   the step; the source column and the totals too, or, with ``step(complete=False)``, when
+   :meth:`Simulation.complete_rates` or the next thermal update forms them);
 5. the second half kick;
 6. overlap check; 7. writers on their triggers (owned by the caller, see
    ``thermodem.engine.runner``).
@@ -198,6 +200,7 @@ class Simulation:
         self.wall_row_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
         self.chunk_check = np.zeros((1, 3))
+        self._complete = True  # step(complete=...): form the total heat rates in the step
         self.moved = 0.0
         self.rebuild_count = 0
         self.slab_axis: int | None = None  # set by each neighbour rebuild
@@ -325,7 +328,10 @@ class Simulation:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
             pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
-            reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_rate_by_mechanism,
+            # the heat sums start at zero: zeroed here, or already by this step's Euler update
+            zero = not (th.rates_cleared and th.conductance_sum.shape[0] == p.count)
+            th.rates_cleared = False
+            reset_forces(p.force, p.torque, p.mass, self.gravity, zero, p.heat_rate_by_mechanism,
                          th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
             no_mech, no_sum = self._no_heat[0][-3:-1]
@@ -345,8 +351,8 @@ class Simulation:
             self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.normal_force,
             wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout, *gen,
         )  # fmt: skip
-        if heat_due:  # the other heat terms of this state, so the rates are complete now
-            th.after_contact_pass(self.time)
+        if heat_due:  # the other heat terms of this state (the totals: see step())
+            th.after_contact_pass(self.time, self._complete)
         if kick:
             final_kick(p.velocity, p.angular_velocity, p.force, p.torque, p.mass,
                        p.moment_of_inertia, self.dt)  # fmt: skip
@@ -375,8 +381,21 @@ class Simulation:
                     cum[f"wall_generation_{name}"] += sums[C.L_WALL_GENERATION + g]
 
     # -------------------------------------------------------------------------------- step
-    def step(self) -> None:
-        """Advance one time step (see the module docstring for the order)."""
+    def complete_rates(self) -> None:
+        """Form the heat rates a step left to the next thermal step (see :meth:`step`); the
+        outputs, checkpoints, :meth:`report`, :meth:`contacts` and :meth:`run` call it."""
+        if self.thermal is not None:
+            self.thermal.complete_rates()
+
+    def step(self, complete: bool = True) -> None:
+        """Advance one time step (see the module docstring for the order).
+
+        ``complete=False``: the source column and the total heat rates of the new state are
+        left to the next step's thermal update, which forms them anyway (one pass over the
+        particles less per step), unless :meth:`complete_rates` is called first; the
+        mechanism columns are complete either way. :meth:`run` and the run loop step so and
+        complete the rates wherever they are read."""
+        self._complete = complete
         th = self.thermal
         if th is not None and th.settings.frozen_mechanics:
             th.step(th.settings.time_step, self.time)
@@ -384,9 +403,10 @@ class Simulation:
             self.time = self.step_count * th.settings.time_step
             return
         if th is not None and self.step_count >= th.next_step:
-            # heat over the next n steps from the positions, contacts and temperatures now
+            # heat over the next n steps from the positions, contacts and temperatures now;
+            # with n = 1 this step's contact pass adds the heat of the next state at once
             n = th.substeps
-            th.step(n * self.dt, self.time)
+            th.step(n * self.dt, self.time, clear=n == 1)
             th.next_step = self.step_count + n
         p = self.particles
         nchunks = p.count // CHECK_CHUNK + 1
@@ -443,9 +463,11 @@ class Simulation:
                 dt = self.thermal.settings.time_step
             steps = max(0, int(round((until - self.time) / dt)))
         for _ in range(int(steps)):
-            self.step()
+            self.step(complete=False)
             if callback is not None and self.step_count % every == 0:
+                self.complete_rates()
                 callback(self)
+        self.complete_rates()
 
     def _where(self) -> str:
         return f"at step {self.step_count} (t = {self.time:.6g} s)"
@@ -560,6 +582,7 @@ class Simulation:
         and heat rate (``thermodem.engine.contacts``)."""
         from thermodem.engine.contacts import contact_data
 
+        self.complete_rates()
         return contact_data(self)
 
     def coordination_number(self) -> np.ndarray:
@@ -588,6 +611,7 @@ class Simulation:
 
         ``engine/runner.py`` writes every key as a column of ``timeseries.csv``.
         """
+        self.complete_rates()
         out: dict[str, float] = dict(self.energies())
         out["energy_balance_error"] = self.energy_balance_error()
         out["particle_count"] = self.particles.count
@@ -601,6 +625,7 @@ class Simulation:
         """The complete restart state (copies); see :mod:`thermodem.engine.restart`."""
         from thermodem.engine.restart import capture
 
+        self.complete_rates()
         return capture(self)
 
     def load_state(self, state: dict) -> None:

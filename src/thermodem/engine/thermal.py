@@ -152,6 +152,10 @@ class ThermalEngine:
         # reuse_conductance = False re-evaluates them at every thermal step (tests)
         self.conductance_ready = False
         self.reuse_conductance = True
+        #: the last explicit update zeroed the mechanism rates and conductance sums (step)
+        self.rates_cleared = False
+        #: the source column and total heat rates are not formed yet (after_contact_pass)
+        self.rates_pending = False
         # the implicit schemes read the per-pair conductances of every term at every state
         # (engine/implicit.py); the passes then store them also with k(T) tables
         self.record_conductances = settings.scheme != "explicit"
@@ -662,17 +666,29 @@ class ThermalEngine:
         self.fresh = False
         return self.finish(time)
 
-    def after_contact_pass(self, time: float) -> None:
+    def after_contact_pass(self, time: float, complete: bool = True) -> None:
         """The fused contact pass has added the contact conduction of this state: add every
-        other term and form the total heat rates, for the thermal step that follows."""
+        other term and (``complete``) form the source column and total heat rates, which the
+        thermal step that follows forms anyway: without ``complete`` they are left to it, or
+        to :meth:`complete_rates` when something reads them first (``rates_pending``)."""
         self._fixed_and_sources(time)
         self.evaluate_terms(time)
-        self.finish(time)
+        if complete:
+            self.finish(time)
+        else:
+            self.rates_pending = True
+
+    def complete_rates(self) -> None:
+        """Form the source column and the total heat rates if the last contact pass left
+        them to the next thermal step (outputs, checkpoints and the API call this)."""
+        if self.rates_pending:
+            self.finish(self.sim.time)
 
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
         kernels.finish_heat(self.source, p.heat_rate, p.heat_rate_by_mechanism, self.sum_columns)
+        self.rates_pending = False
         return self.fixed
 
     def specific_heat(self) -> np.ndarray:
@@ -682,9 +698,14 @@ class ThermalEngine:
             return self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
         return self.specific_heat_by_type[p.type_id]
 
-    def step(self, dt: float, time: float) -> None:
+    def step(self, dt: float, time: float, clear: bool = False) -> None:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler, or the
-        implicit scheme of ``thermal.scheme``: engine/implicit.py)."""
+        implicit scheme of ``thermal.scheme``: engine/implicit.py).
+
+        ``clear``: the contact pass of this same step evaluates the heat of the next state
+        (heat every step): the explicit update then zeroes the mechanism rates and conductance
+        sums it has read (``rates_cleared``), so that the force reset need not. Nothing reads
+        them in between (outputs are written after the step)."""
         if self.implicit is not None:
             self.implicit.step(dt, time)
             self.thermal_steps += 1
@@ -703,6 +724,7 @@ class ThermalEngine:
         by_mech = p.heat_rate_by_mechanism
         if self.has_c_table:
             kernels.finish_heat(source, p.heat_rate, by_mech, self.sum_columns)
+            self.rates_pending = False
             c = self.specific_heat()
             self.limit, where = kernels.stability_limit(p.mass, c, self.conductance_sum, fixed)
             boundary = by_mech[:, self.boundary_columns].sum(axis=0)
@@ -717,8 +739,10 @@ class ThermalEngine:
             self.limit, where, absorbed, bad = kernels.euler_step(
                 p.temperature, p.heat_rate, by_mech, self.sum_columns, source, p.mass, p.type_id,
                 self.specific_heat_by_type, self.conductance_sum, fixed, dt,
-                self.euler_partials,
+                self.euler_partials, clear,
             )  # fmt: skip
+            self.rates_cleared = clear
+            self.rates_pending = False  # the update formed them
             boundary = self.euler_partials[:rows, kernels.EULER_FIXED :].sum(axis=0)
             boundary = boundary[self.boundary_columns]
         self.limit_particle = int(p.global_id[where]) if where >= 0 else -1
@@ -787,6 +811,7 @@ class ThermalEngine:
         ``heat_rate_<mechanism>``: for pairwise mechanisms the heat exchanged, ½ Σ|Q_i| (they
         sum to zero); for boundary mechanisms the net heat into the particles, Σ Q_i.
         """
+        self.complete_rates()
         p = self.sim.particles
         out: dict[str, float] = {}
         if p.count:
@@ -866,6 +891,11 @@ class ThermalEngine:
             for k in list(arrays)
             if k.startswith(EXTERNAL_PREFIX)
         }
+        from thermodem.engine.restart import check_thermal_arrays, keep_derived_thermal
+
+        # tables and ids made from the case stay this case's (a restart may change the case)
+        changed = keep_derived_thermal(self, scalars, arrays)
+        check_thermal_arrays(self, arrays)
         for name, value in scalars.items():
             current = getattr(self, name, None)
             if isinstance(current, float) and value is not None:
@@ -875,6 +905,9 @@ class ThermalEngine:
             setattr(self, name, value)
         for name, value in arrays.items():
             setattr(self, name, np.array(value, copy=True))
+        if changed:  # conductances kept from the old case's models are stale
+            self.conductance_ready = False
+            self.term_ready[:] = False
         if self.range_set is not None:
             if range_scalars is None:
                 raise ConfigError(

@@ -2,14 +2,19 @@
 particles and the heat sources (flux, volumetric, external).
 
 Selections (``thermal.fixed_temperature``, ``heat_flux``, ``volumetric_source``) hold by
-material, global ids and a box region; every given criterion must hold. The material and id
-criteria depend on the particles only, so they are evaluated once into a per-particle mask per
-entry and kept until the particles are reordered (a neighbour rebuild) or inserted; the region
-criterion follows the current positions and is tested at every thermal step inside one
-compiled parallel pass over the particles (``kernels/conditions.py``), which also writes the
-source powers and sets fixed particles to their bath temperature. External sources (a power
-shared by the particles in a box, uniform or Gaussian) take a second compiled pass over the
-particles in their box. Nothing here loops over particles in Python.
+material, global ids and a box region; every given criterion must hold. They are not
+evaluated over all particles at every step. At each neighbour-list build (and after an
+insertion or a restart) one compiled parallel pass classifies every particle
+(``kernels/conditions.py: classify_conditions``): the material and id criteria depend on the
+particle only, and until the next build no particle moves farther than half the Verlet skin
+from its position at the build (``Simulation.reference``; the build comes first otherwise),
+so a region holds a particle surely, or surely not, unless the particle is within half a skin
+of the region's faces. Fixed particles and sources are set there; per thermal step only the
+fixed particles (held at their bath temperature) and the few candidates near a region face
+(evaluated at their current position) are visited (``apply_listed``). A material or id
+selection has no candidates. External sources (a power shared by the particles in a box,
+uniform or Gaussian) take a compiled parallel pass over the particles at every thermal step.
+Nothing here loops over particles in Python.
 """
 
 from __future__ import annotations
@@ -27,7 +32,8 @@ from thermodem.kernels.conditions import (
     FLUX,
     VOLUMETRIC,
     add_weighted,
-    apply_conditions,
+    apply_listed,
+    classify_conditions,
     external_weights,
 )
 
@@ -89,12 +95,23 @@ class ThermalConditions:
         self.static_valid = False
         self.fixed = np.zeros(0, np.bool_)
         self.source = np.zeros(0)
+        #: the flux/volumetric part of the sources (``source`` adds the external sources)
+        self.base_source = np.zeros(0)
+        self.bath = np.zeros(0)
+        self.code = np.zeros(0, np.int8)
+        #: indices of the held and candidate particles (kernels/conditions.py)
+        self.listed = np.zeros(0, np.int64)
+        #: the displacement from Simulation.reference up to which the classification holds
+        self.margin = -1.0
+        self._moved = 0.0  # Simulation.moved when the particles were classified
+        self.classifications = 0
         self._weight = np.zeros(0)
         self._part = np.zeros(1)
         self.active = bool(entries or settings.external_source)
 
     def invalidate(self) -> None:
-        """The particles were reordered or inserted: recompute the static masks."""
+        """The particles were reordered or inserted (a neighbour-list build, a pour, a
+        restart): classify them again at the next evaluation."""
         self.static_valid = False
 
     def _static_masks(self) -> None:
@@ -106,7 +123,43 @@ class ThermalConditions:
             if sel.ids is not None:
                 mask[:, e] &= np.isin(p.global_id, np.asarray(sel.ids, np.int64))
         self.static_mask = mask
+
+    def _classify(self) -> None:
+        """Static masks and the classification of every particle for the selections, valid
+        while no particle is farther than ``margin`` from ``Simulation.reference``."""
+        sim = self.sim
+        p = sim.particles
+        n = p.count
+        self._static_masks()
+        reference = sim.reference
+        margin = 0.5 * float(sim.skin or 0.0)  # Simulation.rebuild_due: moved <= skin / 2
+        self._moved = sim.moved
+        if reference.shape != p.position.shape:
+            # no build since particles came in: valid for the current positions only
+            reference, margin = p.position, 0.0
+            self.margin = -1.0
+        elif sim.moved <= margin or np.array_equal(reference, p.position):
+            # (right after a build `moved` is still the displacement that caused it; the
+            # positions are the reference then, and nothing moves before the next drift,
+            # which computes `moved` again)
+            self.margin = margin
+        else:
+            reference, margin = p.position, 0.0
+            self.margin = -1.0
+        # a relative allowance for the rounding of the displacement and of the bounds
+        extent = float(np.max(np.abs(np.concatenate([sim.lower, sim.upper])))) if n else 0.0
+        allowance = margin + 1e-12 * extent
+        if self.bath.shape[0] != n:
+            self.bath = np.zeros(n)
+            self.code = np.zeros(n, np.int8)
+        classify_conditions(
+            reference, p.radius, self.static_mask, self.kinds, self.values, self.has_region,
+            self.boxes, allowance, sim.lower, sim.upper, sim.periodic, self.fixed,
+            self.base_source, self.bath, self.code,
+        )  # fmt: skip
+        self.listed = np.flatnonzero(self.code).astype(np.int64)
         self.static_valid = True
+        self.classifications += 1
 
     def apply(
         self, time: float, specific_heat_by_type: np.ndarray
@@ -120,23 +173,39 @@ class ThermalConditions:
         n = p.count
         if self.fixed.shape[0] != n:
             self.fixed = np.zeros(n, np.bool_)
-            self.source = np.zeros(n)
+            self.base_source = np.zeros(n)
+            self.source = self.base_source
             self._weight = np.zeros(n)
+            self.static_valid = False
         if not self.active:
             return self.fixed, self.source, 0.0
-        if not self.static_valid or self.static_mask.shape[0] != n:
-            self._static_masks()
+        moved = self.sim.moved
+        if (
+            not self.static_valid
+            or self.static_mask.shape[0] != n
+            or self.margin < 0.0
+            or not (moved <= self.margin or moved == self._moved)
+        ):
+            self._classify()
+        rows = self.listed.shape[0] // CHUNK + 1
+        if self._part.shape[0] < rows:
+            self._part = np.zeros(rows)
+        reset = apply_listed(
+            self.listed, self.code, p.position, p.radius, p.mass, p.type_id, p.temperature,
+            specific_heat_by_type, self.static_mask, self.kinds, self.values, self.has_region,
+            self.boxes, self.fixed, self.base_source, self.bath, self._part,
+        )  # fmt: skip
+        active = [e for e in self.settings.external_source if e.start_time <= time < e.end_time]
+        if not active:
+            self.source = self.base_source
+            return self.fixed, self.source, reset
+        if self.source is self.base_source or self.source.shape[0] != n:
+            self.source = np.empty(n)
+        self.source[:] = self.base_source
         rows = n // CHUNK + 1
         if self._part.shape[0] < rows:
             self._part = np.zeros(rows)
-        reset = apply_conditions(
-            p.position, p.radius, p.mass, p.type_id, p.temperature, specific_heat_by_type,
-            self.static_mask, self.kinds, self.values, self.has_region, self.boxes, self.fixed,
-            self.source, self._part,
-        )  # fmt: skip
-        for e in self.settings.external_source:
-            if not (e.start_time <= time < e.end_time):
-                continue
+        for e in active:
             lower = np.asarray(e.region.lower, np.float64)
             upper = np.asarray(e.region.upper, np.float64)
             axis = np.asarray(e.axis, np.float64) / np.linalg.norm(e.axis)

@@ -253,11 +253,13 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
         kind = _text(attrs["kind"])
         if kind not in KINDS:
             raise ConfigError(f"{damaged}: kind {kind!r} is not one of {', '.join(KINDS)}")
-    from thermodem.engine.restart import check_state
+    from thermodem.engine.restart import check_state, check_values
 
     _check_case_yaml(case_yaml, damaged)
     try:
         check_state(state)
+        if kind != "failed":  # a failed state may hold the non-finite values that stopped it
+            check_values(state)
     except ConfigError as exc:
         raise ConfigError(f"{damaged}: {exc}") from None
     return Checkpoint(

@@ -62,6 +62,7 @@ class ParticleTable:
         self.temperature = np.asarray(temperature, float)
         self.heat_rate = np.asarray(heat_rate, float)
         self.source = source
+        self.frame_index: int | None = None
 
 
 def from_frame(directory: Path, frame: int) -> ParticleTable:
@@ -95,7 +96,7 @@ def from_frame(directory: Path, frame: int) -> ParticleTable:
     def column(name: str, shape: tuple[int, ...] = ()) -> np.ndarray:
         return data[name] if name in data else np.full((n, *shape), np.nan)
 
-    return ParticleTable(
+    table = ParticleTable(
         data.get("global_id", np.arange(n)),
         material,
         mesh.points,
@@ -105,6 +106,8 @@ def from_frame(directory: Path, frame: int) -> ParticleTable:
         column("heat_rate"),
         f"frame {frame % len(entries)} of {pvd} ({file}), t = {time!r} s",
     )
+    table.frame_index = frame % len(entries)  # -1: the last frame's own number
+    return table
 
 
 def from_checkpoint(path: Path) -> ParticleTable:
@@ -187,7 +190,7 @@ def export_particles(
         raise ConfigError("give --frame or --checkpoint, not both")
     if frame is not None:
         table = from_frame(directory, int(frame))
-        default = directory / f"particles_frame_{int(frame)}.csv"
+        default = directory / f"particles_frame_{table.frame_index}.csv"
     else:
         if checkpoint is None:
             found = list_checkpoints(directory / "checkpoints")

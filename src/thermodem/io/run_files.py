@@ -25,11 +25,28 @@ LOG_FILE = "run.log"
 FAILED_FILE = "failed.h5"
 
 
+#: The files a run leaves when its input was refused before the first step (the record of
+#: the refusal: ``status.json`` says ``failed`` with ``refused_input: true``).
+REFUSED_RUN_FILES = frozenset({"case.resolved.yaml", LOG_FILE, STATUS_FILE})
+
+
+def refused_run_record(path: Path) -> bool:
+    """``path`` holds only the record of a run whose input was refused before its first step
+    (nothing a user made or a run computed): the next run may reuse it without --overwrite,
+    so that after fixing the case the same command works (and an unfixed case is told its
+    error again, not that the directory is not empty)."""
+    names = {child.name for child in path.iterdir()}
+    if not names or not names <= REFUSED_RUN_FILES or STATUS_FILE not in names:
+        return False
+    return Status.read(path).get("refused_input") is True
+
+
 def prepare_output_dir(path: Path, overwrite: bool) -> None:
-    """Refuse an existing non-empty directory unless ``overwrite`` (never silently)."""
+    """Refuse an existing non-empty directory unless ``overwrite`` (never silently); the
+    record of a refused input (:func:`refused_run_record`) counts as empty."""
     if path.exists() and not path.is_dir():
         raise ConfigError(f"--output {str(path)!r} exists and is not a directory")
-    if path.exists() and any(path.iterdir()) and not overwrite:
+    if path.exists() and any(path.iterdir()) and not overwrite and not refused_run_record(path):
         raise ConfigError(
             f"--output {str(path)!r} exists and is not empty; choose another "
             "directory or pass --overwrite"

@@ -425,6 +425,7 @@ def write_walls_vtu(
 
 def particle_frame_fields(sim: Simulation) -> dict[str, np.ndarray]:
     """The point data of a particle frame (see the module docstring)."""
+    sim.complete_rates()
     p = sim.particles
     fields = {
         "global_id": p.global_id,

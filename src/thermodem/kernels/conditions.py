@@ -1,7 +1,9 @@
 """Compiled passes of the thermal conditions (``engine/thermal_conditions.py``): fixed
-temperatures and flux/volumetric sources per selection entry, and the weights of external
-sources. Parallel over fixed chunks of particles whose partial sums are combined in chunk
-order, so the results do not depend on the number of threads."""
+temperatures and flux/volumetric sources per selection entry (a classification of every
+particle at each neighbour-list build, then a per-step pass over the held and candidate
+particles only), and the weights of external sources. The sums run over fixed chunks whose
+partial sums are combined in chunk order, so the results do not depend on the number of
+threads."""
 
 from __future__ import annotations
 
@@ -17,55 +19,141 @@ FLUX = 1
 VOLUMETRIC = 2
 
 
+# classes of a particle in classify_conditions
+UNLISTED = 0  # nothing to do per step (not selected, or a source that cannot change)
+CANDIDATE = 1  # near the face of a selection region: evaluated at every thermal step
+HELD = 2  # fixed whatever it does until the next classification: its temperature is held
+
+
+@njit(cache=True, inline="always")
+def _region_class(ref, b, margin, lower, upper, periodic):
+    """0: a particle within ``margin`` of ``ref`` (per axis) is outside box ``b`` (lower 0:3,
+    upper 3:6, faces included); 1: inside; 2: it may be either. On a periodic axis a particle
+    whose margin interval crosses a face of the domain may wrap: it is 2 unless another axis
+    keeps it out."""
+    out = False
+    inside = True
+    for a in range(3):
+        lo = ref[a] - margin
+        hi = ref[a] + margin
+        if periodic[a] and (lo < lower[a] or hi >= upper[a]):
+            inside = False
+            continue
+        if hi < b[a] or lo > b[3 + a]:
+            out = True
+        elif not (b[a] <= lo and hi <= b[3 + a]):
+            inside = False
+    if out:
+        return 0
+    return 1 if inside else 2
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
-def apply_conditions(
-    position, radius, mass, type_id, temperature, c_by_type, static_mask, kinds, values,
-    has_region, boxes, fixed, source, part,
+def classify_conditions(
+    reference, radius, static_mask, kinds, values, has_region, boxes, margin, lower, upper,
+    periodic, fixed, source, bath, code,
 ):  # fmt: skip
-    """Fixed temperatures and flux/volumetric sources of every entry, in entry order.
+    """Which particles the selections of fixed temperatures and flux/volumetric sources hold
+    for until every particle has moved at most ``margin`` from ``reference`` (the positions of
+    the last neighbour-list build: the list is rebuilt before any moves farther).
 
     Entry e (``kinds[e]``: FIXED, FLUX or VOLUMETRIC, ``values[e]``: its temperature, flux or
     power density) holds for particle i when ``static_mask[i, e]`` and, if ``has_region[e]``,
-    the particle is inside ``boxes[e]`` (lower 0:3, upper 3:6). A fixed particle gets its bath
-    temperature (the last holding entry wins); ``part[c]`` collects per chunk the energy that
-    this reset adds, m c (T_bath - T), with the constant specific heats ``c_by_type``.
-    Rewrites ``fixed`` and ``source`` completely.
+    the particle is inside ``boxes[e]`` (lower 0:3, upper 3:6, faces included). A particle
+    that every region entry of its static selections keeps surely inside or surely outside
+    gets its ``fixed``, ``bath`` (the last holding FIXED entry wins) and ``source`` here, and
+    ``code`` HELD (fixed) or UNLISTED; one that some region may hold or not is a CANDIDATE,
+    evaluated at every thermal step by :func:`apply_listed`.
     """
-    n = temperature.shape[0]
+    n = radius.shape[0]
+    nentries = kinds.shape[0]
+    for i in prange(n):
+        candidate = False
+        is_fixed = False
+        t_bath = 0.0
+        q = 0.0
+        for e in range(nentries):
+            if not static_mask[i, e]:
+                continue
+            if has_region[e]:
+                where = _region_class(reference[i], boxes[e], margin, lower, upper, periodic)
+                if where == 0:
+                    continue
+                if where == 2:
+                    candidate = True
+                    break
+            kind = kinds[e]
+            if kind == FIXED:
+                is_fixed = True
+                t_bath = values[e]
+            elif kind == FLUX:
+                q += values[e] * 4.0 * math.pi * radius[i] * radius[i]
+            else:
+                q += values[e] * 4.0 / 3.0 * math.pi * radius[i] * radius[i] * radius[i]
+        if candidate:
+            code[i] = CANDIDATE
+            fixed[i] = False
+            source[i] = 0.0
+            bath[i] = 0.0
+        else:
+            code[i] = HELD if is_fixed else UNLISTED
+            fixed[i] = is_fixed
+            source[i] = q
+            bath[i] = t_bath
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def apply_listed(
+    listed, code, position, radius, mass, type_id, temperature, c_by_type, static_mask, kinds,
+    values, has_region, boxes, fixed, source, bath, part,
+):  # fmt: skip
+    """The per-step part of the conditions, over the listed particles only (``listed``: the
+    indices whose ``code`` is HELD or CANDIDATE, ascending): a HELD particle takes its bath
+    temperature; a CANDIDATE is evaluated against every entry at its current position (as
+    in :func:`classify_conditions`, without the margin) and gets ``fixed``, ``source`` and,
+    if fixed, its bath temperature. ``part[c]`` collects per chunk of CHUNK listed particles
+    the energy the resets add, m c (T_bath - T), with the constant specific heats
+    ``c_by_type``; returns their sum in chunk order (independent of the thread count)."""
+    n = listed.shape[0]
     nentries = kinds.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunks):
         reset = 0.0
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            is_fixed = False
-            bath = 0.0
-            q = 0.0
-            x = position[i, 0]
-            y = position[i, 1]
-            z = position[i, 2]
-            for e in range(nentries):
-                if not static_mask[i, e]:
-                    continue
-                if has_region[e]:
-                    b = boxes[e]
-                    if not (b[0] <= x <= b[3] and b[1] <= y <= b[4] and b[2] <= z <= b[5]):
+        for k in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            i = listed[k]
+            if code[i] == HELD:
+                t_bath = bath[i]
+            else:
+                is_fixed = False
+                t_bath = 0.0
+                q = 0.0
+                x = position[i, 0]
+                y = position[i, 1]
+                z = position[i, 2]
+                for e in range(nentries):
+                    if not static_mask[i, e]:
                         continue
-                kind = kinds[e]
-                if kind == FIXED:
-                    is_fixed = True
-                    bath = values[e]
-                elif kind == FLUX:
-                    r = radius[i]
-                    q += values[e] * 4.0 * math.pi * r * r
-                else:
-                    r = radius[i]
-                    q += values[e] * 4.0 / 3.0 * math.pi * r * r * r
-            fixed[i] = is_fixed
-            source[i] = q
-            if is_fixed:
-                t_old = temperature[i]
-                temperature[i] = bath
-                reset += mass[i] * c_by_type[type_id[i]] * (bath - t_old)
+                    if has_region[e]:
+                        b = boxes[e]
+                        if not (b[0] <= x <= b[3] and b[1] <= y <= b[4] and b[2] <= z <= b[5]):
+                            continue
+                    kind = kinds[e]
+                    if kind == FIXED:
+                        is_fixed = True
+                        t_bath = values[e]
+                    elif kind == FLUX:
+                        r = radius[i]
+                        q += values[e] * 4.0 * math.pi * r * r
+                    else:
+                        r = radius[i]
+                        q += values[e] * 4.0 / 3.0 * math.pi * r * r * r
+                fixed[i] = is_fixed
+                source[i] = q
+                if not is_fixed:
+                    continue
+            t_old = temperature[i]
+            temperature[i] = t_bath
+            reset += mass[i] * c_by_type[type_id[i]] * (t_bath - t_old)
         part[c] = reset
     total = 0.0
     for c in range(nchunks):

@@ -222,14 +222,16 @@ EULER_FIXED = 4
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type_id,
-               c_by_type, conductance_sum, fixed, dt, part):  # fmt: skip
+               c_by_type, conductance_sum, fixed, dt, part, clear):  # fmt: skip
     """One fused per-particle thermal update with constant specific heats.
 
     Fills the source column and the total heat rate (the sum of the mechanism columns in use,
     ``columns``, ascending: the others are zero), finds the explicit Euler limit min m c / ΣH
     over free particles, applies T += dt Q / (m c) to free particles, and sums per chunk the
     heat absorbed by fixed particles and every mechanism column in use [W]
-    (``part[c, EULER_FIXED + m]``).
+    (``part[c, EULER_FIXED + m]``). With ``clear`` it then zeroes the particle's mechanism
+    row and conductance sum, which the contact pass of the same step adds to next (instead of
+    a separate zeroing pass over the particles; the row is in the cache here).
     Returns (limit, limit index, absorbed, first bad index or -1).
     Parallel over fixed chunks of EULER_CHUNK particles whose partial results are combined in
     chunk order, so the sums do not depend on the number of threads (``part``: at least
@@ -254,12 +256,17 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type
                 q += qm
                 row[EULER_FIXED + m] += qm
             heat_rate[i] = q
+            g = conductance_sum[i]
+            if clear:
+                for m in range(nmech):
+                    by_mechanism[i, m] = 0.0
+                conductance_sum[i] = 0.0
             if fixed[i]:
                 absorbed += q
                 continue
             mc = mass[i] * c_by_type[type_id[i]]
-            if conductance_sum[i] > 0.0:
-                lim = mc / conductance_sum[i]
+            if g > 0.0:
+                lim = mc / g
                 if lim < limit:
                     limit = lim
                     where = i
