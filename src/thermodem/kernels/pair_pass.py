@@ -78,14 +78,15 @@ def passes_for(
     layout and generation arguments passed in are ignored. Each combination in use compiles
     once (~7 s on a 2-core machine) and is then cached on disk (Numba keys closures on their
     constants) and in this process. The wall pass, a few percent of the time, is one generic
-    kernel for all combinations (the offsets and the generation switch are its arguments).
+    kernel for all model combinations (the offsets are its arguments), compiled with or
+    without the generation deposits (:func:`wall_pass_for`).
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
         key = (False, 0, 0, 0)
     key = (*key, tuple(int(c) for c in layout), bool(generation))
     if key not in _PASSES:
-        _PASSES[key] = (_compile_pair_pass(*key), wall_pair_pass)
+        _PASSES[key] = (_compile_pair_pass(*key), wall_pass_for(key[-1]))
     return _PASSES[key]
 
 
@@ -331,142 +332,156 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
     return particle_pair_pass
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def wall_pair_pass(
-    position,
-    velocity,
-    angular_velocity,
-    radius,
-    mass,
-    inertia,
-    type_id,
-    wall_pair_i,
-    wall_pair_w,
-    wall_row_start,
-    history,
-    wall_kind,
-    wall_rows,
-    wall_material,
-    extra,
-    dt,
-    normal_id,
-    normal_table,
-    tangential_id,
-    tangential_table,
-    rolling_id,
-    rolling_table,
-    force,
-    torque,
-    out_normal_force,
-    out_state,
-    chunk_ledger,
-    heat_on,
-    temperature,
-    radius_id,
-    radius_table,
-    conduction_id,
-    conduction_table,
-    override,
-    k_particle,
-    rhoc_particle,
-    k_wall,
-    rhoc_wall,
-    scratch,
-    by_mechanism,
-    conductance_sum,
-    tolerance,
-    layout,
-    generation,
-    gen_energy,
-    gen_select,
-    gen_partition,
-):
-    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
-    added to ``force`` and ``torque`` after the particle pairs.
+_WALL_PASSES: dict[bool, object] = {}
 
-    Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
-    ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
-    the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
-    ``layout``: the history offsets (see :func:`passes_for`). With ``generation`` the
-    dissipated energies go to the particle's accumulators, its share ``gen_partition[type,
-    wall material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
-    wall's share to the chunk's ledger row.
-    """
-    h_normal = layout[HL.NORMAL]
-    h_spring = layout[HL.SPRING]
-    h_roll = layout[HL.ROLL]
-    h_collision = layout[HL.COLLISION] if generation else -1
-    h_reuse = layout[HL.REUSE]
-    n = radius.shape[0]
-    nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
-    for c in prange(nchunks):
-        srow = scratch[c] if heat_on else scratch[0]  # (one row when heat is off)
-        row = chunk_ledger[c]
-        for q in range(row.shape[0]):
-            row[q] = 0.0
-        first = wall_row_start[c * WALL_CHUNK]
-        for k in range(first, wall_row_start[min(n, (c + 1) * WALL_CHUNK)]):
-            i = wall_pair_i[k]
-            w = wall_pair_w[k]
-            wrow = wall_rows[w]
-            d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
-            ri = radius[i]
-            overlap = ri - d
-            psi_f = psi_o = 1.0  # the particle's share (adiabatic wall: all of it)
-            if generation and wrow[COL_THERMAL_KIND] != 0.0:
-                psi_f = gen_partition[type_id[i], wall_material[w], 0]
-                psi_o = gen_partition[type_id[i], wall_material[w], 1]
-            if overlap <= 0.0:
-                if h_collision >= 0 and history[k, H_DURATION] != 0.0:
-                    lost = collision_loss(
-                        history, k, h_collision,
-                        kinetic_energy(velocity, angular_velocity, mass, inertia, i),
-                    )  # fmt: skip
-                    row[L_COLLISION] += lost
-                    if gen_select[G_COLLISION] != 0.0:
-                        gen_energy[i, G_COLLISION] += psi_o * lost
-                        row[L_WALL_GENERATION + G_COLLISION] += lost - psi_o * lost
-                e_spring, e_rspring = _open_contact(
-                    k, history, h_spring, h_roll, out_normal_force, out_state, row
-                )
-                if generation and (e_spring != 0.0 or e_rspring != 0.0):
-                    deposit_wall(
-                        gen_energy, i, gen_select, psi_f, psi_o, 0.0, 0.0, e_spring, e_rspring,
-                        0.0, row,
-                    )  # fmt: skip
-                out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
-            else:
-                out_state[k] = STATE_TOUCHING
-                # n from the particle towards the wall
-                nx = -wnx
-                ny = -wny
-                nz = -wnz
-                # wall surface velocity at q: v_w + Ω a × (q - c)
-                om = wrow[COL_OMEGA]
-                ax = wrow[COL_AXIS] * om
-                ay = wrow[COL_AXIS + 1] * om
-                az = wrow[COL_AXIS + 2] * om
-                rx = qx - wrow[COL_POINT]
-                ry = qy - wrow[COL_POINT + 1]
-                rz = qz - wrow[COL_POINT + 2]
-                vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
-                vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
-                vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
-                wix = angular_velocity[i, 0]
-                wiy = angular_velocity[i, 1]
-                wiz = angular_velocity[i, 2]
-                vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
-                vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
-                vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
-                ti = type_id[i]
-                tw = wall_material[w]
-                rolling_inertia = inertia[i] + mass[i] * ri * ri
-                if h_collision >= 0 and history[k, H_DURATION] == 0.0:
-                    history[k, h_collision] = kinetic_energy(
-                        velocity, angular_velocity, mass, inertia, i
+
+def wall_pass_for(generation: bool):  # noqa: ANN201
+    """The wall pair pass with (or without) the heat generation deposits compiled in (a
+    compile-time constant: a case without heat generation does not compile them)."""
+    key = bool(generation)
+    if key not in _WALL_PASSES:
+        _WALL_PASSES[key] = _compile_wall_pass(key)
+    return _WALL_PASSES[key]
+
+
+def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
+    """Define the wall pair pass with the generation switch captured as a constant."""
+
+    @njit(cache=True, parallel=True, error_model="numpy")
+    def wall_pair_pass(
+        position,
+        velocity,
+        angular_velocity,
+        radius,
+        mass,
+        inertia,
+        type_id,
+        wall_pair_i,
+        wall_pair_w,
+        wall_row_start,
+        history,
+        wall_kind,
+        wall_rows,
+        wall_material,
+        extra,
+        dt,
+        normal_id,
+        normal_table,
+        tangential_id,
+        tangential_table,
+        rolling_id,
+        rolling_table,
+        force,
+        torque,
+        out_normal_force,
+        out_state,
+        chunk_ledger,
+        heat_on,
+        temperature,
+        radius_id,
+        radius_table,
+        conduction_id,
+        conduction_table,
+        override,
+        k_particle,
+        rhoc_particle,
+        k_wall,
+        rhoc_wall,
+        scratch,
+        by_mechanism,
+        conductance_sum,
+        tolerance,
+        layout,
+        generation,
+        gen_energy,
+        gen_select,
+        gen_partition,
+    ):
+        """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
+        added to ``force`` and ``torque`` after the particle pairs.
+
+        Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
+        ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
+        the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
+        ``layout``: the history offsets (see :func:`passes_for`). With ``generation`` the
+        dissipated energies go to the particle's accumulators, its share ``gen_partition[type,
+        wall material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
+        wall's share to the chunk's ledger row.
+        """
+        h_normal = layout[HL.NORMAL]
+        h_spring = layout[HL.SPRING]
+        h_roll = layout[HL.ROLL]
+        h_collision = layout[HL.COLLISION] if GENERATION else -1
+        h_reuse = layout[HL.REUSE]
+        n = radius.shape[0]
+        nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
+        for c in prange(nchunks):
+            srow = scratch[c] if heat_on else scratch[0]  # (one row when heat is off)
+            row = chunk_ledger[c]
+            for q in range(row.shape[0]):
+                row[q] = 0.0
+            first = wall_row_start[c * WALL_CHUNK]
+            for k in range(first, wall_row_start[min(n, (c + 1) * WALL_CHUNK)]):
+                i = wall_pair_i[k]
+                w = wall_pair_w[k]
+                wrow = wall_rows[w]
+                d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
+                ri = radius[i]
+                overlap = ri - d
+                psi_f = psi_o = 1.0  # the particle's share (adiabatic wall: all of it)
+                if GENERATION and wrow[COL_THERMAL_KIND] != 0.0:
+                    psi_f = gen_partition[type_id[i], wall_material[w], 0]
+                    psi_o = gen_partition[type_id[i], wall_material[w], 1]
+                if overlap <= 0.0:
+                    if GENERATION and h_collision >= 0 and history[k, H_DURATION] != 0.0:
+                        lost = collision_loss(
+                            history, k, h_collision,
+                            kinetic_energy(velocity, angular_velocity, mass, inertia, i),
+                        )  # fmt: skip
+                        row[L_COLLISION] += lost
+                        if gen_select[G_COLLISION] != 0.0:
+                            gen_energy[i, G_COLLISION] += psi_o * lost
+                            row[L_WALL_GENERATION + G_COLLISION] += lost - psi_o * lost
+                    e_spring, e_rspring = _open_contact(
+                        k, history, h_spring, h_roll, out_normal_force, out_state, row
                     )
-                (f_n, ftx, fty, ftz, tx, ty, tz, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic) = (
-                    contact_response(
+                    if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
+                        deposit_wall(
+                            gen_energy, i, gen_select, psi_f, psi_o, 0.0, 0.0, e_spring, e_rspring,
+                            0.0, row,
+                        )  # fmt: skip
+                    out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
+                else:
+                    out_state[k] = STATE_TOUCHING
+                    # n from the particle towards the wall
+                    nx = -wnx
+                    ny = -wny
+                    nz = -wnz
+                    # wall surface velocity at q: v_w + Ω a × (q - c)
+                    om = wrow[COL_OMEGA]
+                    ax = wrow[COL_AXIS] * om
+                    ay = wrow[COL_AXIS + 1] * om
+                    az = wrow[COL_AXIS + 2] * om
+                    rx = qx - wrow[COL_POINT]
+                    ry = qy - wrow[COL_POINT + 1]
+                    rz = qz - wrow[COL_POINT + 2]
+                    vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
+                    vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
+                    vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
+                    wix = angular_velocity[i, 0]
+                    wiy = angular_velocity[i, 1]
+                    wiz = angular_velocity[i, 2]
+                    vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
+                    vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
+                    vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
+                    ti = type_id[i]
+                    tw = wall_material[w]
+                    rolling_inertia = inertia[i] + mass[i] * ri * ri
+                    if GENERATION and h_collision >= 0 and history[k, H_DURATION] == 0.0:
+                        history[k, h_collision] = kinetic_energy(
+                            velocity, angular_velocity, mass, inertia, i
+                        )
+                    out = contact_response(
                         k,
                         history,
                         nx,
@@ -495,38 +510,41 @@ def wall_pair_pass(
                         out_normal_force,
                         row,
                     )
-                )
-                if generation and dt > 0.0:  # (none at the t = 0 evaluation)
-                    deposit_wall(
-                        gen_energy, i, gen_select, psi_f, psi_o, e_ndamp, e_tdamp, e_slip,
-                        e_roll, e_plastic, row,
-                    )  # fmt: skip
-                # work done by the wall on the particle this step
-                fx = -f_n * nx + ftx
-                fy = -f_n * ny + fty
-                fz = -f_n * nz + ftz
-                force[i, 0] += fx
-                force[i, 1] += fy
-                force[i, 2] += fz
-                torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
-                torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
-                torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
-                row[L_WALL_WORK] += (
-                    fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az
-                ) * dt
-                ratio = overlap / ri
-                if ratio > row[L_MAX_OVERLAP_RATIO]:
-                    row[L_MAX_OVERLAP_RATIO] = ratio
-            # conduction from fixed-temperature walls, touching pairs (one call site, as in the
-            # particle pass)
-            if heat_on and out_state[k] == STATE_TOUCHING:
-                h = 0.0
-                if wrow[COL_THERMAL_KIND] != 0.0:
-                    h = _pw_conductance(
-                        k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
-                        out_normal_force, radius_id, radius_table, conduction_id,
-                        conduction_table, override, k_particle, rhoc_particle, k_wall,
-                        rhoc_wall, srow, h_reuse, tolerance,
-                    )  # fmt: skip
-                by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
-                conductance_sum[i] += h
+                    (f_n, ftx, fty, ftz, tx, ty, tz, e_ndamp, e_tdamp, e_slip, e_roll,
+                     e_plastic) = out  # fmt: skip
+                    if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
+                        deposit_wall(
+                            gen_energy, i, gen_select, psi_f, psi_o, e_ndamp, e_tdamp, e_slip,
+                            e_roll, e_plastic, row,
+                        )  # fmt: skip
+                    # work done by the wall on the particle this step
+                    fx = -f_n * nx + ftx
+                    fy = -f_n * ny + fty
+                    fz = -f_n * nz + ftz
+                    force[i, 0] += fx
+                    force[i, 1] += fy
+                    force[i, 2] += fz
+                    torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
+                    torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
+                    torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
+                    row[L_WALL_WORK] += (
+                        fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az
+                    ) * dt
+                    ratio = overlap / ri
+                    if ratio > row[L_MAX_OVERLAP_RATIO]:
+                        row[L_MAX_OVERLAP_RATIO] = ratio
+                # conduction from fixed-temperature walls, touching pairs (one call site, as in the
+                # particle pass)
+                if heat_on and out_state[k] == STATE_TOUCHING:
+                    h = 0.0
+                    if wrow[COL_THERMAL_KIND] != 0.0:
+                        h = _pw_conductance(
+                            k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
+                            out_normal_force, radius_id, radius_table, conduction_id,
+                            conduction_table, override, k_particle, rhoc_particle, k_wall,
+                            rhoc_wall, srow, h_reuse, tolerance,
+                        )  # fmt: skip
+                    by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    conductance_sum[i] += h
+
+    return wall_pair_pass
