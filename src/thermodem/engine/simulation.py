@@ -309,9 +309,12 @@ class Simulation:
         heat_due = (
             th is not None and not th.settings.frozen_mechanics and th.next_step <= self.step_count
         )
+        # conduction evaluated in the contact pass, for the thermal step that follows (not
+        # without a contact conduction model: the pass would add zeros)
+        fused = heat_due and th.contact.active
         if heat_due:
-            # conduction evaluated in the contact pass, for the thermal step that follows
             th.prepare(self.time)
+        if fused:
             pair_pass, wall_pass = PP.passes_for(
                 True, th.radius_id, th.conduction_id, th.override, layout, self.generation
             )
@@ -327,7 +330,8 @@ class Simulation:
         if heat_due:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
-            pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+            if fused:
+                pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
             # the heat sums start at zero: zeroed here, or already by this step's Euler update
             zero = not (th.rates_cleared and th.conductance_sum.shape[0] == p.count)
             th.rates_cleared = False
