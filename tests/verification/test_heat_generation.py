@@ -23,6 +23,8 @@ References (not the code under test):
 Tolerances are tied to the time step: the closed forms hold for the continuous motion, the
 simulation resolves a collision with STEPS_PER_CONTACT steps (first-order damping lag), the
 slide with a tenth of the Rayleigh time (test_friction_ledger.py: m v0²/7 to 2e-5).
+Measured with 400 steps per contact: damping heat within 0.35 % of (1 - e²) ½ m* v² (e = 0.3),
+Walton–Braun's plastic heat within 1e-5 and its e within 0.1 %.
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ DENSITY = 2500.0  # [kg/m^3]
 MASS = DENSITY * 4.0 / 3.0 * math.pi * RADIUS**3
 STIFFNESS = 2.0e4  # linear and Walton–Braun loading stiffness [N/m]
 C = 800.0  # specific heat [J/(kg K)]
-STEPS_PER_CONTACT = 400
+STEPS_PER_CONTACT = 200
 
 
 @pytest.fixture(autouse=True, scope="module")
@@ -375,8 +377,8 @@ def pour_case(generation: dict, normal) -> dict:
     glass = material(restitution=0.5, sliding_friction=0.5)
     pour = {"kind": "pour", "material": "glass",
             "distribution": {"kind": "mono", "radius": 0.001},
-            "region": {"kind": "box", "lower": [0.001, 0.001, 0.006],
-                       "upper": [0.011, 0.011, 0.017]},
+            "region": {"kind": "box", "lower": [0.001, 0.001, 0.0015],
+                       "upper": [0.011, 0.011, 0.010]},
             "rate": 5000.0, "interval": 2e-3, "end_time": 8e-3}  # fmt: skip
     return {
         "simulation": {"time_step": 5e-6, "end_time": 1.0, "gravity": [0.0, 0.0, -9.81],
@@ -403,7 +405,7 @@ def pour_case(generation: dict, normal) -> dict:
 )
 def test_pour_ledger_closes(generation, normal):
     sim = Simulation(case_from_dict(pour_case(generation, normal)))
-    sim.run(steps=10001)
+    sim.run(steps=6001)
     assert sim.particles.count > 20
     r = generation_ledger_closes(sim)
     if generation["model"] == "al_arkawazi2017":
