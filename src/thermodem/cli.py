@@ -464,6 +464,11 @@ def models(
             typer.echo(f"  {fam}.{spec.name}: {spec.summary}")
             if spec.requires:
                 typer.echo(f"    requires materials.*: {', '.join(spec.requires)}")
+            if spec.requires_of is not None:
+                typer.echo(
+                    "    requires materials.* what its options read (e.g. the partition "
+                    f"formula's properties; docs/models/{fam}-{spec.name}.md)"
+                )
             if spec.uses_gas:
                 typer.echo(f"    reads thermal.gas: {', '.join(spec.uses_gas)}")
             if fam in _THERMAL_PAIR_FAMILIES and spec.name != "none":
@@ -484,7 +489,12 @@ def models(
                 typer.echo("    parameters: none")
             for pname, field in fields.items():
                 unit, text = _unit(field.description or "")
-                default = "required" if field.is_required() else f"default {field.default!r}"
+                if field.is_required():
+                    default = "required"
+                elif field.default_factory is not None:
+                    default = f"default {field.default_factory()!r}"
+                else:
+                    default = f"default {field.default!r}"
                 bounds = _bounds(field)
                 details = ", ".join(
                     x for x in (f"[{unit}]" if unit else "", default, bounds, text) if x

@@ -222,6 +222,30 @@ def test_thermal_columns_and_plots(tmp_path: Path) -> None:
     assert "gas (thermal.gas): k_g = 0.0263 W/(m K)" in info.output  # the default, air
 
 
+def test_heat_generation_columns_and_plot(tmp_path: Path) -> None:
+    """A generation mechanism has its rate and ledger columns and its curve in
+    generation.png; the columns the mechanics ledger gives match the generation's."""
+    data = pour_case(thermal=True)
+    data["thermal"]["heat_generation"] = {"model": "mechanical_dissipation",
+                                          "partition": "conductivity"}  # fmt: skip
+    out = tmp_path / "gen"
+    run_case(case_from_dict(data), out, **_quiet())
+    series = read_timeseries(out / "timeseries.csv")
+    for name in ("sliding_friction", "rolling_friction", "normal_damping", "tangential_damping",
+                 "plastic_deformation"):  # fmt: skip
+        for prefix in ("heat_rate_generation_", "heat_in_generation_", "generated_",
+                       "heat_to_walls_generation_", "heat_pending_generation_"):  # fmt: skip
+            assert prefix + name in series, prefix + name
+    assert "heat_rate_generation_collision" not in series  # not selected
+    last = {k: v[-1] for k, v in series.items()}
+    assert last["generated_normal_damping"] == last["dissipated_normal_damping"]
+    assert last["heat_in_generation_normal_damping"] > 0.0
+    assert last["heat_to_walls_generation_normal_damping"] > 0.0  # the floor is hot: its share
+    result = CliRunner().invoke(app, ["plot", str(out)])
+    assert result.exit_code == 0, result.output
+    assert (out / "plots" / "generation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_timeseries_gains_columns_when_the_engine_reports_more(tmp_path: Path) -> None:
     class Fake:
         def __init__(self, step: int, report: dict) -> None:

@@ -50,7 +50,7 @@ def specs(family: str) -> list[registry.ModelSpec]:
 
 def default_params(spec: registry.ModelSpec):
     """The model's parameters with defaults (a value for the required ones)."""
-    required = {"stiffness": 3.0e4}  # normal.linear
+    required = {"stiffness": 3.0e4, "loading_stiffness": 3.0e4}  # normal.linear, walton_braun
     fields = spec.params.model_fields
     return spec.params(**{k: v for k, v in required.items() if k in fields})
 
@@ -81,8 +81,9 @@ def random_arguments(family: str, rng: np.random.Generator) -> tuple:
     """Arguments after the parameter row, physically shaped but random (signs included)."""
     u = rng.uniform
     if family == "normal":
-        # overlap, overlap_rate, eff_radius, eff_mass
-        return (10 ** u(-9, -3), u(-5, 5), 10 ** u(-4, -1), 10 ** u(-6, 1))
+        # overlap, overlap_rate, eff_radius, eff_mass, max_overlap (below or above the overlap)
+        overlap = 10 ** u(-9, -3)
+        return (overlap, u(-5, 5), 10 ** u(-4, -1), 10 ** u(-6, 1), overlap * u(0.0, 2.0))
     if family == "tangential":
         # ref_stiffness, normal_damping, eff_radius, overlap, normal_force, v_t, s, dt
         return (
@@ -157,7 +158,7 @@ def test_dispatcher_equals_model_kernel(spec):
 def test_normal_dispatcher_rejects_unknown_id():
     p = np.ones(max(s.width for s in registry.all_models()))
     unknown = max(s.model_id for s in specs("normal")) + 1
-    out = dispatch.normal_dispatch(unknown, p, 1e-6, 0.1, 1e-3, 1e-3)
+    out = dispatch.normal_dispatch(unknown, p, 1e-6, 0.1, 1e-3, 1e-3, 0.0)
     assert all(math.isnan(x) for x in out)
 
 
@@ -178,13 +179,14 @@ def test_hertz_force_is_energy_derivative(e_star, eff_radius, rel_overlap, alpha
     p[normal.HERTZ_E_STAR] = e_star
     p[normal.HERTZ_ALPHA] = alpha
     delta = rel_overlap * eff_radius
-    f_el, f_damp, _, _, _ = normal.hertz_force(p, delta, 0.0, eff_radius, eff_mass)
+    f_el, f_damp, _, _, _, _, plastic = normal.hertz_force(p, delta, 0.0, eff_radius, eff_mass, 0.0)
+    assert plastic == 0.0
     assert f_damp == 0.0
     closed = 4.0 / 3.0 * e_star * math.sqrt(eff_radius) * delta**1.5
     assert f_el == pytest.approx(closed, rel=1e-12)
     h = 1e-4 * delta
-    u_plus = normal.hertz_force(p, delta + h, 0.0, eff_radius, eff_mass)[4]
-    u_minus = normal.hertz_force(p, delta - h, 0.0, eff_radius, eff_mass)[4]
+    u_plus = normal.hertz_force(p, delta + h, 0.0, eff_radius, eff_mass, 0.0)[4]
+    u_minus = normal.hertz_force(p, delta - h, 0.0, eff_radius, eff_mass, 0.0)[4]
     # truncation (h/δ)² / 8 ~ 1e-9, round-off ~ 1e-16 / 1e-4 = 1e-12
     assert (u_plus - u_minus) / (2.0 * h) == pytest.approx(f_el, rel=1e-7)
 
@@ -195,11 +197,11 @@ def test_linear_force_is_energy_derivative(stiffness, delta, zeta):
     p = np.zeros(len(normal.LINEAR_COLUMNS))
     p[normal.LINEAR_STIFFNESS] = stiffness
     p[normal.LINEAR_DAMPING_RATIO] = zeta
-    f_el = normal.linear_force(p, delta, 0.0, 1e-3, 1e-3)[0]
+    f_el = normal.linear_force(p, delta, 0.0, 1e-3, 1e-3, 0.0)[0]
     assert f_el == pytest.approx(stiffness * delta, rel=1e-15)
     h = 1e-4 * delta
-    u_plus = normal.linear_force(p, delta + h, 0.0, 1e-3, 1e-3)[4]
-    u_minus = normal.linear_force(p, delta - h, 0.0, 1e-3, 1e-3)[4]
+    u_plus = normal.linear_force(p, delta + h, 0.0, 1e-3, 1e-3, 0.0)[4]
+    u_minus = normal.linear_force(p, delta - h, 0.0, 1e-3, 1e-3, 0.0)[4]
     assert (u_plus - u_minus) / (2.0 * h) == pytest.approx(f_el, rel=1e-7)
 
 
@@ -369,3 +371,41 @@ def test_hertz_restitution_round_trip(e):
     alpha = hertz_alpha_of_restitution(e)
     assert alpha >= 0.0
     assert abs(hertz_restitution_of_alpha(alpha) - e) < 1e-9
+
+
+@SETTINGS
+@given(
+    k1=st.floats(1.0, 1e7),
+    e=st.floats(0.05, 1.0),
+    peak=st.floats(1e-7, 1e-3),
+    back=st.floats(0.0, 1.0),
+    again=st.floats(0.0, 2.0),
+)
+def test_walton_braun_work_is_stored_energy_plus_plastic_dissipation(k1, e, peak, back, again):
+    """Along a path load to δ_a, unload to a fraction of it, reload beyond it (steps small
+    enough to resolve the branches, with the branch points as step ends): the work of the
+    force (trapezoids: the law is piecewise linear) equals the change of the stored energy
+    plus the plastic dissipation, and a full load-unload cycle dissipates ½ k1 (1 - e²) δ_max²
+    (Walton & Braun 1986)."""
+    p = np.array([k1, e * e])
+    d0_of = lambda m: m * (1.0 - e * e)  # noqa: E731 (δ0 of a largest overlap m)
+    lows = (d0_of(peak) + back * (peak - d0_of(peak)), peak, peak * (1.0 + again))
+    points = [np.linspace(0.0, peak, 50)]
+    points.append(np.linspace(peak, lows[0], 50)[1:])
+    points.append(np.linspace(lows[0], peak, 50)[1:])  # reload along the unloading line
+    points.append(np.linspace(peak, lows[2], 50)[1:])  # and beyond: loading again
+    path = np.concatenate(points)
+    m = 0.0
+    work = plastic = 0.0
+    f_prev, u0 = 0.0, 0.0
+    for k, d in enumerate(path):
+        f, _, _, _, u, m, dp = normal.walton_braun_force(p, d, 0.0, 1e-3, 1e-3, m)
+        if k:
+            work += 0.5 * (f + f_prev) * (d - path[k - 1])
+        plastic += dp
+        f_prev = f
+    assert work == pytest.approx(u - u0 + plastic, rel=1e-9, abs=1e-18 * k1)
+    assert m == max(peak, lows[2])
+    cycle = normal.walton_braun_force(p, m, 0.0, 1e-3, 1e-3, m)[4]  # stored at the top
+    assert plastic == pytest.approx(0.5 * k1 * (1.0 - e * e) * m * m, rel=1e-12)
+    assert cycle == pytest.approx(0.5 * k1 * e * e * m * m, rel=1e-12)

@@ -6,8 +6,9 @@ contributions in an order fixed by the list; each group and each chunk of partic
 its own ledger row. A run with 1 thread and a run with 2 threads must therefore be
 bit-identical. The bed below has more than 4096 particles and many slab groups, so every
 parallel loop is split between the threads. A second run adds heat (resistance network with
-the conductance reuse, whose per-pair state sits after the rolling model's history columns),
-a third gap conduction on the range pair set.
+the conductance reuse, whose per-pair state sits after the rolling model's history columns,
+and heat generation, whose per-particle accumulators receive every contact's dissipation, heat
+every third step), a third gap conduction on the range pair set.
 
 Without a request the thread count is chosen from the work (engine/threads.py): 1 thread for
 small systems, every thread Numba has for large ones.
@@ -89,6 +90,10 @@ def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulatio
             "conductance_force_tolerance": 0.02,
             "initial_temperature": {"kind": "expression", "expression": "300 + 1000 * x"},
         }
+    if heat == "reuse":
+        case["thermal"]["heat_generation"] = {"model": "mechanical_dissipation",
+                                              "partition": "effusivity"}  # fmt: skip
+        case["thermal"]["substeps"] = 3
     if heat == "range":  # gap conduction on the range pair set, rebuilt while the bed moves
         case["neighbors"]["extra_distance"] = 0.0
         case["thermal"].update(
@@ -150,7 +155,10 @@ def test_one_and_two_threads_bit_identical(tmp_path, heat):
     if heat:
         names += ["temperature", "heat_rate_by_mechanism"]
     if heat == "reuse":
-        assert one.pairs.history_width == C.HISTORY_WIDTH_ROLLING + 3
+        assert one.history_layout.reuse >= 0 and one.history_layout.roll >= 0
+        names += ["generation_energy"]
+        assert one.report()["heat_in_generation_sliding_friction"] > 0.0
+        assert one.report() == two.report()
     if heat == "range" or (heat in INDIRECT and heat != "vargas"):
         rs = one.thermal.range_set
         assert rs.count > 2 * C.CHUNK and rs.ngroups >= 8 and rs.builds > 1

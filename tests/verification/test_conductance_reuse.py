@@ -19,7 +19,6 @@ import pytest
 from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
 from thermodem.kernels.contact import STATE_TOUCHING
-from thermodem.kernels.pair_pass import REUSE_COLUMNS
 from thermodem.models.thermal.resistance_network import resistance_network_conductance
 from thermodem.state import heat
 
@@ -133,7 +132,7 @@ def test_conductances_with_reuse_stay_within_the_bound_of_the_exact_model(
     fused pass's heat rate within tol² Σ H |ΔT| of the exact one."""
     sim = Simulation(case_from_dict(_case(TOL, _bed_file(tmp_path / "bed.txt"))))
     th = sim.thermal
-    col = sim.pairs.history_width - REUSE_COLUMNS
+    col = sim.history_layout.reuse
     reused = touching = 0
     worst = 0.0
     for _ in range(100):
@@ -168,7 +167,7 @@ def test_conductances_with_reuse_stay_within_the_bound_of_the_exact_model(
 
 def test_without_reuse_the_engine_equals_the_exact_model(tmp_path: Path) -> None:
     sim = Simulation(case_from_dict(_case(0.0, _bed_file(tmp_path / "bed.txt"))))
-    assert sim.pairs.history_width == 6
+    assert sim.history_layout.reuse == -1
     sim.run(steps=1500)
     engine = sim.particles.heat_rate_by_mechanism
     exact = _exact(sim)[2:]

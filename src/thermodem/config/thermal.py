@@ -8,6 +8,7 @@ Example::
       indirect_conduction: none    # e.g. {model: rong_horio1999, layer_thickness_ratio: 0.4}
       convection: none             # e.g. gunn1978, with thermal.fluid and thermal.porosity
       radiation: none              # e.g. {model: krause2017, radius_ratio: 3.0}
+      heat_generation: none        # e.g. {model: mechanical_dissipation, partition: effusivity}
       gas: {thermal_conductivity: 0.0263}   # the interstitial gas (default: air, 300 K, 1 atm)
       substeps: 1                  # solve heat every n mechanical steps, or "auto"
       conductance_force_tolerance: 0   # resistance_network: reuse H while F_n is within tol
@@ -305,6 +306,12 @@ class ThermalSettings(StrictModel):
         validate_default=True,
         description="convection model: particle-fluid heat transfer (per-particle term)",
     )
+    heat_generation: Any = Field(
+        default="none",
+        validate_default=True,
+        description="heat generation model: the mechanical dissipation of the contacts turned "
+        "into heat (conversion fraction, partition between the two bodies)",
+    )
     fluid: FluidSettings | None = Field(
         default=None,
         description="the fluid around the particles (temperature, velocity, properties), "
@@ -391,6 +398,11 @@ class ThermalSettings(StrictModel):
     @classmethod
     def _conv(cls, v: Any):  # noqa: ANN206
         return parse_thermal_choice("convection", v, "none")
+
+    @field_validator("heat_generation", mode="before")
+    @classmethod
+    def _gen(cls, v: Any):  # noqa: ANN206
+        return parse_thermal_choice("heat_generation", v, "none")
 
     @field_validator("porosity", mode="before")
     @classmethod

@@ -8,7 +8,9 @@
   characteristic impact speed v. Warn when a collision would last fewer than
   ``collision_warn_steps`` steps, refuse below ``collision_min_steps``.
   For the linear spring the collision time is π sqrt(m*/k) / sqrt(1 - ζ²) instead, and the
-  same with k = (π/4) E* b for the 2D line contact ``hertz_2d`` (masses of discs, ρ π R² b).
+  same with k = (π/4) E* b for the 2D line contact ``hertz_2d`` (masses of discs, ρ π R² b);
+  for Walton & Braun's law (π/2) (sqrt(m*/k1) + sqrt(m*/k2)), k2 = k1/e² (its loading and
+  unloading half periods).
 
 ``allow_unstable: true`` turns refusals into warnings.
 """
@@ -94,6 +96,10 @@ def critical_times(
                     k = hertz_2d_stiffness(effective_youngs_modulus(ma, mb), thickness or 1.0)
                 e = resolve_pair(ma, mb).restitution
                 tc = linear_collision_time(m_eff, k, max(e, 1e-6))  # (e = 0: critical damping)
+            elif normal.model == "walton_braun":
+                k1 = normal.params.loading_stiffness
+                e = max(resolve_pair(ma, mb).restitution, 1e-6)
+                tc = 0.5 * math.pi * (math.sqrt(m_eff / k1) + e * math.sqrt(m_eff / k1))
             else:
                 tc = hertz_collision_time(m_eff, r_eff, effective_youngs_modulus(ma, mb), v)
             out["collision"] = min(out["collision"], tc)

@@ -108,14 +108,14 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
             p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
             pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
             th.radius_id, th.radius_table, th.conduction_id, th.conduction_table, th.override,
-            th.k_p, th.rhoc_p, th.scratch, pair_h, 0.0,
+            th.k_p, th.rhoc_p, th.scratch, pair_h, -1, 0.0,
         )  # fmt: skip
         thermal_kernels.conduction_wall_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
             wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
             sim.wall_material, th.radius_id, th.radius_table, th.conduction_id,
             th.conduction_table, th.override, th.k_p, th.rhoc_p, th.k_w, th.rhoc_w, th.scratch,
-            wall_h, 0.0,
+            wall_h, -1, 0.0,
         )  # fmt: skip
         add(heat.M_DIRECT, pair_h, wall_h)  # wall contacts too: the `wall` key tells them
     # the other pair terms, evaluated on the contact pairs (side effects into scratch sums)

@@ -11,9 +11,10 @@ The state is a plain nested dict, which :mod:`thermodem.io.checkpoint` writes to
       "scalars":   {time, step_count, next_global_id, skin, moved, rebuild_count,
                     _needs_rebuild, initial_energy, max_overlap_ratio, contact_count,
                     ledger_cumulative, rng (the bit generator state), pourers (state dicts),
-                    material_names, history_width, pair_capacity, wall_pair_capacity},
+                    material_names, history_width, history_layout, pair_capacity,
+                    wall_pair_capacity},
       "particles": {every Particles array, in the current memory order},
-      "pairs":     {i, j, history, dissipation, normal_force, state: the first `count` rows;
+      "pairs":     {i, j, history, normal_force, state: the first `count` rows;
                     group_start: the slab groups of the list},
       "walls":     {the same for particle-wall pairs},
       "arrays":    {wall_row_start, reference, wall_reference, wall_rows, elastic},
@@ -66,7 +67,6 @@ PAIR_ARRAYS: tuple[str, ...] = (
     "i",
     "j",
     "history",
-    "dissipation",
     "normal_force",
     "state",
 )
@@ -106,7 +106,10 @@ DERIVED: tuple[str, ...] = (
     "chunk_check",
     "_complete",  # the argument of the step in progress
     "_no_heat",
+    "_no_generation",
+    "generation",
     "mechanisms",
+    "history_layout",
     # the thread count: the new process's request or choice (results do not depend on it)
     "requested_threads",
     "threads",
@@ -161,6 +164,7 @@ def capture(sim: Simulation) -> dict[str, Any]:
     scalars["pourers"] = [p.state_dict() for p in sim.pourers]
     scalars["material_names"] = list(sim.material_names)
     scalars["history_width"] = sim.pairs.history_width
+    scalars["history_layout"] = sim.history_layout.describe()
     scalars["pair_capacity"] = sim.pairs.capacity
     scalars["wall_pair_capacity"] = sim.walls.capacity
     scalars["pair_count"] = sim.pairs.count
@@ -208,6 +212,7 @@ STATE_SCALARS: tuple[str, ...] = (
     "pourers",
     "material_names",
     "history_width",
+    "history_layout",
     "pair_capacity",
     "wall_pair_capacity",
     "pair_count",
@@ -406,11 +411,16 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
     s = state["scalars"]
     if list(s["material_names"]) != list(sim.material_names):
         raise _mismatch("the list of materials", list(s["material_names"]), sim.material_names)
-    if int(s["history_width"]) != sim.pairs.history_width:
+    saved_layout = [[str(b), int(c), int(w)] for b, c, w in s["history_layout"]]
+    if int(s["history_width"]) != sim.pairs.history_width or saved_layout != [
+        [str(b), int(c), int(w)] for b, c, w in sim.history_layout.describe()
+    ]:
         raise _mismatch(
-            "the contact history width (rolling model, thermal.conductance_force_tolerance)",
-            int(s["history_width"]),
-            sim.pairs.history_width,
+            "the contact history layout (its blocks [name, first column, width] follow from "
+            "the contact models, thermal.conductance_force_tolerance and the heat generation "
+            "model)",
+            saved_layout,
+            sim.history_layout.describe(),
         )
     saved_rows = np.asarray(state["arrays"]["wall_rows"])
     if saved_rows.shape != sim.wall_rows.shape:

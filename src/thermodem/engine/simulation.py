@@ -58,7 +58,8 @@ from thermodem.kernels.integrate import (
 )
 from thermodem.models import registry
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
-from thermodem.state.heat import HEAT_MECHANISMS
+from thermodem.state.heat import GENERATION, HEAT_MECHANISMS
+from thermodem.state.history import HistoryLayout, layout_for
 from thermodem.state.pairs import PairBuffers
 from thermodem.state.particles import Particles
 
@@ -67,7 +68,32 @@ LEDGER_DISSIPATION = (
     "tangential_damping",
     "sliding_friction",
     "rolling_friction",
+    "plastic_deformation",
 )
+#: ledger columns of the dissipation mechanisms, in the order of LEDGER_DISSIPATION
+_DISSIPATION_COLUMNS = (
+    C.L_NORMAL_DAMPING,
+    C.L_TANGENTIAL_DAMPING,
+    C.L_SLIDING_FRICTION,
+    C.L_ROLLING_FRICTION,
+    C.L_PLASTIC_DEFORMATION,
+)
+
+
+def history_layout_of(case: Case) -> HistoryLayout:
+    """The contact history columns of a case: the registered history widths of its normal,
+    tangential and rolling laws, the conductance reuse's block when
+    ``thermal.conductance_force_tolerance`` > 0, and the collision block of a heat generation
+    model that registers one (state/history.py)."""
+    models = case.contact
+    thermal = case.thermal
+    return layout_for(
+        models.normal.spec.history_width,
+        models.tangential.spec.history_width,
+        models.rolling.spec.history_width,
+        reuse=thermal is not None and thermal.conductance_force_tolerance > 0.0,
+        collision=thermal is not None and thermal.heat_generation.spec.history_width > 0,
+    )
 
 
 class Simulation:
@@ -113,13 +139,8 @@ class Simulation:
         self.normal_table = pair_table(models.normal, case, self.material_names)
         self.tangential_table = pair_table(models.tangential, case, self.material_names)
         self.rolling_table = pair_table(models.rolling, case, self.material_names)
-        rolling_history = models.rolling.spec.history_width > 0
-        history_width = C.HISTORY_WIDTH_ROLLING if rolling_history else C.HISTORY_WIDTH_BASE
-        if case.thermal is not None and case.thermal.conductance_force_tolerance > 0.0:
-            # the conductance reuse's columns, last (kernels find them from the row's end;
-            # the base width plus them stays below the rolling width, which kernels test)
-            history_width += PP.REUSE_COLUMNS
-            assert C.HISTORY_WIDTH_BASE + PP.REUSE_COLUMNS < C.HISTORY_WIDTH_ROLLING
+        #: the columns of the contact history, allocated from the registry (state/history.py)
+        self.history_layout = history_layout_of(case)
         # domain and walls
         dom = case.domain
         self.lower = np.asarray(dom.lower, np.float64)
@@ -138,19 +159,26 @@ class Simulation:
         z1, z3 = np.zeros(0), np.zeros((1, 1, width))
         z2 = np.zeros((1, width))
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
+        zm = np.zeros((1, len(HEAT_MECHANISMS)))
         self._no_heat = (
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, np.zeros((1, 7)), z1, 0.0),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, zm, z1, 0.0),
+            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, zm, z1, 0.0),
         )
         self.thermal = None
         if case.thermal is not None:
             from thermodem.engine.thermal import ThermalEngine
 
             self.thermal = ThermalEngine(self, case.thermal)
+        # heat generation: per-particle accumulators of the dissipated energy (the contact
+        # passes add to them at every step; the thermal step turns them into heat)
+        self.generation = self.thermal is not None and self.thermal.generation.active
+        self._no_generation = (np.zeros((1, 0)), np.zeros(len(GENERATION)), np.zeros((1, 1, 2)))
         # particles
         self.mechanisms = len(HEAT_MECHANISMS) if self.thermal is not None else 0
         # constant external loads (engine/external_loads.py): two more particle arrays
-        self.particles = Particles.empty(self.mechanisms, external=bool(case.external_force))
+        self.particles = Particles.empty(
+            self.mechanisms, external=bool(case.external_force), generation=self.generation
+        )
         self.next_global_id = 0
         self.pourers: list[Pourer] = []
         if insert_particles:
@@ -178,8 +206,8 @@ class Simulation:
         self.extra = float(nb.extra_distance)
         self.skin = nb.skin
         self.rebuild_every_step = nb.rebuild_every_step
-        self.pairs = PairBuffers(1024, history_width)
-        self.walls = PairBuffers(64, history_width)
+        self.pairs = PairBuffers(1024, self.history_layout.width)
+        self.walls = PairBuffers(64, self.history_layout.width)
         self.wall_row_start = np.zeros(1, np.int64)
         self.reference = np.zeros((0, 3))
         self.chunk_check = np.zeros((1, 3))
@@ -190,6 +218,8 @@ class Simulation:
         self._needs_rebuild = True
         # ledger
         ledger_keys = ("stiffness_work", "wall_work", "external_work", "inserted_energy")
+        if self.generation:  # the kinetic energy lost in collisions, the walls' shares
+            ledger_keys += ("collision_energy_loss", *(f"wall_generation_{g}" for g in GENERATION))
         self.ledger_cumulative = dict.fromkeys((*LEDGER_DISSIPATION, *ledger_keys), 0.0)
         self.elastic = np.zeros(3)
         self.max_overlap_ratio = 0.0
@@ -287,6 +317,7 @@ class Simulation:
             mechanisms=self.mechanisms,
             external=bool(self.case.external_force),
             disc_thickness=self.disc_thickness,
+            generation=self.generation,
         )
         EL.assign(self.case, extra, self.material_index)
         if hasattr(self, "ledger_cumulative"):
@@ -319,23 +350,34 @@ class Simulation:
         p = self.particles
         pb, wb = self.pairs, self.walls
         nid, tid, rid = self.model_ids
+        layout = self.history_layout.offsets
         th = self.thermal
         heat_due = (
             th is not None and not th.settings.frozen_mechanics and th.next_step <= self.step_count
         )
+        # conduction evaluated in the contact pass, for the thermal step that follows (not
+        # without a contact conduction model: the pass would add zeros)
+        fused = heat_due and th.contact.active
         if heat_due:
-            # conduction evaluated in the contact pass, for the thermal step that follows
             th.prepare(self.time)
-            pair_pass, wall_pass = PP.passes_for(True, th.radius_id, th.conduction_id, th.override)
+        if fused:
+            pair_pass, wall_pass = PP.passes_for(
+                True, th.radius_id, th.conduction_id, th.override, layout, self.generation
+            )
         else:
             pair_heat, wall_heat = self._no_heat
-            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0)
+            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, self.generation)
+        if self.generation:
+            gen = (True, p.generation_energy, th.generation.select, th.generation.partition)
+        else:
+            gen = (False, *self._no_generation)
         ngroups = pb.ngroups
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
-            pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+            if fused:
+                pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
             # the heat sums start at zero: zeroed here, or already by this step's Euler update
             zero = not (th.rates_cleared and th.conductance_sum.shape[0] == p.count)
             th.rates_cleared = False
@@ -349,15 +391,15 @@ class Simulation:
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, pb.i, pb.j, pb.group_start, pb.history, self.lower, self.upper,
             self.periodic, self.extra, dt, nid, self.normal_table, tid, self.tangential_table,
-            rid, self.rolling_table, p.force, p.torque, pb.dissipation, pb.normal_force,
-            pb.state, pb.ledger_rows(ngroups), *pair_heat,
+            rid, self.rolling_table, p.force, p.torque, pb.normal_force, pb.state,
+            pb.ledger_rows(ngroups), *pair_heat, layout, *gen,
         )  # fmt: skip
         wall_pass(
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
             self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
-            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
-            wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat,
+            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.normal_force,
+            wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout, *gen,
         )  # fmt: skip
         if heat_due:  # the other heat terms of this state (the totals: see step())
             th.after_contact_pass(self.time, self._complete)
@@ -379,12 +421,14 @@ class Simulation:
         )
         if count_dissipation:
             cum = self.ledger_cumulative
-            cum["normal_damping"] += sums[C.L_NORMAL_DAMPING]
-            cum["tangential_damping"] += sums[C.L_TANGENTIAL_DAMPING]
-            cum["sliding_friction"] += sums[C.L_SLIDING_FRICTION]
-            cum["rolling_friction"] += sums[C.L_ROLLING_FRICTION]
+            for name, column in zip(LEDGER_DISSIPATION, _DISSIPATION_COLUMNS, strict=True):
+                cum[name] += sums[column]
             cum["stiffness_work"] += sums[C.L_STIFFNESS_WORK]
             cum["wall_work"] += sums[C.L_WALL_WORK]
+            if self.generation:
+                cum["collision_energy_loss"] += sums[C.L_COLLISION]
+                for g, name in enumerate(GENERATION):
+                    cum[f"wall_generation_{name}"] += sums[C.L_WALL_GENERATION + g]
 
     # -------------------------------------------------------------------------------- step
     def complete_rates(self) -> None:
@@ -541,6 +585,8 @@ class Simulation:
                 if k in LEDGER_DISSIPATION
             }
         )
+        if self.generation:  # kinetic energy lost in collisions (not a term of the balance)
+            out["collision_energy_loss"] = self.ledger_cumulative["collision_energy_loss"]
         out["stiffness_work"] = self.ledger_cumulative["stiffness_work"]
         out["wall_work"] = self.ledger_cumulative["wall_work"]
         out["external_work"] = self.ledger_cumulative.get("external_work", 0.0)

@@ -59,6 +59,62 @@ class ContactConduction:
 
 
 @dataclass
+class Generation:
+    """The heat generation model (``thermal.heat_generation``): the contact passes add each
+    contact's dissipated energy per mechanism to its particles' accumulators, shared by the
+    partition coefficients of ``partition``; the thermal step turns them into heat rates of
+    the ``generation_<mechanism>`` columns (kernels/generation.py)."""
+
+    choice: ModelChoice
+    table: np.ndarray  # [nmat, nmat, width] packed rows (models/thermal/heat_generation.py)
+    partition: np.ndarray  # [nmat, nmat, 2]: body i's share of friction heat, of other heat
+    select: np.ndarray  # (len(GENERATION),) 1.0 for a mechanism the model turns into heat
+    conversion_fraction: float  # χ
+
+    @property
+    def active(self) -> bool:
+        return self.choice.model != "none"
+
+    @property
+    def mechanisms(self) -> list[int]:
+        """Indices (in state/heat.GENERATION) of the selected mechanisms."""
+        return [g for g in range(len(heat.GENERATION)) if self.select[g] != 0.0]
+
+    @property
+    def columns(self) -> list[int]:
+        """The heat-by-mechanism columns it writes."""
+        return [heat.M_GENERATION + g for g in self.mechanisms]
+
+
+def build_generation(
+    case: Case,
+    names: list[str],
+    meets: Callable[[str, str], bool],
+    is_wall: Callable[[str, str], bool],
+) -> Generation:
+    """The heat generation of the case's thermal section (its rows for the materials that
+    meet: particles with particles and with walls of a fixed temperature; an adiabatic wall
+    takes no share, so it needs none)."""
+    from thermodem.models.thermal import heat_generation as HG
+
+    choice = case.thermal.heat_generation
+    spec = choice.spec
+    table = pair_table(choice, case, names, meets=meets, is_wall=is_wall,
+                       key="thermal.heat_generation")  # fmt: skip
+    partition = np.ascontiguousarray(
+        table[:, :, [spec.column("psi_friction"), spec.column("psi_other")]]
+    )
+    # χ and the selection are properties of the model, the same in every packed row: the
+    # row of the first particle material with itself (packed: particles meet each other)
+    row = np.zeros(spec.width)
+    if case.insertion:
+        t = names.index(case.insertion[0].material)
+        row = table[t, t]
+    select = np.array([row[HG.C_SELECT + g] for g in range(len(heat.GENERATION))])
+    return Generation(choice, table, partition, select, float(row[HG.C_CHI]))
+
+
+@dataclass
 class HeatTerm:
     """One selected thermal model evaluated by a heat-only pass (see the module docstring)."""
 

@@ -33,11 +33,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermodem.config.thermal import ThermalSettings
+from thermodem.engine import generation
 from thermodem.engine.external_set import ExternalPairSet
 from thermodem.engine.fields import STATE_PREFIX as FIELDS_PREFIX
 from thermodem.engine.fields import FieldProvider
 from thermodem.engine.range_set import RangePairSet
-from thermodem.engine.terms import HeatTerm, build_terms
+from thermodem.engine.terms import HeatTerm, build_generation, build_terms
 from thermodem.engine.thermal_conditions import ThermalConditions
 from thermodem.engine.voronoi import INPUT_WIDTH, VoronoiProvider
 from thermodem.errors import ConfigError, SimulationError
@@ -51,7 +52,8 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 #: Attributes never saved in checkpoints (objects, back references, derived tables).
-SKIP = ("sim", "settings", "conditions", "contact", "terms", "range_set", "external", "_empty",
+SKIP = ("sim", "settings", "conditions", "contact", "terms", "generation", "range_set",
+        "external", "_empty",
         "_conditions_key", "field_provider", "fields", "voronoi", "external_wall_conductance",
         "external_stamp", "implicit", "record_conductances")  # fmt: skip
 #: Prefixes of the pair sets' state in the engine's checkpoint scalars and arrays.
@@ -85,12 +87,14 @@ class ThermalEngine:
         self.contact, self.terms = build_terms(
             case, names, meets, is_wall, lambda name: name in particle_mats
         )
+        #: heat generation by the mechanical dissipation (thermal.heat_generation)
+        self.generation = build_generation(case, names, meets, is_wall)
         self.radius_id = self.contact.radius_id
         self.conduction_id = self.contact.direct_id
         self.radius_table = self.contact.radius_table
         self.conduction_table = self.contact.direct_table
         # conductance reuse (0: the model is evaluated at every thermal step), see
-        # docs/models/conductance_reuse.md; the pair histories carry REUSE_COLUMNS more columns
+        # docs/models/conductance_reuse.md; the pair histories carry its block (state/history.py)
         self.tolerance = float(settings.conductance_force_tolerance)
         self._property_tables(case, names, particle_mats)
         self.specific_heat_by_type = np.zeros(len(names))
@@ -182,6 +186,8 @@ class ThermalEngine:
             cols |= {t.column, t.wall_column} - {-1}
         if self.conditions.active:
             cols.add(heat.M_SOURCE)
+        if self.generation.active:
+            cols |= set(self.generation.columns)
         return sorted(cols)
 
     def _property_tables(self, case, names: list[str], particle_mats: set[str]) -> None:  # noqa: ANN001
@@ -376,14 +382,15 @@ class ThermalEngine:
                 pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
                 self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
                 self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
-                self.tolerance,
+                sim.history_layout.reuse, self.tolerance,
             )  # fmt: skip
             kernels.conduction_wall_pass(
                 p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
                 wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
                 sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
                 self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w,
-                self.rhoc_w, self.scratch, self.wall_conductance, self.tolerance,
+                self.rhoc_w, self.scratch, self.wall_conductance, sim.history_layout.reuse,
+                self.tolerance,
             )  # fmt: skip
             self.conductance_ready = reuse
         passes.pair_heat_from_conductance(
@@ -463,9 +470,24 @@ class ThermalEngine:
                 )
         return gap, wall_gap
 
+    def thermal_dt(self) -> float:
+        """Length of the thermal step that the rates being evaluated are for [s]."""
+        if self.settings.frozen_mechanics:
+            return float(self.settings.time_step)
+        return self.substeps * self.sim.dt
+
+    def generation_rates(self) -> None:
+        """The heat generation columns from the accumulated dissipated energy
+        (engine/generation.py); the thermal step clears the accumulators after using them."""
+        generation.rates(self)
+
+    def _generation_used(self) -> None:
+        generation.clear(self)
+
     def evaluate_terms(self, time: float) -> None:
         """Add the heat of every term other than the contact conduction (at this state and
-        ``time``; the per-particle fields are filled first)."""
+        ``time``; the per-particle fields are filled first), and the heat generation."""
+        self.generation_rates()
         if not self.terms:
             return
         sim = self.sim
@@ -718,6 +740,7 @@ class ThermalEngine:
         if self.implicit is not None:
             self.implicit.step(dt, time)
             self.thermal_steps += 1
+            self._generation_used()
             return
         sim = self.sim
         p = sim.particles
@@ -780,6 +803,7 @@ class ThermalEngine:
             self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
+        self._generation_used()
         if bad_gid >= 0:
             raise SimulationError(
                 f"temperature of particle {bad_gid} became {bad_temperature:.6g} K at step "
@@ -851,6 +875,8 @@ class ThermalEngine:
                 out[name] = self.cumulative[name]
         out.update({k: v for k, v in self.cumulative.items() if not k.startswith("heat_in_")})
         out["heat_balance_error"] = self.balance_error()
+        if self.generation.active:
+            out.update(generation.ledger(self))
         out["thermal_limit"] = self.limit
         if self.range_set is not None:
             out["range_pair_count"] = self.range_set.count

@@ -61,7 +61,7 @@ ROW_SECONDS = 2.0e-4
 FILE_SECONDS = 3.0e-3
 FILE_SECONDS_PER_PARTICLE = 1.0e-6
 #: Memory model: bytes per particle (state arrays, neighbour index, copies while sorting) and
-#: per listed pair (indices, history, dissipation, normal force, state, and a rebuild's new
+#: per listed pair (indices, history, normal force, state, and a rebuild's new
 #: indices; ×1.25 growth margin), and pairs per particle in a dense bed (3.6 measured in the
 #: benchmark bed, plus near pairs). Measured: ~560 B per particle in that bed.
 BYTES_PER_PARTICLE = 400.0
@@ -124,7 +124,7 @@ def check_completeness(case: Case) -> None:
         for name in meets:
             material = case.materials[name]
             partners = (set(meets) if name in particles else set(particles)) or {name}
-            for prop in spec.requires:
+            for prop in spec.required(choice.params):
                 if getattr(material, prop, None) is None and not given_per_pair(
                     name, prop, partners
                 ):
@@ -304,7 +304,7 @@ def run_time(
 
 def bytes_per_particle(history_width: int = 6, thermal: bool = False) -> float:
     """Estimated memory per particle [B]: its arrays plus its share of the pair lists."""
-    pair_bytes = 1.25 * (8 + 8 * history_width + 16 + 8 + 1 + 9)
+    pair_bytes = 1.25 * (8 + 8 * history_width + 8 + 1 + 9)
     if thermal:
         pair_bytes += 16  # conductance and heat rate (heat-only passes)
     return BYTES_PER_PARTICLE + PAIRS_PER_PARTICLE * pair_bytes
@@ -351,7 +351,9 @@ def check_insertion_memory(case: Case) -> None:
     if not counts:
         return
     total_count = sum(n for _, n, _ in counts)
-    width = 10 if case.contact.rolling.spec.history_width > 0 else 6
+    from thermodem.engine.simulation import history_layout_of
+
+    width = history_layout_of(case).width
     memory = BASELINE_BYTES + total_count * bytes_per_particle(width, case.thermal is not None)
     total, _ = physical_memory()
     if math.isfinite(total) and memory > total:

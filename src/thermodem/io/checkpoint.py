@@ -47,7 +47,9 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 FORMAT = "thermodem-checkpoint"
-FORMAT_VERSION = 2  # 2: pair lists with slab groups, no per-pair force rows
+FORMAT_VERSION = 3  # 2: pair lists with slab groups, no per-pair force rows; 3: the contact
+# history laid out from the registry (state/history.py), its layout among the scalars; no
+# per-pair dissipation rows; the particles' heat generation accumulators
 KINDS = ("checkpoint", "interrupted", "final", "failed")
 _NAME = re.compile(r"^checkpoint_(\d+)\.h5$")
 

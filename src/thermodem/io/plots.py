@@ -8,7 +8,10 @@
 - ``contacts.png``: contact and particle counts, and the largest overlap ratio;
 - ``temperature.png`` (when the run has ``temperature_*`` columns): mean, min and max;
 - ``heat.png`` (when it has ``heat_rate_*`` or ``heat_*`` columns): heat rate by mechanism
-  and the cumulative heat ledger.
+  and the cumulative heat ledger;
+- ``generation.png`` (with a heat generation model): the heat rate generated per mechanism
+  and, below, per mechanism the heat generated (χ × dissipated), into the particles and to
+  the walls, and the generation balance error.
 
 Columns are picked by name, so new columns reported by the engine appear without changes here
 as long as they follow the prefixes.
@@ -112,4 +115,18 @@ def plot_directory(
             _plot(axes[k], t, data, ledger, "cumulative heat [J]")
         fig.suptitle(f"heat: {directory.name}")
         save(fig, "heat.png")
+
+    # heat generation by mechanism
+    gen_rates = [k for k in data if k.startswith("heat_rate_generation_")]
+    if gen_rates:
+        fig, (ax1, ax2) = _figure(2)
+        _plot(ax1, t, data, gen_rates, "generated heat rate [W]")
+        cumulative = [
+            k
+            for k in data
+            if k.startswith(("generated_", "heat_in_generation_", "heat_to_walls_generation_"))
+        ]
+        _plot(ax2, t, data, [*cumulative, "generation_balance_error"], "cumulative [J]")
+        fig.suptitle(f"heat generation: {directory.name}")
+        save(fig, "generation.png")
     return written

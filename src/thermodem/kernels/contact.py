@@ -2,8 +2,9 @@
 
 :func:`contact_response` evaluates one touching contact, :func:`_open_contact` clears one that
 does not touch; the parallel passes that call them for every listed pair are in
-:mod:`thermodem.kernels.pair_pass`. This module also holds the column layouts of the contact
-history, the per-chunk ledger and the per-pair dissipation, and the pair states.
+:mod:`thermodem.kernels.pair_pass`. This module also holds the column layout of the per-chunk
+ledger, the pair states, and the deposit of a contact's dissipated energy into its particles'
+heat generation accumulators (:func:`deposit_pair`, :func:`deposit_wall`).
 
 Sign conventions: n is the unit vector from i to j; the relative velocity of i with respect to j
 at the contact point is v_rel = (v_i + ω_i × R_i n) - (v_j - ω_j × R_j n); the overlap rate is
@@ -23,18 +24,22 @@ from thermodem.models.mechanics.dispatch import (
     rolling_dispatch,
     tangential_dispatch,
 )
+from thermodem.state import history as history_layout
+from thermodem.state.heat import (
+    G_NORMAL_DAMPING,
+    G_PLASTIC_DEFORMATION,
+    G_ROLLING_FRICTION,
+    G_SLIDING_FRICTION,
+    G_TANGENTIAL_DAMPING,
+    GENERATION,
+)
 
 CHUNK = 2048  # pairs per chunk of the heat-only pair passes
 
-# History columns of a contact (particle-particle or particle-wall).
-H_SPRING = 0  # 0:3 tangential spring displacement [m]
-H_SPRING_ENERGY = 3  # elastic energy of the tangential spring at the end of the last step [J]
-H_DURATION = 4  # time in contact [s]; 0 when not touching (first touching step counts dt)
-H_IMPACT_VELOCITY = 5  # normal approach speed at first contact [m/s]
-H_ROLL = 6  # 6:9 elastic rolling torque [N m] (only with a rolling spring model)
-H_ROLL_ENERGY = 9  # elastic energy of the rolling spring [J]
-HISTORY_WIDTH_BASE = 6
-HISTORY_WIDTH_ROLLING = 10
+# History columns: allocated per simulation from the registry (state/history.py); the
+# kernels take the offsets of the blocks (-1: absent). The contact's own columns are first.
+H_DURATION = history_layout.DURATION  # time in contact [s]; 0 when not touching
+H_IMPACT_VELOCITY = history_layout.IMPACT_VELOCITY  # normal approach speed at first contact
 
 # Ledger columns written per chunk.
 L_ELASTIC_NORMAL = 0
@@ -44,17 +49,16 @@ L_NORMAL_DAMPING = 3
 L_TANGENTIAL_DAMPING = 4
 L_SLIDING_FRICTION = 5
 L_ROLLING_FRICTION = 6
-L_STIFFNESS_WORK = 7
-L_WALL_WORK = 8
-L_MAX_OVERLAP_RATIO = 9
-L_TOUCHING = 10
-LEDGER_WIDTH = 11
-
-# Per-pair dissipated power columns.
-D_NORMAL_DAMPING = 0
-D_TANGENTIAL_DAMPING = 1
-D_SLIDING_FRICTION = 2
-D_ROLLING_FRICTION = 3
+L_PLASTIC_DEFORMATION = 7
+L_STIFFNESS_WORK = 8
+L_WALL_WORK = 9
+L_MAX_OVERLAP_RATIO = 10
+L_TOUCHING = 11
+#: kinetic energy lost by the pairs whose collision ended (heat generation of Al-Arkawazi 2017)
+L_COLLISION = 12
+#: the walls' share of the generated heat's energy, per mechanism of state/heat.GENERATION
+L_WALL_GENERATION = 13
+LEDGER_WIDTH = L_WALL_GENERATION + len(GENERATION)
 
 STATE_FAR = 0
 STATE_NEAR = 1
@@ -106,27 +110,40 @@ def contact_response(
     p_tangential,
     rolling_id,
     p_rolling,
-    out_diss,
+    h_normal,
+    h_spring,
+    h_roll,
     out_normal_force,
     ledger_row,
 ):
     """Forces of one touching contact (row k of the pair or wall-pair arrays).
 
-    Returns (F_n, F_t (3), rolling torque on i (3)); the force on i is -F_n n + F_t and the
-    torque on i is R_i n x F_t plus the rolling torque. Writes the dissipated power per
-    mechanism (out_diss[k]) and the normal force, updates the history row and adds energies to
-    the ledger row.
+    Returns (F_n, F_t (3), rolling torque on i (3), and the energies dissipated in this step
+    by normal damping, tangential damping, sliding friction, rolling friction and plastic
+    deformation [J]); the force on i is -F_n n + F_t and the torque on i is R_i n x F_t plus
+    the rolling torque. Writes the normal force, updates the history row and adds energies to
+    the ledger row. ``h_normal``, ``h_spring``, ``h_roll``: first history column of the normal
+    law's value, the tangential spring (its energy follows the 3-vector) and the rolling
+    torque, -1 when the selected law keeps none (state/history.py).
     """
     rate = vrx * nx + vry * ny + vrz * nz
-    f_el, f_damp, k_ref, gamma_n, u_n = normal_dispatch(
-        normal_id, p_normal, overlap, rate, eff_radius, eff_mass
+    h0 = history[k, h_normal] if h_normal >= 0 else 0.0
+    f_el, f_damp, k_ref, gamma_n, u_n, h0, e_plastic = normal_dispatch(
+        normal_id, p_normal, overlap, rate, eff_radius, eff_mass, h0
     )
+    if h_normal >= 0:
+        history[k, h_normal] = h0
     f_n = f_el + f_damp
     # tangential relative velocity
     vtx = vrx - rate * nx
     vty = vry - rate * ny
     vtz = vrz - rate * nz
-    sx, sy, sz = _rotate_into_plane(history, k, H_SPRING, nx, ny, nz)
+    if h_spring >= 0:
+        sx, sy, sz = _rotate_into_plane(history, k, h_spring, nx, ny, nz)
+    else:
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
     ftx, fty, ftz, sx, sy, sz, k_t, e_tdamp, e_slip = tangential_dispatch(
         tangential_id,
         p_tangential,
@@ -143,21 +160,17 @@ def contact_response(
         sz,
         dt,
     )
-    u_t_rotated = (
-        0.5
-        * k_t
-        * (
-            history[k, H_SPRING] ** 2
-            + history[k, H_SPRING + 1] ** 2
-            + history[k, H_SPRING + 2] ** 2
-        )
-    )
-    stiffness_work = u_t_rotated - history[k, H_SPRING_ENERGY]
-    u_t = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
-    history[k, H_SPRING] = sx
-    history[k, H_SPRING + 1] = sy
-    history[k, H_SPRING + 2] = sz
-    history[k, H_SPRING_ENERGY] = u_t
+    stiffness_work = 0.0
+    u_t = 0.0
+    if h_spring >= 0:
+        old_s2 = history[k, h_spring] ** 2 + history[k, h_spring + 1] ** 2
+        old_s2 += history[k, h_spring + 2] ** 2
+        stiffness_work = 0.5 * k_t * old_s2 - history[k, h_spring + 3]
+        u_t = 0.5 * k_t * (sx * sx + sy * sy + sz * sz)
+        history[k, h_spring] = sx
+        history[k, h_spring + 1] = sy
+        history[k, h_spring + 2] = sz
+        history[k, h_spring + 3] = u_t
     if history[k, H_DURATION] == 0.0:
         history[k, H_IMPACT_VELOCITY] = rate
     history[k, H_DURATION] += dt
@@ -166,9 +179,8 @@ def contact_response(
     wrx -= wn * nx
     wry -= wn * ny
     wrz -= wn * nz
-    has_roll_history = history.shape[1] >= HISTORY_WIDTH_ROLLING
-    if has_roll_history:
-        mx, my, mz = _rotate_into_plane(history, k, H_ROLL, nx, ny, nz)
+    if h_roll >= 0:
+        mx, my, mz = _rotate_into_plane(history, k, h_roll, nx, ny, nz)
     else:
         mx = 0.0
         my = 0.0
@@ -189,51 +201,122 @@ def contact_response(
         dt,
     )
     u_r = 0.0
-    if has_roll_history:
+    if h_roll >= 0:
         if k_r > 0.0:
-            old_m2 = history[k, H_ROLL] ** 2 + history[k, H_ROLL + 1] ** 2
-            old_m2 += history[k, H_ROLL + 2] ** 2
-            stiffness_work += 0.5 * old_m2 / k_r - history[k, H_ROLL_ENERGY]
+            old_m2 = history[k, h_roll] ** 2 + history[k, h_roll + 1] ** 2
+            old_m2 += history[k, h_roll + 2] ** 2
+            stiffness_work += 0.5 * old_m2 / k_r - history[k, h_roll + 3]
             u_r = 0.5 * (mx * mx + my * my + mz * mz) / k_r
-        history[k, H_ROLL] = mx
-        history[k, H_ROLL + 1] = my
-        history[k, H_ROLL + 2] = mz
-        history[k, H_ROLL_ENERGY] = u_r
-    p_ndamp = f_damp * rate
-    out_diss[k, D_NORMAL_DAMPING] = p_ndamp
-    inv_dt = 1.0 / dt if dt > 0.0 else 0.0
-    out_diss[k, D_TANGENTIAL_DAMPING] = e_tdamp * inv_dt
-    out_diss[k, D_SLIDING_FRICTION] = e_slip * inv_dt
-    out_diss[k, D_ROLLING_FRICTION] = e_roll * inv_dt
+        history[k, h_roll] = mx
+        history[k, h_roll + 1] = my
+        history[k, h_roll + 2] = mz
+        history[k, h_roll + 3] = u_r
+    e_ndamp = f_damp * rate * dt
     out_normal_force[k] = f_n
     ledger_row[L_ELASTIC_NORMAL] += u_n
     ledger_row[L_ELASTIC_TANGENTIAL] += u_t
     ledger_row[L_ELASTIC_ROLLING] += u_r
-    ledger_row[L_NORMAL_DAMPING] += p_ndamp * dt
+    ledger_row[L_NORMAL_DAMPING] += e_ndamp
     ledger_row[L_TANGENTIAL_DAMPING] += e_tdamp
     ledger_row[L_SLIDING_FRICTION] += e_slip
     ledger_row[L_ROLLING_FRICTION] += e_roll
+    ledger_row[L_PLASTIC_DEFORMATION] += e_plastic
     ledger_row[L_STIFFNESS_WORK] += stiffness_work
     ledger_row[L_TOUCHING] += 1.0
-    return f_n, ftx, fty, ftz, tx, ty, tz
+    return f_n, ftx, fty, ftz, tx, ty, tz, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _open_contact(k, history, out_diss, out_normal_force, out_state, ledger_row):
+def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, ledger_row):
     """Outputs of a pair that does not touch; a contact that just opened is cleared.
 
-    The energy left in its springs when a contact opens is counted as friction (documented).
-    A pair that did not touch at the previous pass already has zero outputs and history: no
-    writes (a rebuild marks every pair STATE_UNSET, so the outputs of a new list are written).
+    The energy left in its springs when a contact opens is counted as friction (documented);
+    returns it, (sliding, rolling) [J], for the heat generation. A pair that did not touch at
+    the previous pass already has zero outputs and history: no writes (a rebuild marks every
+    pair STATE_UNSET, so the outputs of a new list are written).
     """
     if out_state[k] == STATE_NEAR or out_state[k] == STATE_FAR:
-        return
+        return 0.0, 0.0
+    e_spring = 0.0
+    e_roll = 0.0
     if history[k, H_DURATION] != 0.0:
-        ledger_row[L_SLIDING_FRICTION] += history[k, H_SPRING_ENERGY]
-        if history.shape[1] >= HISTORY_WIDTH_ROLLING:
-            ledger_row[L_ROLLING_FRICTION] += history[k, H_ROLL_ENERGY]
+        if h_spring >= 0:
+            e_spring = history[k, h_spring + 3]
+            ledger_row[L_SLIDING_FRICTION] += e_spring
+        if h_roll >= 0:
+            e_roll = history[k, h_roll + 3]
+            ledger_row[L_ROLLING_FRICTION] += e_roll
         for c in range(history.shape[1]):
             history[k, c] = 0.0
-    for c in range(out_diss.shape[1]):
-        out_diss[k, c] = 0.0
     out_normal_force[k] = 0.0
+    return e_spring, e_roll
+
+
+# ------------------------------------------------------------------- heat generation deposits
+@njit(cache=True, inline="always", error_model="numpy")
+def _deposit(energy, i, j, g, e, psi):
+    share = psi * e
+    energy[i, g] += share
+    energy[j, g] += e - share
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def deposit_pair(
+    energy, i, j, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
+):
+    """Add a particle pair's dissipated energies of one step [J] to the two particles'
+    accumulators of the selected mechanisms (``select[g]`` != 0): ψ e to i, the rest to j
+    (``psi_*``: i's share of the friction heat and of the other heat, the heat generation
+    row's partition; models/thermal/heat_generation.py)."""
+    if select[G_SLIDING_FRICTION] != 0.0:
+        _deposit(energy, i, j, G_SLIDING_FRICTION, e_slip, psi_friction)
+    if select[G_ROLLING_FRICTION] != 0.0:
+        _deposit(energy, i, j, G_ROLLING_FRICTION, e_roll, psi_friction)
+    if select[G_NORMAL_DAMPING] != 0.0:
+        _deposit(energy, i, j, G_NORMAL_DAMPING, e_ndamp, psi_other)
+    if select[G_TANGENTIAL_DAMPING] != 0.0:
+        _deposit(energy, i, j, G_TANGENTIAL_DAMPING, e_tdamp, psi_other)
+    if select[G_PLASTIC_DEFORMATION] != 0.0:
+        _deposit(energy, i, j, G_PLASTIC_DEFORMATION, e_plastic, psi_other)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _deposit_wall(energy, i, g, e, psi, ledger_row):
+    share = psi * e
+    energy[i, g] += share
+    ledger_row[L_WALL_GENERATION + g] += e - share
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def deposit_wall(
+    energy, i, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic,
+    ledger_row,
+):  # fmt: skip
+    """The same for a particle-wall pair: the particle's share into its accumulators, the
+    wall's share into the ledger row (``psi_*`` = 1 for an adiabatic wall)."""
+    if select[G_SLIDING_FRICTION] != 0.0:
+        _deposit_wall(energy, i, G_SLIDING_FRICTION, e_slip, psi_friction, ledger_row)
+    if select[G_ROLLING_FRICTION] != 0.0:
+        _deposit_wall(energy, i, G_ROLLING_FRICTION, e_roll, psi_friction, ledger_row)
+    if select[G_NORMAL_DAMPING] != 0.0:
+        _deposit_wall(energy, i, G_NORMAL_DAMPING, e_ndamp, psi_other, ledger_row)
+    if select[G_TANGENTIAL_DAMPING] != 0.0:
+        _deposit_wall(energy, i, G_TANGENTIAL_DAMPING, e_tdamp, psi_other, ledger_row)
+    if select[G_PLASTIC_DEFORMATION] != 0.0:
+        _deposit_wall(energy, i, G_PLASTIC_DEFORMATION, e_plastic, psi_other, ledger_row)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def kinetic_energy(velocity, angular_velocity, mass, inertia, i):
+    """½ m |v|² + ½ I |ω|² of particle i [J]."""
+    v2 = velocity[i, 0] ** 2 + velocity[i, 1] ** 2 + velocity[i, 2] ** 2
+    w2 = angular_velocity[i, 0] ** 2 + angular_velocity[i, 1] ** 2
+    w2 += angular_velocity[i, 2] ** 2
+    return 0.5 * (mass[i] * v2 + inertia[i] * w2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def collision_loss(history, k, h_collision, kinetic_now):
+    """Kinetic energy the pair of row k lost since its collision started (the value kept at
+    the first touching pass), clipped at 0 (Al-Arkawazi 2017, ΔU; documented)."""
+    return max(history[k, h_collision] - kinetic_now, 0.0)

@@ -9,7 +9,8 @@ The particle pass runs over the slab groups of the list (:mod:`thermodem.kernels
 even groups in parallel, then the odd ones. Each pair adds its force and torque (and, when
 heat is due, its heat rate and conductance) straight into the arrays of its two particles,
 which no other group of the same parity touches, and writes its own per-pair rows
-(dissipated power per mechanism, normal force, state); each group writes its own ledger row.
+(normal force, state; with heat generation the dissipated energy per mechanism goes into the
+two particles' accumulators); each group writes its own ledger row.
 The wall pass runs over fixed chunks of particles and their wall pairs. Nothing is accumulated
 with atomics and every particle receives its contributions in an order fixed by the list, so
 the results do not depend on the number of threads.
@@ -18,8 +19,6 @@ Sign conventions: see :mod:`thermodem.kernels.contact`.
 """
 
 from __future__ import annotations
-
-import math
 
 from numba import njit, prange
 
@@ -31,164 +30,76 @@ from thermodem.geometry.wall_layout import (
     COL_THERMAL_KIND,
     COL_VELOCITY,
 )
-from thermodem.kernels.conduction import pair_conductance
 from thermodem.kernels.contact import (
     H_DURATION,
-    H_IMPACT_VELOCITY,
+    L_COLLISION,
     L_MAX_OVERLAP_RATIO,
+    L_WALL_GENERATION,
     L_WALL_WORK,
     STATE_FAR,
     STATE_NEAR,
     STATE_TOUCHING,
     _open_contact,
+    collision_loss,
     contact_response,
+    deposit_pair,
+    deposit_wall,
+    kinetic_energy,
 )
+from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
-from thermodem.models import registry
-from thermodem.state.heat import M_DIRECT, M_WALL_DIRECT
+from thermodem.state import history as HL
+from thermodem.state.heat import G_COLLISION, M_DIRECT, M_WALL_DIRECT
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
 
 
-#: history columns of the conductance reuse (last in the row, present only when
-#: thermal.conductance_force_tolerance > 0): reference normal force (negative: no slope yet),
-#: conductance there, slope dH/dF_n of the secant through the last two evaluations
-REUSE_COLUMNS = 3
+_PASSES: dict[tuple, tuple] = {}
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _reused_conductance(k, history, f_n, tolerance):
-    """(H, True) from the stored evaluations of pair k when its normal force f_n > 0 is close
-    to the last evaluated one, else (0, False): the conductance reuse of
-    ``thermal.conductance_force_tolerance`` (docs/models/conductance_reuse.md).
+def passes_for(
+    heat_on: bool,
+    radius_id: int,
+    conduction_id: int,
+    override: int,
+    layout: tuple[int, ...],
+    generation: bool = False,
+) -> tuple:
+    """(particle pair pass, wall pair pass) for one model combination and history layout.
 
-    With a slope: H = H_ref + S (f_n - F_ref) while |f_n - F_ref| <= tol F_ref. Without one
-    (a single evaluation so far, or a jump): H = H_ref while |f_n - F_ref| <= tol² F_ref.
-    """
-    col = history.shape[1] - REUSE_COLUMNS
-    f_ref = history[k, col]
-    df = f_n - abs(f_ref)
-    if f_ref > 0.0:
-        if abs(df) <= tolerance * f_ref:
-            return history[k, col + 1] + history[k, col + 2] * df, True
-    elif f_ref < 0.0 and abs(df) <= -tolerance * tolerance * f_ref:
-        return history[k, col + 1], True
-    return 0.0, False
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _store_evaluation(k, history, f_n, h, tolerance):
-    """Keep the evaluation (f_n, H) of pair k, with the secant slope from the previous one when
-    the two forces are within 2 tol f_n of each other (else: no slope)."""
-    col = history.shape[1] - REUSE_COLUMNS
-    f_ref = abs(history[k, col])
-    df = f_n - f_ref
-    if f_ref > 0.0 and df != 0.0 and abs(df) <= 2.0 * tolerance * f_n:
-        history[k, col + 2] = (h - history[k, col + 1]) / df
-        history[k, col] = f_n
-    else:
-        history[k, col + 2] = 0.0
-        history[k, col] = -f_n
-    history[k, col + 1] = h
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _conductance(
-    k, history, tolerance, ri, rj, dist, overlap, eff_mass, f_n, radius_id, p_radius,
-    conduction_id, p_conduction, override, ki, kj, ci, cj, srow,
-):  # fmt: skip
-    """:func:`pair_conductance` of pair k, or its reuse (``tolerance`` > 0, touching pairs)."""
-    reuse = tolerance > 0.0 and f_n > 0.0
-    if reuse:
-        h, found = _reused_conductance(k, history, f_n, tolerance)
-        if found:
-            return h
-    h = pair_conductance(
-        ri, rj, dist, overlap, eff_mass, f_n, history[k, H_DURATION],
-        history[k, H_IMPACT_VELOCITY], radius_id, p_radius, conduction_id, p_conduction,
-        override, ki, kj, ci, cj, srow,
-    )  # fmt: skip
-    if reuse:
-        _store_evaluation(k, history, f_n, h, tolerance)
-    return h
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _pp_conductance(
-    k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history, normal_force, radius_id,
-    radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, srow,
-    tolerance,
-):  # fmt: skip
-    ti = type_id[i]
-    tj = type_id[j]
-    ki = kj = ci = cj = 0.0
-    if override > 0:
-        ki = k_particle[i]
-        kj = k_particle[j]
-        if override > 1:
-            ci = rhoc_particle[i]
-            cj = rhoc_particle[j]
-    return _conductance(
-        k, history, tolerance, ri, rj, dist, overlap, eff_mass, normal_force[k], radius_id,
-        radius_table[ti, tj], conduction_id, conduction_table[ti, tj], override, ki, kj, ci,
-        cj, srow,
-    )  # fmt: skip
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _pw_conductance(
-    k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force, radius_id,
-    radius_table, conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall,
-    rhoc_wall, srow, tolerance,
-):  # fmt: skip
-    ti = type_id[i]
-    tw = wall_material[w]
-    ki = kw = ci = cw = 0.0
-    if override > 0:
-        ki = k_particle[i]
-        kw = k_wall[w]
-        if override > 1:
-            ci = rhoc_particle[i]
-            cw = rhoc_wall[w]
-    return _conductance(
-        k, history, tolerance, ri, math.inf, d, overlap, mass[i], normal_force[k], radius_id,
-        radius_table[ti, tw], conduction_id, conduction_table[ti, tw], override, ki, kw, ci,
-        cw, srow,
-    )  # fmt: skip
-
-
-def reusable(conduction_id: int) -> bool:
-    """Whether the direct-conduction model of this id allows the conductance reuse."""
-    specs = [m for m in registry.all_models() if m.family == "direct_conduction"]
-    return any(m.model_id == conduction_id and m.conductance_from_force for m in specs)
-
-
-_PASSES: dict[tuple[bool, int, int, int], tuple] = {}
-
-
-def passes_for(heat_on: bool, radius_id: int, conduction_id: int, override: int) -> tuple:
-    """(particle pair pass, wall pair pass) for one model combination.
-
-    The heat switch, the contact radius and direct conduction model ids and the k(T)/ρc(T)
-    override are compile-time constants of the particle pair pass, so the compiler drops the
-    code of every other model: the generic loop with the model switches inside costs the
-    simple conduction models ~20 ns per particle more (docs/architecture.md, "Cost of the
-    generic model switch"). Its arguments keep their order and types; the model arguments
-    passed in are ignored. Each combination in use compiles once (~7 s on a 2-core machine)
-    and is then cached on disk (Numba keys closures on their constants) and in this process.
-    The wall pass, a few percent of the time, is one generic kernel for all combinations.
+    The heat switch, the contact radius and direct conduction model ids, the k(T)/ρc(T)
+    override, the history offsets ``layout`` (``HistoryLayout.offsets``: normal, spring,
+    roll, collision, reuse; -1 for an absent block; state/history.py) and the heat generation
+    switch are compile-time constants of the particle pair pass, so the compiler drops the
+    code of every other model, of absent history blocks and, without heat generation, of the
+    deposits into the generation accumulators: the generic loop with the model switches
+    inside costs the simple conduction models ~20 ns per particle more (docs/architecture.md,
+    "Cost of the generic model switch"). Its arguments keep their order and types; the model,
+    layout and generation arguments passed in are ignored. Each combination in use compiles
+    once (~7 s on a 2-core machine) and is then cached on disk (Numba keys closures on their
+    constants) and in this process. The wall pass, a few percent of the time, is one generic
+    kernel for all model combinations (the offsets are its arguments), compiled with or
+    without the generation deposits (:func:`wall_pass_for`).
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
         key = (False, 0, 0, 0)
+    key = (*key, tuple(int(c) for c in layout), bool(generation))
     if key not in _PASSES:
-        _PASSES[key] = (_compile_pair_pass(*key), wall_pair_pass)
+        _PASSES[key] = (_compile_pair_pass(*key), wall_pass_for(key[-1]))
     return _PASSES[key]
 
 
-def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
+def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int,  # noqa: N803
+                       LAYOUT: tuple[int, ...], GENERATION: bool):  # noqa: ANN202, N803  # fmt: skip
     """Define the particle pair pass with the model choice captured as constants."""
     REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
+    H_NORMAL = LAYOUT[HL.NORMAL]  # noqa: N806
+    H_SPRING = LAYOUT[HL.SPRING]  # noqa: N806
+    H_ROLL = LAYOUT[HL.ROLL]  # noqa: N806
+    H_COLLISION = LAYOUT[HL.COLLISION] if GENERATION else -1  # noqa: N806
+    H_REUSE = LAYOUT[HL.REUSE]  # noqa: N806
+    REUSABLE = REUSABLE and H_REUSE >= 0  # noqa: N806
 
     @njit(cache=True, parallel=True, error_model="numpy")
     def particle_pair_pass(
@@ -216,7 +127,6 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         rolling_table,
         force,
         torque,
-        out_diss,
         out_normal_force,
         out_state,
         chunk_ledger,
@@ -233,9 +143,20 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         by_mechanism,
         conductance_sum,
         tolerance,
+        layout,
+        generation,
+        gen_energy,
+        gen_select,
+        gen_partition,
     ):
         """Contact forces of every listed particle pair, added to ``force`` and ``torque``
         (see module docstring; the caller sets them to their non-contact values first).
+
+        With heat generation (the ``generation`` constant of :func:`passes_for`) each contact
+        adds the energy it dissipates in this step, per mechanism selected by
+        ``gen_select``, to the accumulators ``gen_energy`` of its two particles, shared by
+        ``gen_partition[type_i, type_j]`` (i's share of friction and other heat), and a
+        collision that ends adds the kinetic energy the pair lost (with a collision block).
 
         With ``heat_on`` the same pass evaluates the conduction of every touching pair (see
         :func:`thermodem.kernels.conduction.pair_conductance`) with the temperatures of this
@@ -267,7 +188,28 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     overlap = ri + rj - dist
                     eff_mass = 0.0
                     if overlap <= 0.0 or dist == 0.0:
-                        _open_contact(k, history, out_diss, out_normal_force, out_state, row)
+                        if GENERATION and H_COLLISION >= 0 and history[k, H_DURATION] != 0.0:
+                            # a collision ends: the kinetic energy the pair lost
+                            lost = collision_loss(
+                                history, k, H_COLLISION,
+                                kinetic_energy(velocity, angular_velocity, mass, inertia, i)
+                                + kinetic_energy(velocity, angular_velocity, mass, inertia, j),
+                            )  # fmt: skip
+                            row[L_COLLISION] += lost
+                            if gen_select[G_COLLISION] != 0.0:
+                                share = gen_partition[type_id[i], type_id[j], 1] * lost
+                                gen_energy[i, G_COLLISION] += share
+                                gen_energy[j, G_COLLISION] += lost - share
+                        e_spring, e_rspring = _open_contact(
+                            k, history, H_SPRING, H_ROLL, out_normal_force, out_state, row
+                        )
+                        if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
+                            ti = type_id[i]
+                            tj = type_id[j]
+                            deposit_pair(
+                                gen_energy, i, j, gen_select, gen_partition[ti, tj, 0],
+                                gen_partition[ti, tj, 1], 0.0, 0.0, e_spring, e_rspring, 0.0,
+                            )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                     else:
                         out_state[k] = STATE_TOUCHING
@@ -296,7 +238,25 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             rolling_inertia = ii * ij / (ii + ij)
                         ti = type_id[i]
                         tj = type_id[j]
-                        f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
+                        if GENERATION and H_COLLISION >= 0 and history[k, H_DURATION] == 0.0:
+                            # a collision starts: the pair's kinetic energy now
+                            history[k, H_COLLISION] = kinetic_energy(
+                                velocity, angular_velocity, mass, inertia, i
+                            ) + kinetic_energy(velocity, angular_velocity, mass, inertia, j)
+                        (
+                            f_n,
+                            ftx,
+                            fty,
+                            ftz,
+                            tx,
+                            ty,
+                            tz,
+                            e_ndamp,
+                            e_tdamp,
+                            e_slip,
+                            e_roll,
+                            e_plastic,
+                        ) = contact_response(
                             k,
                             history,
                             nx,
@@ -319,10 +279,18 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             tangential_table[ti, tj],
                             rolling_id,
                             rolling_table[ti, tj],
-                            out_diss,
+                            H_NORMAL,
+                            H_SPRING,
+                            H_ROLL,
                             out_normal_force,
                             row,
                         )
+                        if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
+                            deposit_pair(
+                                gen_energy, i, j, gen_select, gen_partition[ti, tj, 0],
+                                gen_partition[ti, tj, 1], e_ndamp, e_tdamp, e_slip, e_roll,
+                                e_plastic,
+                            )  # fmt: skip
                         # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
                         fx = -f_n * nx + ftx
                         fy = -f_n * ny + fty
@@ -353,7 +321,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
                             conduction_table, override, k_particle, rhoc_particle, srow,
-                            tolerance,
+                            H_REUSE, tolerance,
                         )  # fmt: skip
                         q_ij = h * (temperature[j] - temperature[i])
                         by_mechanism[i, M_DIRECT] += q_ij
@@ -364,156 +332,219 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
     return particle_pair_pass
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def wall_pair_pass(
-    position,
-    velocity,
-    angular_velocity,
-    radius,
-    mass,
-    inertia,
-    type_id,
-    wall_pair_i,
-    wall_pair_w,
-    wall_row_start,
-    history,
-    wall_kind,
-    wall_rows,
-    wall_material,
-    extra,
-    dt,
-    normal_id,
-    normal_table,
-    tangential_id,
-    tangential_table,
-    rolling_id,
-    rolling_table,
-    force,
-    torque,
-    out_diss,
-    out_normal_force,
-    out_state,
-    chunk_ledger,
-    heat_on,
-    temperature,
-    radius_id,
-    radius_table,
-    conduction_id,
-    conduction_table,
-    override,
-    k_particle,
-    rhoc_particle,
-    k_wall,
-    rhoc_wall,
-    scratch,
-    by_mechanism,
-    conductance_sum,
-    tolerance,
-):
-    """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
-    added to ``force`` and ``torque`` after the particle pairs.
+_WALL_PASSES: dict[bool, object] = {}
 
-    Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
-    ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
-    the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
-    """
-    n = radius.shape[0]
-    nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
-    for c in prange(nchunks):
-        srow = scratch[c] if heat_on else scratch[0]  # (one row when heat is off)
-        row = chunk_ledger[c]
-        for q in range(row.shape[0]):
-            row[q] = 0.0
-        first = wall_row_start[c * WALL_CHUNK]
-        for k in range(first, wall_row_start[min(n, (c + 1) * WALL_CHUNK)]):
-            i = wall_pair_i[k]
-            w = wall_pair_w[k]
-            wrow = wall_rows[w]
-            d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
-            ri = radius[i]
-            overlap = ri - d
-            if overlap <= 0.0:
-                _open_contact(k, history, out_diss, out_normal_force, out_state, row)
-                out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
-            else:
-                out_state[k] = STATE_TOUCHING
-                # n from the particle towards the wall
-                nx = -wnx
-                ny = -wny
-                nz = -wnz
-                # wall surface velocity at q: v_w + Ω a × (q - c)
-                om = wrow[COL_OMEGA]
-                ax = wrow[COL_AXIS] * om
-                ay = wrow[COL_AXIS + 1] * om
-                az = wrow[COL_AXIS + 2] * om
-                rx = qx - wrow[COL_POINT]
-                ry = qy - wrow[COL_POINT + 1]
-                rz = qz - wrow[COL_POINT + 2]
-                vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
-                vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
-                vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
-                wix = angular_velocity[i, 0]
-                wiy = angular_velocity[i, 1]
-                wiz = angular_velocity[i, 2]
-                vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
-                vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
-                vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
-                ti = type_id[i]
-                tw = wall_material[w]
-                rolling_inertia = inertia[i] + mass[i] * ri * ri
-                f_n, ftx, fty, ftz, tx, ty, tz = contact_response(
-                    k,
-                    history,
-                    nx,
-                    ny,
-                    nz,
-                    overlap,
-                    ri,
-                    mass[i],
-                    rolling_inertia,
-                    vrx,
-                    vry,
-                    vrz,
-                    wix - ax,
-                    wiy - ay,
-                    wiz - az,
-                    dt,
-                    normal_id,
-                    normal_table[ti, tw],
-                    tangential_id,
-                    tangential_table[ti, tw],
-                    rolling_id,
-                    rolling_table[ti, tw],
-                    out_diss,
-                    out_normal_force,
-                    row,
-                )
-                # work done by the wall on the particle this step
-                fx = -f_n * nx + ftx
-                fy = -f_n * ny + fty
-                fz = -f_n * nz + ftz
-                force[i, 0] += fx
-                force[i, 1] += fy
-                force[i, 2] += fz
-                torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
-                torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
-                torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
-                row[L_WALL_WORK] += (
-                    fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az
-                ) * dt
-                ratio = overlap / ri
-                if ratio > row[L_MAX_OVERLAP_RATIO]:
-                    row[L_MAX_OVERLAP_RATIO] = ratio
-            # conduction from fixed-temperature walls, touching pairs (one call site, as in the
-            # particle pass)
-            if heat_on and out_state[k] == STATE_TOUCHING:
-                h = 0.0
-                if wrow[COL_THERMAL_KIND] != 0.0:
-                    h = _pw_conductance(
-                        k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
-                        out_normal_force, radius_id, radius_table, conduction_id,
-                        conduction_table, override, k_particle, rhoc_particle, k_wall,
-                        rhoc_wall, srow, tolerance,
-                    )  # fmt: skip
-                by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
-                conductance_sum[i] += h
+
+def wall_pass_for(generation: bool):  # noqa: ANN201
+    """The wall pair pass with (or without) the heat generation deposits compiled in (a
+    compile-time constant: a case without heat generation does not compile them)."""
+    key = bool(generation)
+    if key not in _WALL_PASSES:
+        _WALL_PASSES[key] = _compile_wall_pass(key)
+    return _WALL_PASSES[key]
+
+
+def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
+    """Define the wall pair pass with the generation switch captured as a constant."""
+
+    @njit(cache=True, parallel=True, error_model="numpy")
+    def wall_pair_pass(
+        position,
+        velocity,
+        angular_velocity,
+        radius,
+        mass,
+        inertia,
+        type_id,
+        wall_pair_i,
+        wall_pair_w,
+        wall_row_start,
+        history,
+        wall_kind,
+        wall_rows,
+        wall_material,
+        extra,
+        dt,
+        normal_id,
+        normal_table,
+        tangential_id,
+        tangential_table,
+        rolling_id,
+        rolling_table,
+        force,
+        torque,
+        out_normal_force,
+        out_state,
+        chunk_ledger,
+        heat_on,
+        temperature,
+        radius_id,
+        radius_table,
+        conduction_id,
+        conduction_table,
+        override,
+        k_particle,
+        rhoc_particle,
+        k_wall,
+        rhoc_wall,
+        scratch,
+        by_mechanism,
+        conductance_sum,
+        tolerance,
+        layout,
+        generation,
+        gen_energy,
+        gen_select,
+        gen_partition,
+    ):
+        """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
+        added to ``force`` and ``torque`` after the particle pairs.
+
+        Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
+        ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
+        the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
+        ``layout``: the history offsets (see :func:`passes_for`). With ``generation`` the
+        dissipated energies go to the particle's accumulators, its share ``gen_partition[type,
+        wall material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
+        wall's share to the chunk's ledger row.
+        """
+        h_normal = layout[HL.NORMAL]
+        h_spring = layout[HL.SPRING]
+        h_roll = layout[HL.ROLL]
+        h_collision = layout[HL.COLLISION] if GENERATION else -1
+        h_reuse = layout[HL.REUSE]
+        n = radius.shape[0]
+        nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
+        for c in prange(nchunks):
+            srow = scratch[c] if heat_on else scratch[0]  # (one row when heat is off)
+            row = chunk_ledger[c]
+            for q in range(row.shape[0]):
+                row[q] = 0.0
+            first = wall_row_start[c * WALL_CHUNK]
+            for k in range(first, wall_row_start[min(n, (c + 1) * WALL_CHUNK)]):
+                i = wall_pair_i[k]
+                w = wall_pair_w[k]
+                wrow = wall_rows[w]
+                d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
+                ri = radius[i]
+                overlap = ri - d
+                psi_f = psi_o = 1.0  # the particle's share (adiabatic wall: all of it)
+                if GENERATION and wrow[COL_THERMAL_KIND] != 0.0:
+                    psi_f = gen_partition[type_id[i], wall_material[w], 0]
+                    psi_o = gen_partition[type_id[i], wall_material[w], 1]
+                if overlap <= 0.0:
+                    if GENERATION and h_collision >= 0 and history[k, H_DURATION] != 0.0:
+                        lost = collision_loss(
+                            history, k, h_collision,
+                            kinetic_energy(velocity, angular_velocity, mass, inertia, i),
+                        )  # fmt: skip
+                        row[L_COLLISION] += lost
+                        if gen_select[G_COLLISION] != 0.0:
+                            gen_energy[i, G_COLLISION] += psi_o * lost
+                            row[L_WALL_GENERATION + G_COLLISION] += lost - psi_o * lost
+                    e_spring, e_rspring = _open_contact(
+                        k, history, h_spring, h_roll, out_normal_force, out_state, row
+                    )
+                    if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
+                        deposit_wall(
+                            gen_energy, i, gen_select, psi_f, psi_o, 0.0, 0.0, e_spring, e_rspring,
+                            0.0, row,
+                        )  # fmt: skip
+                    out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
+                else:
+                    out_state[k] = STATE_TOUCHING
+                    # n from the particle towards the wall
+                    nx = -wnx
+                    ny = -wny
+                    nz = -wnz
+                    # wall surface velocity at q: v_w + Ω a × (q - c)
+                    om = wrow[COL_OMEGA]
+                    ax = wrow[COL_AXIS] * om
+                    ay = wrow[COL_AXIS + 1] * om
+                    az = wrow[COL_AXIS + 2] * om
+                    rx = qx - wrow[COL_POINT]
+                    ry = qy - wrow[COL_POINT + 1]
+                    rz = qz - wrow[COL_POINT + 2]
+                    vwx = wrow[COL_VELOCITY] + ay * rz - az * ry
+                    vwy = wrow[COL_VELOCITY + 1] + az * rx - ax * rz
+                    vwz = wrow[COL_VELOCITY + 2] + ax * ry - ay * rx
+                    wix = angular_velocity[i, 0]
+                    wiy = angular_velocity[i, 1]
+                    wiz = angular_velocity[i, 2]
+                    vrx = velocity[i, 0] - vwx + (wiy * nz - wiz * ny) * ri
+                    vry = velocity[i, 1] - vwy + (wiz * nx - wix * nz) * ri
+                    vrz = velocity[i, 2] - vwz + (wix * ny - wiy * nx) * ri
+                    ti = type_id[i]
+                    tw = wall_material[w]
+                    rolling_inertia = inertia[i] + mass[i] * ri * ri
+                    if GENERATION and h_collision >= 0 and history[k, H_DURATION] == 0.0:
+                        history[k, h_collision] = kinetic_energy(
+                            velocity, angular_velocity, mass, inertia, i
+                        )
+                    out = contact_response(
+                        k,
+                        history,
+                        nx,
+                        ny,
+                        nz,
+                        overlap,
+                        ri,
+                        mass[i],
+                        rolling_inertia,
+                        vrx,
+                        vry,
+                        vrz,
+                        wix - ax,
+                        wiy - ay,
+                        wiz - az,
+                        dt,
+                        normal_id,
+                        normal_table[ti, tw],
+                        tangential_id,
+                        tangential_table[ti, tw],
+                        rolling_id,
+                        rolling_table[ti, tw],
+                        h_normal,
+                        h_spring,
+                        h_roll,
+                        out_normal_force,
+                        row,
+                    )
+                    (f_n, ftx, fty, ftz, tx, ty, tz, e_ndamp, e_tdamp, e_slip, e_roll,
+                     e_plastic) = out  # fmt: skip
+                    if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
+                        deposit_wall(
+                            gen_energy, i, gen_select, psi_f, psi_o, e_ndamp, e_tdamp, e_slip,
+                            e_roll, e_plastic, row,
+                        )  # fmt: skip
+                    # work done by the wall on the particle this step
+                    fx = -f_n * nx + ftx
+                    fy = -f_n * ny + fty
+                    fz = -f_n * nz + ftz
+                    force[i, 0] += fx
+                    force[i, 1] += fy
+                    force[i, 2] += fz
+                    torque[i, 0] += ri * (ny * ftz - nz * fty) + tx
+                    torque[i, 1] += ri * (nz * ftx - nx * ftz) + ty
+                    torque[i, 2] += ri * (nx * fty - ny * ftx) + tz
+                    row[L_WALL_WORK] += (
+                        fx * vwx + fy * vwy + fz * vwz + tx * ax + ty * ay + tz * az
+                    ) * dt
+                    ratio = overlap / ri
+                    if ratio > row[L_MAX_OVERLAP_RATIO]:
+                        row[L_MAX_OVERLAP_RATIO] = ratio
+                # conduction from fixed-temperature walls, touching pairs (one call site, as in the
+                # particle pass)
+                if heat_on and out_state[k] == STATE_TOUCHING:
+                    h = 0.0
+                    if wrow[COL_THERMAL_KIND] != 0.0:
+                        h = _pw_conductance(
+                            k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
+                            out_normal_force, radius_id, radius_table, conduction_id,
+                            conduction_table, override, k_particle, rhoc_particle, k_wall,
+                            rhoc_wall, srow, h_reuse, tolerance,
+                        )  # fmt: skip
+                    by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    conductance_sum[i] += h
+
+    return wall_pair_pass

@@ -18,8 +18,8 @@ from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_THERMAL_KIND
 from thermodem.kernels.contact import CHUNK, STATE_TOUCHING
+from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
-from thermodem.kernels.pair_pass import _pp_conductance, _pw_conductance, reusable
 from thermodem.state.heat import M_SOURCE
 
 _CONDUCTION_PASSES: dict[tuple[int, int, int], Any] = {}
@@ -44,13 +44,14 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
     def conduction_pair_pass(
         position, radius, mass, temperature, type_id, pair_i, pair_j, npairs, state, normal_force,
         history, lower, upper, periodic, radius_id, radius_table, conduction_id, conduction_table,
-        override, k_particle, rhoc_particle, scratch, out_conductance, tolerance,
+        override, k_particle, rhoc_particle, scratch, out_conductance, reuse_col, tolerance,
     ):  # fmt: skip
         """Conductance of every listed particle pair (0 unless touching).
 
         With ``override`` > 0 the conductivity columns (0, 1) of the model's row are replaced by
         the particles' current k(T), and with ``override`` > 1 also the heat capacity columns
-        (2, 3) by ρ c(T) (temperature-dependent properties).
+        (2, 3) by ρ c(T) (temperature-dependent properties). ``reuse_col``: first history
+        column of the conductance reuse (state/history.py), with ``tolerance`` > 0.
         """
         # the model choice as compile-time constants (see conduction_pair_pass_for)
         radius_id = RADIUS_ID
@@ -76,7 +77,7 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
                     k, i, j, ri, rj, dist, overlap, mass[i] * mass[j] / (mass[i] + mass[j]),
                     type_id, history, normal_force, radius_id,
                     radius_table, conduction_id, conduction_table, override, k_particle,
-                    rhoc_particle, row, tolerance,
+                    rhoc_particle, row, reuse_col, tolerance,
                 )  # fmt: skip
                 out_conductance[k] = h
 
@@ -88,7 +89,7 @@ def conduction_wall_pass(
     position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
     normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
     conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
-    scratch, out_conductance, tolerance,
+    scratch, out_conductance, reuse_col, tolerance,
 ):  # fmt: skip
     """Conductance of touching particle–fixed-temperature-wall pairs (adiabatic walls: 0).
 
@@ -111,7 +112,7 @@ def conduction_wall_pass(
             h = _pw_conductance(
                 k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force,
                 radius_id, radius_table, conduction_id, conduction_table, override, k_particle,
-                rhoc_particle, k_wall, rhoc_wall, row, tolerance,
+                rhoc_particle, k_wall, rhoc_wall, row, reuse_col, tolerance,
             )  # fmt: skip
             out_conductance[k] = h
 

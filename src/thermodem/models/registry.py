@@ -96,6 +96,13 @@ class ModelSpec:
     planar: tuple[str, ...] = ()
     only_2d: bool = False
     range_parameter: str | None = None
+    requires_of: Callable[[BaseModel], tuple[str, ...]] | None = None
+
+    def required(self, params: BaseModel) -> tuple[str, ...]:
+        """Material properties required with these parameter values: ``requires`` and what
+        ``requires_of(params)`` adds (a property that only some options read)."""
+        extra = self.requires_of(params) if self.requires_of is not None else ()
+        return tuple(dict.fromkeys((*self.requires, *extra)))
 
     @property
     def width(self) -> int:
@@ -140,6 +147,7 @@ def register(
     planar: tuple[str, ...] = (),
     only_2d: bool = False,
     range_parameter: str | None = None,
+    requires_of: Callable[[BaseModel], tuple[str, ...]] | None = None,
 ) -> ModelSpec:
     """Register a model; the (family, name) and (family, model_id) pairs must be unique.
 
@@ -158,7 +166,9 @@ def register(
     supports: ``"disc"`` (discs of ``simulation.thickness``: the model has a 2D form, or
     needs none) and/or ``"sphere"`` (spheres kept in the plane: the 3D form is right for
     them); empty: 3D only, refused in 2D before the run (:data:`PLANAR_SHAPES`); ``only_2d``
-    a 2D law (refused in 3D cases).
+    a 2D law (refused in 3D cases).;
+    ``requires_of(params)`` material properties required only with some parameter values (a
+    partition formula's inputs).
     """
     if family not in _REGISTRY:
         raise ValueError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
@@ -206,6 +216,7 @@ def register(
         planar=tuple(planar),
         only_2d=only_2d,
         range_parameter=range_parameter,
+        requires_of=requires_of,
     )
     if range_parameter is not None and range_parameter not in params.model_fields:
         raise ValueError(f"{family}.{name}: range_parameter {range_parameter!r} is no parameter")

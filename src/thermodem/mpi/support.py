@@ -35,6 +35,7 @@ REFUSED: tuple[tuple[str, str], ...] = (
     ("thermal.porosity", "per-particle porosity fields"),
     ("thermal.fluid", "fluid fields"),
     ("thermal.indirect_conduction", "Voronoi (external pair set) and contact-target models"),
+    ("thermal.heat_generation", "heat generation from the mechanical dissipation"),
 )
 
 
@@ -79,6 +80,13 @@ def check_case(case: Case) -> None:
             "contacts": "heat terms on the contact lists outside the fused contact pass",
         }.get(ic.spec.target, f"heat terms on the pair set {ic.spec.target!r}")
         raise _refuse(f"thermal.indirect_conduction = {ic.model!r}", what)
+    hg = getattr(th, "heat_generation", None)
+    if hg is not None and getattr(hg, "model", "none") != "none":
+        raise _refuse(
+            f"thermal.heat_generation = {hg.model!r}",
+            "heat generation (its per-particle accumulators and wall shares are not split by "
+            "rank yet)",
+        )
     if th.porosity is not None:
         raise _refuse("thermal.porosity", "per-particle porosity fields")
     if th.fluid is not None:

@@ -33,6 +33,9 @@ class Material(StrictModel):
     thermal_conductivity: float | None = Field(default=None, gt=0, description="[W/(m K)]")
     specific_heat: float | None = Field(default=None, gt=0, description="[J/(kg K)]")
     emissivity: float | None = Field(default=None, ge=0.0, le=1.0, description="[-]")
+    electrical_resistivity: float | None = Field(
+        default=None, gt=0, description="[Ω m] (heat generation: Mokrani & Bourouga partition)"
+    )
     # Surface properties for the stagnant-gas resistance network (Beaulieu 2020).
     microhardness: float | None = Field(default=None, gt=0, description="[Pa]")
     surface_roughness: float | None = Field(default=None, gt=0, description="RMS roughness [m]")

@@ -4,10 +4,12 @@ The arrays are indexed by pair; ``count`` of them are in use. History rows are c
 neighbour rebuilds by particle identity, in place (see
 :func:`thermodem.kernels.neighbors.move_rows`).
 
-Memory layout (bytes per pair slot, history width W = 6, or 10 with a rolling spring): ``i``,
-``j`` int32 (8), ``history`` float64 (8 W), ``dissipation`` float32 (16), ``normal_force`` (8),
-``state`` int8 (1): 81 B with W = 6. Forces and torques are not stored per pair: the pair
-passes add them straight into the particles' arrays (:mod:`thermodem.kernels.slabs`). The
+Memory layout (bytes per pair slot, history width W from the layout of
+:mod:`thermodem.state.history`: 6 for Hertz–Mindlin, 10 with a rolling spring): ``i``,
+``j`` int32 (8), ``history`` float64 (8 W), ``normal_force`` (8), ``state`` int8 (1): 65 B
+with W = 6. Forces and torques are not stored per pair: the pair passes add them straight into
+the particles' arrays (:mod:`thermodem.kernels.slabs`), and neither is the dissipation (the
+ledger sums it per slab group; heat generation accumulates it per particle). The
 capacity grows to 1.1 x the count a rebuild needed, never shrinks; capacity that is never
 written is not resident.
 
@@ -51,7 +53,6 @@ class PairBuffers:
         if keep and old is not None:
             self.history[:keep] = old[:keep]
         del old
-        self.dissipation = np.zeros((capacity, 4), np.float32)
         self.normal_force = np.zeros(capacity)
         self.state = np.zeros(capacity, np.int8)
 

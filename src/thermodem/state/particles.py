@@ -6,7 +6,9 @@ order changes when the neighbour list sorts particles by cell. ``heat_rate_by_me
 one column per heat transfer mechanism (:data:`thermodem.state.heat.MECHANISMS`).
 ``external_force`` and ``external_torque`` hold the constant loads of the case key
 ``external_force`` (added to the weight at every force reset); without that key they have no
-columns (0 B per particle).
+columns (0 B per particle). ``generation_energy`` accumulates, per mechanism of
+:data:`thermodem.state.heat.GENERATION`, the particle's share of the energy its contacts
+dissipated since the last thermal step (heat generation; no columns without it).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from thermodem.state.heat import HEAT_MECHANISMS  # the columns, defined in state/heat.py
+from thermodem.state.heat import GENERATION, HEAT_MECHANISMS  # defined in state/heat.py
 
 
 def particle_mass(
@@ -47,13 +49,19 @@ class Particles:
     global_id: np.ndarray  # (n,) int64, stable identity
     external_force: np.ndarray  # (n, 3) [N], constant; (n, 0) when the case has none
     external_torque: np.ndarray  # (n, 3) [N m], constant; (n, 0) when the case has none
+    generation_energy: np.ndarray  # (n, len(GENERATION)) [J]; (n, 0) without heat generation
 
     @property
     def count(self) -> int:
         return int(self.radius.shape[0])
 
     @classmethod
-    def empty(cls, mechanisms: int = len(HEAT_MECHANISMS), external: bool = False) -> Particles:
+    def empty(
+        cls,
+        mechanisms: int = len(HEAT_MECHANISMS),
+        external: bool = False,
+        generation: bool = False,
+    ) -> Particles:
         return cls.create(
             np.zeros((0, 3)),
             np.zeros(0),
@@ -62,6 +70,7 @@ class Particles:
             np.zeros(0, np.int64),
             mechanisms=mechanisms,
             external=external,
+            generation=generation,
         )
 
     @classmethod
@@ -77,6 +86,7 @@ class Particles:
         mechanisms: int = len(HEAT_MECHANISMS),
         external: bool = False,
         disc_thickness: float = 0.0,
+        generation: bool = False,
     ) -> Particles:
         """Solid spheres: m = ρ 4/3 π R³, I = 2/5 m R²; with ``disc_thickness`` b > 0 (a 2D
         case of discs) solid discs of that thickness: m = ρ π R² b, I = 1/2 m R² (about the
@@ -85,7 +95,8 @@ class Particles:
         ``mechanisms`` is the number of columns of ``heat_rate_by_mechanism``: all of
         :data:`HEAT_MECHANISMS` with a thermal engine, 0 for mechanics only (64 B/particle less).
         ``external``: the case has external loads (``external_force`` and ``external_torque``
-        get 3 columns, zero until the simulation assigns them).
+        get 3 columns, zero until the simulation assigns them). ``generation``: the case has a
+        heat generation model (``generation_energy`` gets a column per mechanism).
         """
         n = radius.shape[0]
         radius = np.ascontiguousarray(radius, dtype=np.float64)
@@ -110,6 +121,7 @@ class Particles:
             global_id=np.ascontiguousarray(global_id, dtype=np.int64),
             external_force=np.zeros((n, 3 if external else 0)),
             external_torque=np.zeros((n, 3 if external else 0)),
+            generation_energy=np.zeros((n, len(GENERATION) if generation else 0)),
         )
 
     def permute(self, order: np.ndarray) -> None:

@@ -15,15 +15,19 @@ from thermodem.models.mechanics import normal, rolling, tangential
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass):
+def normal_dispatch(model_id, p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap):
     if model_id == normal.HERTZ:
-        return normal.hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+        return normal.hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap)
     if model_id == normal.LINEAR:
-        return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+        return normal.linear_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap)
+    if model_id == normal.WALTON_BRAUN:
+        return normal.walton_braun_force(
+            p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap
+        )
     if model_id == normal.HERTZ_2D:
-        return normal.hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass)
+        return normal.hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap)
     nan = np.nan  # unknown id: NaN forces stop the run at the next check
-    return nan, nan, nan, nan, nan
+    return nan, nan, nan, nan, nan, nan, nan
 
 
 @njit(cache=True, inline="always", error_model="numpy")

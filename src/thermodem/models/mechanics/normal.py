@@ -2,8 +2,9 @@
 
 Kernel signature (all float64)::
 
-    kernel(p, overlap, overlap_rate, eff_radius, eff_mass)
-        -> (force_elastic, force_damping, ref_stiffness, damping_coeff, elastic_energy)
+    kernel(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap)
+        -> (force_elastic, force_damping, ref_stiffness, damping_coeff, elastic_energy,
+            max_overlap, plastic_energy)
 
 ``overlap`` δ > 0 in contact; ``overlap_rate`` dδ/dt > 0 while approaching. Forces are
 positive when repulsive; the damping force is ``damping_coeff * overlap_rate`` so the power it
@@ -11,6 +12,13 @@ dissipates is ``damping_coeff * overlap_rate**2 >= 0``. ``ref_stiffness`` is the
 damping coefficient is scaled with (the tangential laws reuse the same damping ratio).
 The normal force is not clipped at zero: a damped contact may pull briefly before it opens,
 which is what makes the restitution coefficient exact (see the docs page).
+
+``max_overlap`` is the law's history value (the largest overlap of the contact so far, 0 at the
+first touch) for a law that registers ``history_width=1`` (the elasto-plastic law; the others
+return it unchanged and the contact keeps no column for them); the kernel returns its new value
+and the energy dissipated plastically in this step [J] (0 for elastic laws), so that the
+elastic energy plus the plastic dissipation account for the work of the elastic-plastic force
+along the overlap.
 
 The damping family of the architecture is folded into this one: the map from the coefficient of
 restitution to a damping coefficient depends on the elastic law, so each law owns it.
@@ -42,6 +50,9 @@ LINEAR_COLUMNS = ("stiffness", "damping_ratio")
 LINEAR_STIFFNESS, LINEAR_DAMPING_RATIO = 0, 1
 HERTZ_2D_COLUMNS = ("effective_youngs_modulus", "thickness", "damping_ratio")
 HERTZ_2D_E_STAR, HERTZ_2D_THICKNESS, HERTZ_2D_DAMPING_RATIO = 0, 1, 2
+WALTON_BRAUN = 4
+WALTON_BRAUN_COLUMNS = ("loading_stiffness", "restitution_squared")
+WB_LOADING_STIFFNESS, WB_RESTITUTION_SQUARED = 0, 1
 
 
 # ----------------------------------------------------------------------------------- Hertz
@@ -148,7 +159,7 @@ def pack_hertz(params: HertzParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+def hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap):
     e_star = p[HERTZ_E_STAR]
     alpha = p[HERTZ_ALPHA]
     k_hz = 4.0 / 3.0 * e_star * math.sqrt(eff_radius)
@@ -157,7 +168,7 @@ def hertz_force(p, overlap, overlap_rate, eff_radius, eff_mass):
     f_el = secant * overlap
     gamma = alpha * math.sqrt(eff_mass * secant)
     energy = 0.4 * f_el * overlap  # ∫ k δ^{3/2} dδ = (2/5) k δ^{5/2}
-    return f_el, gamma * overlap_rate, secant, gamma, energy
+    return f_el, gamma * overlap_rate, secant, gamma, energy, max_overlap, 0.0
 
 
 # ---------------------------------------------------------------------------------- linear
@@ -190,10 +201,62 @@ def pack_linear(params: LinearParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def linear_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+def linear_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap):
     k = p[LINEAR_STIFFNESS]
     gamma = 2.0 * p[LINEAR_DAMPING_RATIO] * math.sqrt(eff_mass * k)
-    return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
+    u = 0.5 * k * overlap * overlap
+    return k * overlap, gamma * overlap_rate, k, gamma, u, max_overlap, 0.0
+
+
+# ---------------------------------------------------------------------------- Walton–Braun
+class WaltonBraunParams(StrictModel):
+    """Elasto-plastic (hysteretic) linear law of Walton & Braun (1986).
+
+    Loading (the overlap beyond its largest value so far, δ ≥ δ_max): F = k1 δ.
+    Unloading and reloading below δ_max: F = k2 (δ - δ0), δ0 = δ_max (1 - k1/k2), and F = 0
+    for δ ≤ δ0 (the permanent deformation). k2 = k1 / e², so the coefficient of restitution is
+    e = sqrt(k1/k2) for every impact velocity. No viscous damping: the energy a collision loses
+    is the plastic work ½ k1 (1 - k1/k2) δ_max², dissipated while the contact loads.
+
+    Walton, O.R., Braun, R.L. (1986) Viscosity, granular-temperature, and stress calculations
+    for shearing assemblies of inelastic, frictional disks, J. Rheol. 30, 949-980. The tangential
+    and rolling laws scale with the loading stiffness k1 (``ref_stiffness``).
+    """
+
+    loading_stiffness: float = Field(gt=0, description="k1, loading stiffness [N/m]")
+
+
+def pack_walton_braun(params: WaltonBraunParams, pair: PairContext) -> np.ndarray:
+    if not pair.restitution > 0.0:
+        raise ValueError(
+            f"walton_braun needs a restitution > 0 (k2 = k1 / e²); the pair's restitution is "
+            f"{pair.restitution}"
+        )
+    return packed(
+        WALTON_BRAUN_COLUMNS,
+        {
+            "loading_stiffness": params.loading_stiffness,
+            "restitution_squared": pair.restitution * pair.restitution,
+        },
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def walton_braun_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap):
+    """One evaluation of the Walton–Braun law. The stored elastic energy is that of the
+    unloading spring, ½ k2 (δ - δ0)² (at δ = δ_max: ½ k1 e² δ_max²); a step that raises δ_max
+    from a to b dissipates the loading work minus the stored energy gained,
+    ½ k1 (1 - e²) (b² - a²)."""
+    k1 = p[WB_LOADING_STIFFNESS]
+    r = p[WB_RESTITUTION_SQUARED]  # k1 / k2
+    if overlap >= max_overlap:  # loading: a new largest overlap
+        plastic = 0.5 * k1 * (1.0 - r) * (overlap * overlap - max_overlap * max_overlap)
+        return k1 * overlap, 0.0, k1, 0.0, 0.5 * k1 * r * overlap * overlap, overlap, plastic
+    x = overlap - max_overlap * (1.0 - r)  # δ - δ0
+    if x <= 0.0:
+        return 0.0, 0.0, k1, 0.0, 0.0, max_overlap, 0.0
+    k2 = k1 / r
+    return k2 * x, 0.0, k1, 0.0, 0.5 * k2 * x * x, max_overlap, 0.0
 
 
 # ------------------------------------------------------------------- 2D Hertz (line contact)
@@ -229,10 +292,11 @@ def pack_hertz_2d(params: Hertz2DParams, pair: PairContext) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass):
+def hertz_2d_force(p, overlap, overlap_rate, eff_radius, eff_mass, max_overlap):
     k = 0.25 * math.pi * p[HERTZ_2D_E_STAR] * p[HERTZ_2D_THICKNESS]
     gamma = 2.0 * p[HERTZ_2D_DAMPING_RATIO] * math.sqrt(eff_mass * k)
-    return k * overlap, gamma * overlap_rate, k, gamma, 0.5 * k * overlap * overlap
+    u = 0.5 * k * overlap * overlap
+    return k * overlap, gamma * overlap_rate, k, gamma, u, max_overlap, 0.0
 
 
 register(
@@ -275,6 +339,21 @@ register(
     requires=("youngs_modulus", "poisson_ratio", "restitution"),
     planar=("disc",),
     only_2d=True,
+)
+register(
+    family="normal",
+    name="walton_braun",
+    model_id=WALTON_BRAUN,
+    kernel=walton_braun_force,
+    params=WaltonBraunParams,
+    pack=pack_walton_braun,
+    columns=WALTON_BRAUN_COLUMNS,
+    summary="elasto-plastic hysteretic spring: k1 loading, k2 = k1/e² unloading, plastic "
+    "dissipation",
+    reference="Walton & Braun (1986) J. Rheol. 30, 949-980",
+    requires=("restitution",),
+    history_width=1,
+    history_flip=(False,),
 )
 
 

@@ -1,0 +1,67 @@
+"""Heat generation in the thermal engine: the accumulated dissipation becomes heat, and its
+ledger (docs/thermal-engine.md, "Heat generation").
+
+The contact passes add every contact's dissipated energy per mechanism into its particles'
+accumulators (``Particles.generation_energy``) at each mechanical step; :func:`rates` turns them
+into the heat rates χ E / Δt_th of the ``generation_<mechanism>`` columns for the thermal step
+that follows, and :func:`clear` empties them once that step has applied them. :func:`ledger`
+reports, per selected mechanism, what the mechanics dissipated (× χ), what went into the
+particles, to the walls and what waits for the next thermal step; they close to round-off.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from thermodem.kernels import generation as kernels
+from thermodem.state import heat
+
+if TYPE_CHECKING:
+    from thermodem.engine.thermal import ThermalEngine
+
+
+def rates(engine: ThermalEngine) -> None:
+    """χ E / Δt_th into the generation column of every selected mechanism (nothing without a
+    generation model)."""
+    gen = engine.generation
+    if not gen.active:
+        return
+    p = engine.sim.particles
+    kernels.generation_heat(p.generation_energy, gen.select, gen.conversion_fraction,
+                            engine.thermal_dt(), p.heat_rate_by_mechanism)  # fmt: skip
+
+
+def clear(engine: ThermalEngine) -> None:
+    """The thermal step applied the generated heat: empty the accumulators."""
+    if engine.generation.active:
+        engine.sim.particles.generation_energy[:] = 0.0
+
+
+def ledger(engine: ThermalEngine) -> dict[str, float]:
+    """The heat generation ledger [J] per selected mechanism g: χ × the energy the mechanics
+    dissipated (``generated_<g>``: the mechanical ledger's ``dissipated_<g>``, or the kinetic
+    energy lost in collisions), the heat that went to walls with a fixed temperature
+    (``heat_to_walls_generation_<g>``), the heat accumulated in the particles but not yet
+    applied by a thermal step (``heat_pending_generation_<g>``); with the heat into the
+    particles (``heat_in_generation_<g>``, the heat ledger) they close:
+    ``generation_balance_error`` = Σ_g generated - in - walls - pending, round-off."""
+    sim = engine.sim
+    gen = engine.generation
+    chi = gen.conversion_fraction
+    cum = sim.ledger_cumulative
+    pending = sim.particles.generation_energy.sum(axis=0)
+    out: dict[str, float] = {}
+    error = 0.0
+    for g in gen.mechanisms:
+        name = heat.GENERATION[g]
+        source = "collision_energy_loss" if g == heat.G_COLLISION else name
+        generated = chi * cum[source]
+        walls = chi * cum[f"wall_generation_{name}"]
+        waiting = chi * float(pending[g])
+        out[f"generated_{name}"] = generated
+        out[f"heat_to_walls_generation_{name}"] = walls
+        out[f"heat_pending_generation_{name}"] = waiting
+        into = engine.cumulative[f"heat_in_generation_{name}"]
+        error += generated - walls - waiting - into
+    out["generation_balance_error"] = error
+    return out
