@@ -361,3 +361,42 @@ def test_region_selections_of_a_2d_case_take_x_y_boxes() -> None:
     cap = RHO * math.pi * R**2 * 0.002 * C
     assert t[1] == pytest.approx(300.0 + q * sim.time / cap, rel=1e-9)
     assert t[2] == 300.0
+
+
+def test_a_disc_sliding_until_it_rolls_generates_a_sixth_of_m_v0_squared() -> None:
+    """Heat generation for discs (hertz_2d, linear tangential): a disc launched without spin
+    on a rough line slides until it rolls at 2 v0/3 and loses m v0²/6 of kinetic energy, all
+    by Coulomb sliding (test_two_dimensional.py's rolling disc; a sphere: m v0²/7). With
+    ``mechanical_dissipation`` and χ the sliding heat is χ m v0²/6, every joule of it in the
+    ledger (an adiabatic line: all of it into the disc), and the disc's temperature rises by
+    that heat over its capacity ρ π R² b c."""
+    v0, chi, b = 0.3, 0.8, 0.01
+    material = dict(MATERIAL, rolling_friction=0.0)
+    case = disc_case([[0.0, R - 1e-6]], [300.0], {
+        "direct_conduction": "rojek2014",
+        "heat_generation": {"model": "mechanical_dissipation", "conversion_fraction": chi},
+    }, thickness=b)  # fmt: skip
+    case["materials"]["glass"] = material
+    case["simulation"].update(time_step=2e-6, gravity=[0.0, -9.81])
+    case["contact"] = {"normal": "hertz_2d", "tangential": "linear", "rolling": "none"}
+    case["insertion"][0]["velocities"] = [[v0, 0.0]]
+    case["walls"] = [{"kind": "plane", "point": [0, 0], "normal": [0, 1], "material": "glass"}]
+    sim = Simulation(case_from_dict(case))
+    mu = material["sliding_friction"]
+    sim.run(until=2.0 * v0 / (3.0 * mu * 9.81))  # twice the time to rolling
+    m = sim.particles.mass[0]
+    r = sim.report()
+    en = sim.energies()
+
+    def generated(mechanism: str) -> float:  # applied + accumulated, not yet applied
+        return r[f"heat_in_generation_{mechanism}"] + r[f"heat_pending_generation_{mechanism}"]
+
+    friction = generated("sliding_friction")
+    assert friction == pytest.approx(chi * en["dissipated_sliding_friction"], rel=1e-12)
+    sliding = friction + generated("tangential_damping")
+    assert sliding == pytest.approx(chi * m * v0**2 / 6.0, rel=5e-3)
+    assert r["heat_to_walls_generation_sliding_friction"] == 0.0
+    capacity = RHO * math.pi * R * R * b * C
+    heat_in = sum(r[f"heat_in_generation_{g}"] for g in ("sliding_friction", "tangential_damping",
+                                                          "normal_damping"))  # fmt: skip
+    assert (sim.particles.temperature[0] - 300.0) * capacity == pytest.approx(heat_in, rel=1e-9)

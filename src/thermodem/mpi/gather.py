@@ -210,17 +210,16 @@ def gathered_view(sim: DistributedSimulation) -> GatheredView | None:
 
 
 def _pair_rows(sim: DistributedSimulation, buf: Any, wall: bool) -> np.ndarray:
-    """Rows [gid i, gid j (wall index), history, dissipation, normal force, state] of a list."""
+    """Rows [gid i, gid j (wall index), history, normal force, state] of a list."""
     c = buf.count
     gid = sim.particles.global_id
     w = buf.history_width
-    rows = np.empty((c, 2 + w + 4 + 2))
+    rows = np.empty((c, 2 + w + 2))
     rows[:, 0] = gid[buf.i[:c]]
     rows[:, 1] = buf.j[:c] if wall else gid[buf.j[:c]]
     rows[:, 2 : 2 + w] = buf.history[:c]
-    rows[:, 2 + w : 6 + w] = buf.dissipation[:c]
-    rows[:, 6 + w] = buf.normal_force[:c]
-    rows[:, 7 + w] = buf.state[:c]
+    rows[:, 2 + w] = buf.normal_force[:c]
+    rows[:, 3 + w] = buf.state[:c]
     return rows
 
 
@@ -233,9 +232,8 @@ def _pair_arrays(
         "i": i.astype(np.int32),
         "j": j.astype(np.int32),
         "history": np.ascontiguousarray(rows[:, 2 : 2 + width]),
-        "dissipation": rows[:, 2 + width : 6 + width].astype(np.float32),
-        "normal_force": np.ascontiguousarray(rows[:, 6 + width]),
-        "state": rows[:, 7 + width].astype(np.int8),
+        "normal_force": np.ascontiguousarray(rows[:, 2 + width]),
+        "state": rows[:, 3 + width].astype(np.int8),
     }
 
 
@@ -291,6 +289,7 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
     scalars["pourers"] = []
     scalars["material_names"] = list(sim.material_names)
     scalars["history_width"] = width
+    scalars["history_layout"] = sim.history_layout.describe()
     scalars["pair_capacity"] = max(pairs["i"].shape[0], 16)
     scalars["wall_pair_capacity"] = max(walls["i"].shape[0], 16)
     scalars["pair_count"] = int(pairs["i"].shape[0])

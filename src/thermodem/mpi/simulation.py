@@ -246,19 +246,29 @@ class DistributedSimulation(Simulation):
         p = self.particles
         pb, mb, wb = self.pairs, self.mirror, self.walls
         nid, tid, rid = self.model_ids
+        layout = self.history_layout.offsets
         th = self.thermal
         heat_due = th is not None and th.next_step <= self.step_count
+        # as in the serial step: the fused pass only with a contact conduction model (heat
+        # generation is refused under MPI, mpi/support.py: its deposits are compiled out)
+        fused = heat_due and th.contact.active
         if heat_due:
             th.prepare(self.time)
-            pair_pass, wall_pass = PP.passes_for(True, th.radius_id, th.conduction_id, th.override)
+        if fused:
+            pair_pass, wall_pass = PP.passes_for(
+                True, th.radius_id, th.conduction_id, th.override, layout, False
+            )
         else:
             pair_heat, wall_heat = self._no_heat
-            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0)
+            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, False)
+        gen = (False, *self._no_generation)
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
             th.fresh = True
             th.fused_rows(max(pb.ngroups, mb.ngroups, nwchunks))
-            pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+            if fused:
+                pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+            th.rates_cleared = False  # zeroed here, owned and ghost rows alike
             reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_rate_by_mechanism,
                          th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
@@ -273,18 +283,18 @@ class DistributedSimulation(Simulation):
                 p.moment_of_inertia, p.type_id, buf.i, buf.j, buf.group_start, buf.history,
                 self.lower, self.upper, self.periodic, self.extra, dt, nid, self.normal_table,
                 tid, self.tangential_table, rid, self.rolling_table, p.force, p.torque,
-                buf.dissipation, buf.normal_force, buf.state, buf.ledger_rows(buf.ngroups),
-                *pair_heat,
+                buf.normal_force, buf.state, buf.ledger_rows(buf.ngroups), *pair_heat, layout,
+                *gen,
             )  # fmt: skip
         wall_pass(
             p.position, p.velocity, p.angular_velocity, p.radius, p.mass, p.moment_of_inertia,
             p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
             self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
-            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.dissipation,
-            wb.normal_force, wb.state, wb.ledger_rows(nwchunks), *wall_heat,
+            self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.normal_force,
+            wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout, *gen,
         )  # fmt: skip
         if heat_due:
-            th.after_contact_pass(self.time)
+            th.after_contact_pass(self.time, self._complete)
         if kick:
             own = self.owned_count
             final_kick(p.velocity[:own], p.angular_velocity[:own], p.force[:own],

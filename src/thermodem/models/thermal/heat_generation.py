@@ -285,11 +285,15 @@ def required_properties(params: StrictModel) -> tuple[str, ...]:
     return _requires(getattr(params, "partition", "equal"))
 
 
+#: 2D (``planar``): every model converts the energy the contact laws report as dissipated,
+#: whatever the law (``hertz_2d`` for discs included); ψ reads material properties only. So
+#: the models hold for discs and for spheres in a plane as written.
 _COMMON = dict(
     family="heat_generation",
     kernel=partition_share,
     columns=COLUMNS,
     requires_of=required_properties,
+    planar=("disc", "sphere"),
 )
 register(
     name="none",
