@@ -110,7 +110,7 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
             th.radius_id, th.radius_table, th.conduction_id, th.conduction_table, th.override,
             th.k_p, th.rhoc_p, th.scratch, pair_h, -1, 0.0,
         )  # fmt: skip
-        thermal_kernels.conduction_wall_pass(
+        thermal_kernels.conduction_wall_pass_for(th.radius_id, th.conduction_id, th.override)(
             p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
             wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
             sim.wall_material, th.radius_id, th.radius_table, th.conduction_id,
@@ -119,7 +119,7 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
         )  # fmt: skip
         add(heat.M_DIRECT, pair_h, wall_h)  # wall contacts too: the `wall` key tells them
     # the other pair terms, evaluated on the contact pairs (side effects into scratch sums)
-    by_mech = np.zeros_like(p.heat_rate_by_mechanism)
+    by_mech = np.zeros_like(p.heat_columns)  # (scratch: the kernels take a row per mechanism)
     sums = np.zeros(p.count)
     rows_needed = max(pb.ngroups, p.count // heat_terms.WALL_CHUNK + 1)
     for term in th.terms:

@@ -28,7 +28,7 @@ def rates(engine: ThermalEngine) -> None:
         return
     p = engine.sim.particles
     kernels.generation_heat(p.generation_energy, gen.select, gen.conversion_fraction,
-                            engine.thermal_dt(), p.heat_rate_by_mechanism)  # fmt: skip
+                            engine.thermal_dt(), p.heat_columns)  # fmt: skip
 
 
 def clear(engine: ThermalEngine) -> None:

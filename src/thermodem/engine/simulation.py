@@ -159,11 +159,8 @@ class Simulation:
         z1, z3 = np.zeros(0), np.zeros((1, 1, width))
         z2 = np.zeros((1, width))
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
-        zm = np.zeros((1, len(HEAT_MECHANISMS)))
-        self._no_heat = (
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, zm, z1, 0.0),
-            (False, z1, 0, z3, 0, z3, 0, z1, z1, z1, z1, z2, zm, z1, 0.0),
-        )
+        zm = np.zeros((len(HEAT_MECHANISMS), 1))  # (the layout of Particles.heat_columns)
+        self._no_heat = (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, zm, z1, 0.0)
         self.thermal = None
         if case.thermal is not None:
             from thermodem.engine.thermal import ThermalEngine
@@ -365,7 +362,7 @@ class Simulation:
                 True, th.radius_id, th.conduction_id, th.override, layout, self.generation
             )
         else:
-            pair_heat, wall_heat = self._no_heat
+            pair_heat = self._no_heat
             pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, self.generation)
         if self.generation:
             gen = (True, p.generation_energy, th.generation.select, th.generation.partition)
@@ -377,14 +374,14 @@ class Simulation:
             th.fresh = True
             th.fused_rows(max(ngroups, nwchunks))
             if fused:
-                pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+                pair_heat = th.pair_heat_args()
             # the heat sums start at zero: zeroed here, or already by this step's Euler update
             zero = not (th.rates_cleared and th.conductance_sum.shape[0] == p.count)
             th.rates_cleared = False
-            reset_forces(p.force, p.torque, p.mass, self.gravity, zero, p.heat_rate_by_mechanism,
+            reset_forces(p.force, p.torque, p.mass, self.gravity, zero, p.heat_columns,
                          th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
-            no_mech, no_sum = self._no_heat[0][-3:-1]
+            no_mech, no_sum = self._no_heat[-3:-1]
             reset_forces(p.force, p.torque, p.mass, self.gravity, False, no_mech, no_sum,
                          p.external_force, p.external_torque)  # fmt: skip
         pair_pass(
@@ -399,8 +396,10 @@ class Simulation:
             p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
             self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
             self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.normal_force,
-            wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout, *gen,
+            wb.state, wb.ledger_rows(nwchunks), layout, *gen,
         )  # fmt: skip
+        if fused:  # the wall pairs' contact conduction (a pass of its own)
+            th.wall_conduction()
         if heat_due:  # the other heat terms of this state (the totals: see step())
             th.after_contact_pass(self.time, self._complete)
         if kick:

@@ -342,14 +342,7 @@ class ThermalEngine:
         """Arguments of the fused contact pass (particle pairs) that switch conduction on."""
         return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
                 self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
-                self.scratch, self.sim.particles.heat_rate_by_mechanism,
-                self.conductance_sum, self.tolerance)  # fmt: skip
-
-    def wall_heat_args(self) -> tuple:
-        """Arguments of the fused contact pass (wall pairs) that switch conduction on."""
-        return (True, self.sim.particles.temperature, self.radius_id, self.radius_table,
-                self.conduction_id, self.conduction_table, self.override, self.k_p, self.rhoc_p,
-                self.k_w, self.rhoc_w, self.scratch, self.sim.particles.heat_rate_by_mechanism,
+                self.scratch, self.sim.particles.heat_columns,
                 self.conductance_sum, self.tolerance)  # fmt: skip
 
     def fused_rows(self, rows: int) -> None:
@@ -370,8 +363,8 @@ class ThermalEngine:
         """
         sim = self.sim
         p = sim.particles
-        pb, wb = sim.pairs, sim.walls
-        by_mech = p.heat_rate_by_mechanism
+        pb = sim.pairs
+        by_mech = p.heat_columns
         passes.zero_heat(by_mech, self.conductance_sum)
         if not self.contact.active:
             return
@@ -384,22 +377,37 @@ class ThermalEngine:
                 self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
                 sim.history_layout.reuse, self.tolerance,
             )  # fmt: skip
-            kernels.conduction_wall_pass(
-                p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
-                wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
-                sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
-                self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w,
-                self.rhoc_w, self.scratch, self.wall_conductance, sim.history_layout.reuse,
-                self.tolerance,
-            )  # fmt: skip
+            self._wall_conductances()
             self.conductance_ready = reuse
         passes.pair_heat_from_conductance(
             pb.i, pb.j, pb.group_start, self.pair_conductance, p.temperature, heat.M_DIRECT,
             by_mech, self.conductance_sum,
         )  # fmt: skip
+        self._wall_heat()
+
+    def wall_conduction(self) -> None:
+        """The contact conduction of the wall pairs, after the fused contact pass (which
+        conducts through the particle pairs only; kernels/pair_pass.py)."""
+        self._wall_conductances()
+        self._wall_heat()
+
+    def _wall_conductances(self) -> None:
+        sim = self.sim
+        p, wb = sim.particles, sim.walls
+        kernels.conduction_wall_pass_for(self.radius_id, self.conduction_id, self.override)(
+            p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
+            wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
+            sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
+            self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w, self.rhoc_w,
+            self.scratch, self.wall_conductance, sim.history_layout.reuse, self.tolerance,
+        )  # fmt: skip
+
+    def _wall_heat(self) -> None:
+        sim = self.sim
+        p = sim.particles
         passes.wall_heat_from_conductance(
-            wb.j, sim.wall_row_start, sim.wall_rows, self.wall_conductance, p.temperature,
-            heat.M_WALL_DIRECT, by_mech, self.conductance_sum,
+            sim.walls.j, sim.wall_row_start, sim.wall_rows, self.wall_conductance, p.temperature,
+            heat.M_WALL_DIRECT, p.heat_columns, self.conductance_sum,
         )  # fmt: skip
 
     # ----------------------------------------------------------------- the other terms
@@ -584,12 +592,12 @@ class ThermalEngine:
                 p.position, p.radius, p.temperature, p.type_id, ext.wall_i, ext.wall_w,
                 ext.wall_offsets, ext.wall_inputs, sim.wall_kind, sim.wall_rows,
                 sim.wall_material, term.model_id, term.table, k_i, k_j, self.k_p, self.k_w,
-                scratch, term.wall_column, p.heat_rate_by_mechanism, self.conductance_sum,
+                scratch, term.wall_column, p.heat_columns, self.conductance_sum,
                 not reuse, self.external_wall_conductance,
             )  # fmt: skip
         passes.csr_heat(
             ext.offsets, ext.entries, ext.i, ext.j, h, p.temperature, term.column,
-            p.heat_rate_by_mechanism, self.conductance_sum,
+            p.heat_columns, self.conductance_sum,
         )  # fmt: skip
 
     def _particle_term(self, term: HeatTerm, second: HeatTerm | None = None) -> None:
@@ -599,7 +607,7 @@ class ThermalEngine:
         passes.particle_pass(
             p.temperature, p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
             term.table, term.column, other.evaluator, other.model_id, other.table,
-            -1 if second is None else second.column, p.heat_rate_by_mechanism,
+            -1 if second is None else second.column, p.heat_columns,
             self.conductance_sum,
         )  # fmt: skip
 
@@ -617,7 +625,7 @@ class ThermalEngine:
         sim = self.sim
         p = sim.particles
         rs = self.range_set
-        by_mech = p.heat_rate_by_mechanism
+        by_mech = p.heat_columns
         store = frozen or self.record_conductances
         pair_h, wall_h = self._stored(
             index, rs.count if store else 0, rs.wall_count if store else 0
@@ -653,7 +661,7 @@ class ThermalEngine:
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
-        by_mech = p.heat_rate_by_mechanism
+        by_mech = p.heat_columns
         store = frozen or self.record_conductances
         pair_h, wall_h = self._stored(index, pb.count if store else 0, wb.count if store else 0)
         if frozen and self.term_ready[index]:
@@ -718,7 +726,7 @@ class ThermalEngine:
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
-        kernels.finish_heat(self.source, p.heat_rate, p.heat_rate_by_mechanism, self.sum_columns)
+        kernels.finish_heat(self.source, p.heat_rate, p.heat_columns, self.sum_columns)
         self.rates_pending = False
         return self.fixed
 
@@ -756,14 +764,15 @@ class ThermalEngine:
         # owned_count, the ghosts after them are updated by their owners, thermodem.mpi)
         n = sim.owned_count
         temperature, heat_rate, mass = p.temperature[:n], p.heat_rate[:n], p.mass[:n]
-        by_mech, type_id = p.heat_rate_by_mechanism[:n], p.type_id[:n]
+        # (the kernels loop over the first n particles of the full rows)
+        by_mech, type_id = p.heat_columns, p.type_id[:n]
         fixed, source, conductance = fixed[:n], source[:n], self.conductance_sum[:n]
         if self.has_c_table:
             kernels.finish_heat(source, heat_rate, by_mech, self.sum_columns)
             self.rates_pending = False
             c = self.specific_heat()[:n]
             limit, where = kernels.stability_limit(mass, c, conductance, fixed)
-            boundary = by_mech[:, self.boundary_columns].sum(axis=0)
+            boundary = p.heat_rate_by_mechanism[:n, self.boundary_columns].sum(axis=0)
             absorbed, bad = kernels.euler_update_enthalpy(temperature, heat_rate, mass, type_id,
                                                           self.c_t, self.c_v, self.c_n, fixed,
                                                           dt)  # fmt: skip

@@ -29,4 +29,4 @@ def generation_heat(energy, select, conversion_fraction, dt, by_mechanism):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             for g in range(ng):
                 if select[g] != 0.0:
-                    by_mechanism[i, M_GENERATION + g] = scale * energy[i, g]
+                    by_mechanism[M_GENERATION + g, i] = scale * energy[i, g]

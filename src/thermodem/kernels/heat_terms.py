@@ -121,8 +121,8 @@ def range_pair_pass(
                     out_conductance[k] = h
                 if h != 0.0:
                     q = h * (temperature[j] - temperature[i])
-                    by_mechanism[i, column] += q
-                    by_mechanism[j, column] -= q
+                    by_mechanism[column, i] += q
+                    by_mechanism[column, j] -= q
                     conductance_sum[i] += h
                     conductance_sum[j] += h
 
@@ -157,7 +157,7 @@ def range_wall_pass(
                 if store:
                     out_conductance[k] = h
                 if h != 0.0:
-                    by_mechanism[i, column] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    by_mechanism[column, i] += h * (wrow[COL_TEMPERATURE] - temperature[i])
                     conductance_sum[i] += h
 
 
@@ -199,8 +199,8 @@ def contact_term_pair_pass(
                     h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, f_n)
                     if h != 0.0:
                         q = h * (temperature[j] - temperature[i])
-                        by_mechanism[i, column] += q
-                        by_mechanism[j, column] -= q
+                        by_mechanism[column, i] += q
+                        by_mechanism[column, j] -= q
                         conductance_sum[i] += h
                         conductance_sum[j] += h
                 if store:
@@ -240,7 +240,7 @@ def contact_term_wall_pass(
                     p = _row(table[type_id[i], tw], k_col_i, k_col_j, ki, kw, srow)
                     h = term_conductance(evaluator, model_id, p, ri, math.inf, d, r_c, f_n)
                     if h != 0.0:
-                        by_mechanism[i, column] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                        by_mechanism[column, i] += h * (wrow[COL_TEMPERATURE] - temperature[i])
                         conductance_sum[i] += h
                 if store:
                     out_conductance[k] = h
@@ -403,7 +403,7 @@ def external_wall_pass(
                                                           inputs[k])  # fmt: skip
                 h = out_conductance[k]
                 if h != 0.0:
-                    by_mechanism[i, column] += h * (wrow[COL_TEMPERATURE] - temperature[i])
+                    by_mechanism[column, i] += h * (wrow[COL_TEMPERATURE] - temperature[i])
                     conductance_sum[i] += h
 
 
@@ -422,9 +422,9 @@ def csr_heat(
             if h != 0.0:
                 q = h * (temperature[pair_j[k]] - temperature[pair_i[k]])
                 if entries[e] & 1:
-                    by_mechanism[a, column] -= q
+                    by_mechanism[column, a] -= q
                 else:
-                    by_mechanism[a, column] += q
+                    by_mechanism[column, a] += q
                 conductance_sum[a] += h
 
 
@@ -460,7 +460,7 @@ def particle_pass(
                 col = column if first else column2
                 row = table[type_id[i]] if first else table2[type_id[i]]
                 q, g = particle_term(ev, mid, row, t_i, r_i, fields, i)
-                by_mechanism[i, col] += q
+                by_mechanism[col, i] += q
                 conductance_sum[i] += g
 
 
@@ -481,8 +481,8 @@ def pair_heat_from_conductance(
                     i = pair_i[k]
                     j = pair_j[k]
                     q = h * (temperature[j] - temperature[i])
-                    by_mechanism[i, column] += q
-                    by_mechanism[j, column] -= q
+                    by_mechanism[column, i] += q
+                    by_mechanism[column, j] -= q
                     conductance_sum[i] += h
                     conductance_sum[j] += h
 
@@ -499,16 +499,16 @@ def wall_heat_from_conductance(
             h = conductance[k]
             if h != 0.0:
                 t_wall = wall_rows[wall_pair_w[k], COL_TEMPERATURE]
-                by_mechanism[i, column] += h * (t_wall - temperature[i])
+                by_mechanism[column, i] += h * (t_wall - temperature[i])
                 conductance_sum[i] += h
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def zero_heat(by_mechanism, conductance_sum):
     """Every mechanism column and the conductance sums to zero (before the terms add)."""
-    for i in prange(by_mechanism.shape[0]):
-        for m in range(by_mechanism.shape[1]):
-            by_mechanism[i, m] = 0.0
+    for i in prange(by_mechanism.shape[1]):
+        for m in range(by_mechanism.shape[0]):
+            by_mechanism[m, i] = 0.0
         conductance_sum[i] = 0.0
 
 

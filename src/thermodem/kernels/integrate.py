@@ -132,8 +132,8 @@ def reset_forces(
                 force[i, a] = m * gravity[a]
                 torque[i, a] = 0.0
         if heat_on:
-            for c in range(by_mechanism.shape[1]):
-                by_mechanism[i, c] = 0.0
+            for c in range(by_mechanism.shape[0]):
+                by_mechanism[c, i] = 0.0
             conductance_sum[i] = 0.0
 
 

@@ -26,7 +26,6 @@ from thermodem.geometry.wall_layout import (
     COL_AXIS,
     COL_OMEGA,
     COL_POINT,
-    COL_TEMPERATURE,
     COL_THERMAL_KIND,
     COL_VELOCITY,
 )
@@ -46,10 +45,10 @@ from thermodem.kernels.contact import (
     deposit_wall,
     kinetic_energy,
 )
-from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
+from thermodem.kernels.contact_conduction import _pp_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.state import history as HL
-from thermodem.state.heat import G_COLLISION, M_DIRECT, M_WALL_DIRECT
+from thermodem.state.heat import G_COLLISION, M_DIRECT
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
 
@@ -78,8 +77,11 @@ def passes_for(
     layout and generation arguments passed in are ignored. Each combination in use compiles
     once (~7 s on a 2-core machine) and is then cached on disk (Numba keys closures on their
     constants) and in this process. The wall pass, a few percent of the time, is one generic
-    kernel for all model combinations (the offsets are its arguments), compiled with or
-    without the generation deposits (:func:`wall_pass_for`).
+    kernel of the mechanics for all model combinations (the offsets are its arguments),
+    compiled with or without the generation deposits (:func:`wall_pass_for`); the conduction
+    from walls follows it in a small pass compiled per model combination
+    (:func:`thermodem.kernels.thermal.conduction_wall_pass_for`): the generic wall pass with
+    every conduction model inlined took 16 s of a 40 s cold start.
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
@@ -324,8 +326,8 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             H_REUSE, tolerance,
                         )  # fmt: skip
                         q_ij = h * (temperature[j] - temperature[i])
-                        by_mechanism[i, M_DIRECT] += q_ij
-                        by_mechanism[j, M_DIRECT] -= q_ij
+                        by_mechanism[M_DIRECT, i] += q_ij
+                        by_mechanism[M_DIRECT, j] -= q_ij
                         conductance_sum[i] += h
                         conductance_sum[j] += h
 
@@ -376,21 +378,6 @@ def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
         out_normal_force,
         out_state,
         chunk_ledger,
-        heat_on,
-        temperature,
-        radius_id,
-        radius_table,
-        conduction_id,
-        conduction_table,
-        override,
-        k_particle,
-        rhoc_particle,
-        k_wall,
-        rhoc_wall,
-        scratch,
-        by_mechanism,
-        conductance_sum,
-        tolerance,
         layout,
         generation,
         gen_energy,
@@ -400,9 +387,10 @@ def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
         """Contact forces of every listed particle-wall pair (wall = j, infinite radius and mass),
         added to ``force`` and ``torque`` after the particle pairs.
 
-        Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). With
-        ``heat_on`` also the conduction from fixed-temperature walls (adiabatic: zero), added to
-        the wall direct-conduction column of ``by_mechanism`` and to ``conductance_sum``.
+        Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). The
+        conduction from fixed-temperature walls is a pass of its own after this one
+        (:func:`thermodem.kernels.thermal.conduction_wall_pass_for`, compiled per model
+        combination: the wall pairs are few, and this pass stays one kernel for all of them).
         ``layout``: the history offsets (see :func:`passes_for`). With ``generation`` the
         dissipated energies go to the particle's accumulators, its share ``gen_partition[type,
         wall material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
@@ -412,11 +400,9 @@ def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
         h_spring = layout[HL.SPRING]
         h_roll = layout[HL.ROLL]
         h_collision = layout[HL.COLLISION] if GENERATION else -1
-        h_reuse = layout[HL.REUSE]
         n = radius.shape[0]
         nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
         for c in prange(nchunks):
-            srow = scratch[c] if heat_on else scratch[0]  # (one row when heat is off)
             row = chunk_ledger[c]
             for q in range(row.shape[0]):
                 row[q] = 0.0
@@ -533,18 +519,5 @@ def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
                     ratio = overlap / ri
                     if ratio > row[L_MAX_OVERLAP_RATIO]:
                         row[L_MAX_OVERLAP_RATIO] = ratio
-                # conduction from fixed-temperature walls, touching pairs (one call site, as in the
-                # particle pass)
-                if heat_on and out_state[k] == STATE_TOUCHING:
-                    h = 0.0
-                    if wrow[COL_THERMAL_KIND] != 0.0:
-                        h = _pw_conductance(
-                            k, i, w, ri, d, overlap, mass, type_id, wall_material, history,
-                            out_normal_force, radius_id, radius_table, conduction_id,
-                            conduction_table, override, k_particle, rhoc_particle, k_wall,
-                            rhoc_wall, srow, h_reuse, tolerance,
-                        )  # fmt: skip
-                    by_mechanism[i, M_WALL_DIRECT] += h * (wrow[COL_TEMPERATURE] - temperature[i])
-                    conductance_sum[i] += h
 
     return wall_pair_pass

@@ -84,37 +84,61 @@ def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
     return conduction_pair_pass
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def conduction_wall_pass(
-    position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
-    normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
-    conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
-    scratch, out_conductance, reuse_col, tolerance,
-):  # fmt: skip
-    """Conductance of touching particle–fixed-temperature-wall pairs (adiabatic walls: 0).
+_CONDUCTION_WALL_PASSES: dict[tuple[int, int, int], Any] = {}
 
-    ``override`` as in :func:`conduction_pair_pass`; the wall's values are ``k_wall[w]`` and
-    ``rhoc_wall[w]`` (its material at the wall temperature).
-    """
-    nchunks = (nwpairs + CHUNK - 1) // CHUNK
-    for c in prange(nchunks):
-        row = scratch[c]
-        for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
-            w = wall_pair_w[k]
-            wrow = wall_rows[w]
-            if state[k] != STATE_TOUCHING or wrow[COL_THERMAL_KIND] == 0.0:
-                out_conductance[k] = 0.0
-                continue
-            i = wall_pair_i[k]
-            d = wall_distance(wall_kind[w], wrow, position[i])[0]
-            ri = radius[i]
-            overlap = ri - d
-            h = _pw_conductance(
-                k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force,
-                radius_id, radius_table, conduction_id, conduction_table, override, k_particle,
-                rhoc_particle, k_wall, rhoc_wall, row, reuse_col, tolerance,
-            )  # fmt: skip
-            out_conductance[k] = h
+
+def conduction_wall_pass_for(radius_id: int, conduction_id: int, override: int) -> Any:
+    """The particle–wall conduction pass for one model combination (the model ids and the
+    override as compile-time constants, as :func:`conduction_pair_pass_for`). It serves the
+    heat-only steps and follows the mechanics' wall pass at the steps whose contact pass
+    conducts (``kernels/pair_pass.py``)."""
+    key = (int(radius_id), int(conduction_id), int(override))
+    if key not in _CONDUCTION_WALL_PASSES:
+        _CONDUCTION_WALL_PASSES[key] = _compile_conduction_wall_pass(*key)
+    return _CONDUCTION_WALL_PASSES[key]
+
+
+def _compile_conduction_wall_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
+    REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
+
+    @njit(cache=True, parallel=True, error_model="numpy")
+    def conduction_wall_pass(
+        position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
+        normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
+        conduction_id, conduction_table, override, k_particle, rhoc_particle, k_wall, rhoc_wall,
+        scratch, out_conductance, reuse_col, tolerance,
+    ):  # fmt: skip
+        """Conductance of touching particle–fixed-temperature-wall pairs (adiabatic walls: 0).
+
+        ``override`` as in :func:`conduction_pair_pass`; the wall's values are ``k_wall[w]``
+        and ``rhoc_wall[w]`` (its material at the wall temperature).
+        """
+        radius_id = RADIUS_ID
+        conduction_id = CONDUCTION_ID
+        override = OVERRIDE
+        if not REUSABLE:
+            tolerance = 0.0  # (the reuse's code is dropped)
+        nchunks = (nwpairs + CHUNK - 1) // CHUNK
+        for c in prange(nchunks):
+            row = scratch[c]
+            for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
+                w = wall_pair_w[k]
+                wrow = wall_rows[w]
+                if state[k] != STATE_TOUCHING or wrow[COL_THERMAL_KIND] == 0.0:
+                    out_conductance[k] = 0.0
+                    continue
+                i = wall_pair_i[k]
+                d = wall_distance(wall_kind[w], wrow, position[i])[0]
+                ri = radius[i]
+                overlap = ri - d
+                h = _pw_conductance(
+                    k, i, w, ri, d, overlap, mass, type_id, wall_material, history, normal_force,
+                    radius_id, radius_table, conduction_id, conduction_table, override,
+                    k_particle, rhoc_particle, k_wall, rhoc_wall, row, reuse_col, tolerance,
+                )  # fmt: skip
+                out_conductance[k] = h
+
+    return conduction_wall_pass
 
 
 @njit(cache=True, error_model="numpy")
@@ -208,10 +232,10 @@ def finish_heat(source, heat_rate, by_mechanism, columns):
     """Source column and total heat rate: the sum of the mechanism columns ``columns`` (the
     columns in use, ascending; the others are zero)."""
     for i in prange(heat_rate.shape[0]):
-        by_mechanism[i, M_SOURCE] = source[i]
+        by_mechanism[M_SOURCE, i] = source[i]
         q = 0.0
         for m in columns:
-            q += by_mechanism[i, m]
+            q += by_mechanism[m, i]
         heat_rate[i] = q
 
 
@@ -230,15 +254,15 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type
     over free particles, applies T += dt Q / (m c) to free particles, and sums per chunk the
     heat absorbed by fixed particles and every mechanism column in use [W]
     (``part[c, EULER_FIXED + m]``). With ``clear`` it then zeroes the particle's mechanism
-    row and conductance sum, which the contact pass of the same step adds to next (instead of
-    a separate zeroing pass over the particles; the row is in the cache here).
+    columns in use and conductance sum, which the contact pass of the same step adds to next
+    (instead of a separate zeroing pass over the particles; they are in the cache here).
     Returns (limit, limit index, absorbed, first bad index or -1).
     Parallel over fixed chunks of EULER_CHUNK particles whose partial results are combined in
     chunk order, so the sums do not depend on the number of threads (``part``: at least
     n // EULER_CHUNK + 1 rows of EULER_FIXED + the number of mechanisms, scratch).
     """
     n = temperature.shape[0]
-    nmech = by_mechanism.shape[1]
+    nmech = by_mechanism.shape[0]
     nchunks = (n + EULER_CHUNK - 1) // EULER_CHUNK
     for c in prange(nchunks):
         limit = math.inf
@@ -249,17 +273,17 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type
         for m in range(nmech):
             row[EULER_FIXED + m] = 0.0
         for i in range(c * EULER_CHUNK, min(n, (c + 1) * EULER_CHUNK)):
-            by_mechanism[i, M_SOURCE] = source[i]
+            by_mechanism[M_SOURCE, i] = source[i]
             q = 0.0
             for m in columns:
-                qm = by_mechanism[i, m]
+                qm = by_mechanism[m, i]
                 q += qm
                 row[EULER_FIXED + m] += qm
             heat_rate[i] = q
             g = conductance_sum[i]
-            if clear:
-                for m in range(nmech):
-                    by_mechanism[i, m] = 0.0
+            if clear:  # (the other columns are never written: zero)
+                for m in columns:
+                    by_mechanism[m, i] = 0.0
                 conductance_sum[i] = 0.0
             if fixed[i]:
                 absorbed += q

@@ -259,7 +259,7 @@ class DistributedSimulation(Simulation):
                 True, th.radius_id, th.conduction_id, th.override, layout, False
             )
         else:
-            pair_heat, wall_heat = self._no_heat
+            pair_heat = self._no_heat
             pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, False)
         gen = (False, *self._no_generation)
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
@@ -267,12 +267,12 @@ class DistributedSimulation(Simulation):
             th.fresh = True
             th.fused_rows(max(pb.ngroups, mb.ngroups, nwchunks))
             if fused:
-                pair_heat, wall_heat = th.pair_heat_args(), th.wall_heat_args()
+                pair_heat = th.pair_heat_args()
             th.rates_cleared = False  # zeroed here, owned and ghost rows alike
-            reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_rate_by_mechanism,
+            reset_forces(p.force, p.torque, p.mass, self.gravity, True, p.heat_columns,
                          th.conductance_sum, p.external_force, p.external_torque)  # fmt: skip
         else:
-            no_mech, no_sum = self._no_heat[0][-3:-1]
+            no_mech, no_sum = self._no_heat[-3:-1]
             reset_forces(p.force, p.torque, p.mass, self.gravity, False, no_mech, no_sum,
                          p.external_force, p.external_torque)  # fmt: skip
         for buf in (pb, mb):
@@ -291,8 +291,10 @@ class DistributedSimulation(Simulation):
             p.type_id, wb.i, wb.j, self.wall_row_start, wb.history, self.wall_kind,
             self.wall_rows, self.wall_material, self.extra, dt, nid, self.normal_table, tid,
             self.tangential_table, rid, self.rolling_table, p.force, p.torque, wb.normal_force,
-            wb.state, wb.ledger_rows(nwchunks), *wall_heat, layout, *gen,
+            wb.state, wb.ledger_rows(nwchunks), layout, *gen,
         )  # fmt: skip
+        if fused:  # the wall pairs' contact conduction (a pass of its own)
+            th.wall_conduction()
         if heat_due:
             th.after_contact_pass(self.time, self._complete)
         if kick:

@@ -3,7 +3,13 @@
 Every per-particle quantity is a contiguous NumPy array with the particle as first index.
 ``global_id`` is the stable identity of a particle (history keys, restarts, output); the array
 order changes when the neighbour list sorts particles by cell. ``heat_rate_by_mechanism`` has
-one column per heat transfer mechanism (:data:`thermodem.state.heat.MECHANISMS`).
+one column per heat transfer mechanism (:data:`thermodem.state.heat.MECHANISMS`), stored
+column by column (Fortran order, kept so by every constructor, :meth:`permute` and
+:meth:`append`); the kernels take its transpose :attr:`Particles.heat_columns`, a row per
+mechanism in C order whatever the particle count. A pass that adds to one mechanism, such as
+the contact pass to the direct conduction, so touches 8 B per particle, not the whole 104 B
+row (on the 50,000-sphere shared bed the row layout made the contact pass's heat cost ~3×
+more, docs/architecture.md).
 ``external_force`` and ``external_torque`` hold the constant loads of the case key
 ``external_force`` (added to the weight at every force reset); without that key they have no
 columns (0 B per particle). ``generation_energy`` accumulates, per mechanism of
@@ -50,6 +56,15 @@ class Particles:
     external_force: np.ndarray  # (n, 3) [N], constant; (n, 0) when the case has none
     external_torque: np.ndarray  # (n, 3) [N m], constant; (n, 0) when the case has none
     generation_energy: np.ndarray  # (n, len(GENERATION)) [J]; (n, 0) without heat generation
+
+    def __post_init__(self) -> None:
+        self.heat_rate_by_mechanism = np.asfortranarray(self.heat_rate_by_mechanism)
+
+    @property
+    def heat_columns(self) -> np.ndarray:
+        """``heat_rate_by_mechanism`` as the kernels take it: (mechanisms, n), C order, a row per
+        mechanism (a view: the kernels' writes are the particles' heat rates)."""
+        return self.heat_rate_by_mechanism.T
 
     @property
     def count(self) -> int:
@@ -116,7 +131,7 @@ class Particles:
             if temperature is None
             else np.ascontiguousarray(temperature, dtype=np.float64),
             heat_rate=np.zeros(n),
-            heat_rate_by_mechanism=np.zeros((n, mechanisms)),
+            heat_rate_by_mechanism=np.zeros((n, mechanisms), order="F"),
             type_id=np.ascontiguousarray(type_id, dtype=np.int32),
             global_id=np.ascontiguousarray(global_id, dtype=np.int64),
             external_force=np.zeros((n, 3 if external else 0)),
@@ -128,10 +143,12 @@ class Particles:
         """Reorder every array so that new index k holds old particle order[k]."""
         for f in fields(self):
             setattr(self, f.name, np.ascontiguousarray(getattr(self, f.name)[order]))
+        self.__post_init__()
 
     def append(self, other: Particles) -> None:
         for f in fields(self):
             setattr(self, f.name, np.concatenate([getattr(self, f.name), getattr(other, f.name)]))
+        self.__post_init__()
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
