@@ -101,7 +101,7 @@ def conduction_wall_pass_for(radius_id: int, conduction_id: int, override: int) 
 def _compile_conduction_wall_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
     REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
 
-    @njit(cache=True, parallel=True, error_model="numpy")
+    @njit(cache=True, error_model="numpy")
     def conduction_wall_pass(
         position, radius, mass, temperature, type_id, wall_pair_i, wall_pair_w, nwpairs, state,
         normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
@@ -119,7 +119,7 @@ def _compile_conduction_wall_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: 
         if not REUSABLE:
             tolerance = 0.0  # (the reuse's code is dropped)
         nchunks = (nwpairs + CHUNK - 1) // CHUNK
-        for c in prange(nchunks):
+        for c in range(nchunks):  # (serial: few pairs, and ~1 s less to compile)
             row = scratch[c]
             for k in range(c * CHUNK, min(nwpairs, (c + 1) * CHUNK)):
                 w = wall_pair_w[k]
