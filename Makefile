@@ -27,8 +27,10 @@ run: venv
 	$(BIN)/thermodem run examples/default.yaml --output $(OUT) --overwrite
 	@echo "Results written to $(OUT) (open $(OUT)/particles.pvd in ParaView)"
 
+# two pytest workers (pytest-xdist): the suite is mostly compilation and small single-threaded
+# runs, so the two cores halve it (15 -> 8 min with an empty Numba cache)
 test: venv
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist worksteal
 
 lint: venv
 	$(BIN)/ruff check src tests bench tools

@@ -198,7 +198,9 @@ def test_docs_page_exists(spec):
     assert spec.name in page.read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize("spec", [s for s in SPECS if s.family != "contact_radius"], ids=str)
+@pytest.mark.parametrize(
+    "spec", [s for s in SPECS if s.family != "contact_radius"], ids=lambda s: f"{s.family}.{s.name}"
+)
 def test_no_model_conducts_beyond_the_pairs_its_pair_set_holds(spec):
     """A model whose range the neighbour machinery does not cover cannot exist: a model that
     is not evaluated on the range set (contacts target, no interaction range of its own)
