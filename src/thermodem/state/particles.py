@@ -142,13 +142,19 @@ class Particles:
     def permute(self, order: np.ndarray) -> None:
         """Reorder every array so that new index k holds old particle order[k]."""
         for f in fields(self):
-            setattr(self, f.name, np.ascontiguousarray(getattr(self, f.name)[order]))
-        self.__post_init__()
+            if f.name == "heat_rate_by_mechanism":  # one copy, in its column order
+                self.heat_rate_by_mechanism = np.take(self.heat_columns, order, axis=1).T
+            else:
+                setattr(self, f.name, np.ascontiguousarray(getattr(self, f.name)[order]))
 
     def append(self, other: Particles) -> None:
         for f in fields(self):
-            setattr(self, f.name, np.concatenate([getattr(self, f.name), getattr(other, f.name)]))
-        self.__post_init__()
+            if f.name == "heat_rate_by_mechanism":  # one copy, in its column order
+                rows = np.concatenate([self.heat_columns, other.heat_columns], axis=1)
+                self.heat_rate_by_mechanism = rows.T
+            else:
+                both = [getattr(self, f.name), getattr(other, f.name)]
+                setattr(self, f.name, np.concatenate(both))
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
