@@ -70,7 +70,7 @@ def instrument() -> None:
     if not getattr(original, "__wrapped_phase__", False):
 
         @functools.wraps(original)
-        def passes_for(heat: bool, *ids: int) -> tuple[Any, Any]:
+        def passes_for(heat: bool, *ids: Any) -> tuple[Any, Any]:
             pair, wall = original(heat, *ids)
             tag = "heat" if heat else "mech"
             return _timed(f"pair pass ({tag})", pair), _timed(f"wall pass ({tag})", wall)

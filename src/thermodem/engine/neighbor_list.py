@@ -21,6 +21,7 @@ from thermodem.geometry import wall_layout as WL
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
 from thermodem.kernels import slabs as SL
+from thermodem.kernels.integrate import max_wall_shift
 from thermodem.state.pairs import PairBuffers
 
 if TYPE_CHECKING:
@@ -169,6 +170,5 @@ def rebuild_due(sim: Simulation) -> bool:
     moved = sim.moved
     wall_moved = 0.0
     if sim.wall_rows.shape[0]:
-        shift = sim.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3] - sim.wall_reference
-        wall_moved = float(np.sqrt((shift**2).sum(axis=1)).max())
+        wall_moved = max_wall_shift(sim.wall_rows, WL.COL_POINT, sim.wall_reference)
     return 2.0 * moved > sim.skin or moved + wall_moved > sim.skin

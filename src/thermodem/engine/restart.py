@@ -107,6 +107,8 @@ DERIVED: tuple[str, ...] = (
     "_complete",  # the argument of the step in progress
     "_no_heat",
     "_no_generation",
+    "_passes",
+    "_ledger_totals",
     "generation",
     "mechanisms",
     "history_layout",

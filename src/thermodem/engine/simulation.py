@@ -49,12 +49,12 @@ from thermodem.kernels import contact as C
 from thermodem.kernels import pair_pass as PP
 from thermodem.kernels.integrate import (
     CHECK_CHUNK,
+    advance_walls,
     final_kick,
     kick_drift,
-    max_column,
+    ledger_totals,
     reduce_checks,
     reset_forces,
-    sum_rows,
 )
 from thermodem.models import registry
 from thermodem.models.tables import pair_table  # noqa: F401 (public here too)
@@ -161,6 +161,8 @@ class Simulation:
         # heat arguments of the contact passes when no heat is due (the scratch is unused)
         zm = np.zeros((len(HEAT_MECHANISMS), 1))  # (the layout of Particles.heat_columns)
         self._no_heat = (False, z1, 0, z3, 0, z3, 0, z1, z1, z2, zm, z1, 0.0)
+        self._passes: dict[bool, tuple] = {}  # (pair pass, wall pass) by "heat compiled in"
+        self._ledger_totals = np.zeros(C.LEDGER_WIDTH + 1)  # scratch of _accumulate_ledger
         self.thermal = None
         if case.thermal is not None:
             from thermodem.engine.thermal import ThermalEngine
@@ -357,13 +359,9 @@ class Simulation:
         fused = heat_due and th.contact.active
         if heat_due:
             th.prepare(self.time)
-        if fused:
-            pair_pass, wall_pass = PP.passes_for(
-                True, th.radius_id, th.conduction_id, th.override, layout, self.generation
-            )
-        else:
+        pair_pass, wall_pass = self._contact_passes(th is not None and th.contact.active)
+        if not fused:
             pair_heat = self._no_heat
-            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, self.generation)
         if self.generation:
             gen = (True, p.generation_energy, th.generation.select, th.generation.partition)
         else:
@@ -407,17 +405,32 @@ class Simulation:
                        p.moment_of_inertia, self.dt, self.planar)  # fmt: skip
         self._accumulate_ledger(kick)
 
+    def _contact_passes(self, conducts: bool) -> tuple:
+        """(particle pair pass, wall pair pass) of this case: compiled with the contact
+        conduction when the case has a contact conduction model (that pass serves the steps
+        without heat too: one compiled variant, kernels/pair_pass.py), else mechanics only."""
+        passes = self._passes.get(conducts)
+        if passes is None:
+            layout = self.history_layout.offsets
+            if conducts:
+                th = self.thermal
+                ids = (th.radius_id, th.conduction_id, th.override)
+            else:
+                ids = (0, 0, 0)
+            passes = PP.passes_for(conducts, *ids, layout, self.generation, self.model_ids)
+            self._passes[conducts] = passes
+        return passes
+
     def _accumulate_ledger(self, count_dissipation: bool) -> None:
         pb, wb = self.pairs, self.walls
-        npc = pb.ngroups
         nwc = (self.particles.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
-        sums = sum_rows(pb.chunk_ledger, npc) + sum_rows(wb.chunk_ledger, nwc)
-        self.elastic = sums[C.L_ELASTIC_NORMAL : C.L_ELASTIC_ROLLING + 1].copy()
+        totals = self._ledger_totals
+        ledger_totals(pb.chunk_ledger, pb.ngroups, wb.chunk_ledger, nwc,
+                      C.L_MAX_OVERLAP_RATIO, totals)  # fmt: skip
+        sums = totals.tolist()  # (Python floats: cheaper to add up than NumPy scalars)
+        self.elastic = totals[C.L_ELASTIC_NORMAL : C.L_ELASTIC_ROLLING + 1].copy()
         self.contact_count = int(sums[C.L_TOUCHING])
-        self.max_overlap_ratio = max(
-            max_column(pb.chunk_ledger, npc, C.L_MAX_OVERLAP_RATIO),
-            max_column(wb.chunk_ledger, nwc, C.L_MAX_OVERLAP_RATIO),
-        )
+        self.max_overlap_ratio = sums[C.LEDGER_WIDTH]
         if count_dissipation:
             cum = self.ledger_cumulative
             for name, column in zip(LEDGER_DISSIPATION, _DISSIPATION_COLUMNS, strict=True):
@@ -485,9 +498,7 @@ class Simulation:
         self.time = (self.step_count + 1) * self.dt
         self.step_count += 1
         if self.wall_rows.shape[0]:
-            self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3] += (
-                self.wall_rows[:, WL.COL_VELOCITY : WL.COL_VELOCITY + 3] * self.dt
-            )
+            advance_walls(self.wall_rows, WL.COL_POINT, WL.COL_VELOCITY, self.dt)
         for pourer in self.pourers:
             if pourer.due(self.time, self.dt):
                 self.add_particles(
@@ -548,9 +559,9 @@ class Simulation:
         )
 
     def _check_overlap(self) -> None:
-        where = self._where()
         limit = self.case.simulation.max_overlap_ratio
         if self.max_overlap_ratio > limit:
+            where = self._where()
             _, gid, other, kind = D.worst_overlap(self)
             who = f"particle {gid} and {kind}" + (f" {other}" if other >= 0 else "")
             raise SimulationError(

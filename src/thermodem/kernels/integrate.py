@@ -187,6 +187,52 @@ def sum_rows(table, count):
 
 
 @njit(cache=True, error_model="numpy")
+def ledger_totals(pair_table, pair_count, wall_table, wall_count, max_col, out):
+    """The step's ledger: into ``out[:width]`` the column sums of the first ``pair_count``
+    rows of ``pair_table`` plus those of the first ``wall_count`` rows of ``wall_table`` (in
+    a fixed order), into ``out[width]`` the largest value of column ``max_col`` of both (the
+    overlap ratio; 0 if none). One kernel call per step instead of four and no allocation."""
+    width = pair_table.shape[1]
+    best = 0.0
+    for c in range(width):
+        a = 0.0
+        for r in range(pair_count):
+            a += pair_table[r, c]
+        b = 0.0
+        for r in range(wall_count):
+            b += wall_table[r, c]
+        out[c] = a + b
+    for r in range(pair_count):
+        if pair_table[r, max_col] > best:
+            best = pair_table[r, max_col]
+    for r in range(wall_count):
+        if wall_table[r, max_col] > best:
+            best = wall_table[r, max_col]
+    out[width] = best
+
+
+@njit(cache=True, error_model="numpy")
+def advance_walls(wall_rows, point_col, velocity_col, dt):
+    """Move every wall's reference point by its velocity × dt (rows of geometry/wall_layout)."""
+    for w in range(wall_rows.shape[0]):
+        for a in range(3):
+            wall_rows[w, point_col + a] += wall_rows[w, velocity_col + a] * dt
+
+
+@njit(cache=True, error_model="numpy")
+def max_wall_shift(wall_rows, point_col, reference):
+    """Largest distance of a wall's reference point from its position at the last rebuild."""
+    best = 0.0
+    for w in range(wall_rows.shape[0]):
+        d2 = 0.0
+        for a in range(3):
+            d = wall_rows[w, point_col + a] - reference[w, a]
+            d2 += d * d
+        best = max(best, d2)
+    return np.sqrt(best)
+
+
+@njit(cache=True, error_model="numpy")
 def max_column(table, count, col):
     best = 0.0
     for r in range(count):

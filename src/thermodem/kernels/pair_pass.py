@@ -62,39 +62,49 @@ def passes_for(
     conduction_id: int,
     override: int,
     layout: tuple[int, ...],
-    generation: bool = False,
+    generation: bool,
+    mechanics: tuple[int, int, int],
 ) -> tuple:
     """(particle pair pass, wall pair pass) for one model combination and history layout.
 
     The heat switch, the contact radius and direct conduction model ids, the k(T)/ρc(T)
     override, the history offsets ``layout`` (``HistoryLayout.offsets``: normal, spring,
-    roll, collision, reuse; -1 for an absent block; state/history.py) and the heat generation
-    switch are compile-time constants of the particle pair pass, so the compiler drops the
-    code of every other model, of absent history blocks and, without heat generation, of the
-    deposits into the generation accumulators: the generic loop with the model switches
-    inside costs the simple conduction models ~20 ns per particle more (docs/architecture.md,
-    "Cost of the generic model switch"). Its arguments keep their order and types; the model,
-    layout and generation arguments passed in are ignored. Each combination in use compiles
-    once (~7 s on a 2-core machine) and is then cached on disk (Numba keys closures on their
-    constants) and in this process. The wall pass, a few percent of the time, is one generic
-    kernel of the mechanics for all model combinations (the offsets are its arguments),
-    compiled with or without the generation deposits (:func:`wall_pass_for`); the conduction
-    from walls follows it in a small pass compiled per model combination
+    roll, collision, reuse; -1 for an absent block; state/history.py), the heat generation
+    switch and the ``mechanics`` model ids (normal, tangential, rolling) are compile-time
+    constants of the particle pair pass, so the compiler drops the code of every other model,
+    of absent history blocks and, without heat generation, of the deposits into the
+    generation accumulators: the generic loop with the model switches inside costs the
+    simple conduction models ~20 ns per particle more (docs/architecture.md, "Cost of the
+    generic model switch"), and with every mechanics law inlined the pass took 12 s to
+    compile instead of 6 s. Its arguments keep their order and types; the model, layout and
+    generation arguments passed in are ignored (the heat switch passed in is honoured by the
+    pass compiled with heat). Each combination in use compiles once
+    (~6 s on a 2-core machine) and is then cached on disk (Numba keys closures on their
+    constants) and in this process. The wall pass is compiled per mechanics combination,
+    history layout and generation switch (:func:`wall_pass_for`); the conduction from walls
+    follows it in a small pass compiled per conduction model combination
     (:func:`thermodem.kernels.thermal.conduction_wall_pass_for`): the generic wall pass with
     every conduction model inlined took 16 s of a 40 s cold start.
     """
     key = (bool(heat_on), int(radius_id), int(conduction_id), int(override))
     if not key[0]:
         key = (False, 0, 0, 0)
-    key = (*key, tuple(int(c) for c in layout), bool(generation))
+    layout = tuple(int(c) for c in layout)
+    mechanics = tuple(int(m) for m in mechanics)
+    key = (*key, layout, bool(generation), mechanics)
     if key not in _PASSES:
-        _PASSES[key] = (_compile_pair_pass(*key), wall_pass_for(key[-1]))
+        _PASSES[key] = (
+            _compile_pair_pass(*key),
+            wall_pass_for(bool(generation), layout, mechanics),
+        )
     return _PASSES[key]
 
 
 def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int,  # noqa: N803
-                       LAYOUT: tuple[int, ...], GENERATION: bool):  # noqa: ANN202, N803  # fmt: skip
+                       LAYOUT: tuple[int, ...], GENERATION: bool,  # noqa: N803
+                       MECHANICS: tuple[int, int, int]):  # noqa: ANN202, N803  # fmt: skip
     """Define the particle pair pass with the model choice captured as constants."""
+    NORMAL_ID, TANGENTIAL_ID, ROLLING_ID = MECHANICS  # noqa: N806
     REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
     H_NORMAL = LAYOUT[HL.NORMAL]  # noqa: N806
     H_SPRING = LAYOUT[HL.SPRING]  # noqa: N806
@@ -160,16 +170,21 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         ``gen_partition[type_i, type_j]`` (i's share of friction and other heat), and a
         collision that ends adds the kinetic energy the pair lost (with a collision block).
 
-        With ``heat_on`` the same pass evaluates the conduction of every touching pair (see
+        With ``heat_on`` (an argument: the pass compiled with heat serves the steps without
+        heat too, with the arguments ``Simulation._no_heat``; one compiled variant less, 6 s
+        of a cold start; compiled without heat, the code is dropped) the same pass evaluates
+        the conduction of every touching pair (see
         :func:`thermodem.kernels.conduction.pair_conductance`) with the temperatures of this
         moment, and adds the heat rate to the direct-conduction column of ``by_mechanism`` and
         the conductance to ``conductance_sum`` of both particles (the caller zeroes them first).
         """
         # the model choice as compile-time constants (see passes_for)
-        heat_on = HEAT_ON
         radius_id = RADIUS_ID
         conduction_id = CONDUCTION_ID
         override = OVERRIDE
+        normal_id = NORMAL_ID
+        tangential_id = TANGENTIAL_ID
+        rolling_id = ROLLING_ID
         if not REUSABLE:
             tolerance = 0.0  # (the reuse's code is dropped)
         length = upper - lower
@@ -177,7 +192,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         for parity in range(2):
             for half in prange((ngroups + 1 - parity) // 2):
                 g = 2 * half + parity
-                srow = scratch[g] if heat_on else scratch[0]  # (one row when heat is off)
+                srow = scratch[g] if HEAT_ON and heat_on else scratch[0]  # (one row if no heat)
                 row = chunk_ledger[g]
                 for q in range(row.shape[0]):
                     row[q] = 0.0
@@ -318,7 +333,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     # conduction of touching pairs (one call site: Numba's SSA check warns
                     # when the inlined model selection appears twice in one function); pairs
                     # across a gap are the range set's (engine/range_set.py)
-                    if heat_on and out_state[k] == STATE_TOUCHING:
+                    if HEAT_ON and heat_on and out_state[k] == STATE_TOUCHING:
                         h = _pp_conductance(
                             k, i, j, ri, rj, dist, overlap, eff_mass, type_id, history,
                             out_normal_force, radius_id, radius_table, conduction_id,
@@ -334,20 +349,27 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
     return particle_pair_pass
 
 
-_WALL_PASSES: dict[bool, object] = {}
+_WALL_PASSES: dict[tuple, object] = {}
 
 
-def wall_pass_for(generation: bool):  # noqa: ANN201
-    """The wall pair pass with (or without) the heat generation deposits compiled in (a
-    compile-time constant: a case without heat generation does not compile them)."""
-    key = bool(generation)
+def wall_pass_for(generation: bool, layout: tuple[int, ...], mechanics: tuple[int, int, int]):  # noqa: ANN201
+    """The wall pair pass for one mechanics combination (normal, tangential, rolling ids) and
+    history layout, with (or without) the heat generation deposits compiled in: all three are
+    compile-time constants (the generic pass with every law inlined took 6 s to compile)."""
+    key = (bool(generation), tuple(int(c) for c in layout), tuple(int(m) for m in mechanics))
     if key not in _WALL_PASSES:
-        _WALL_PASSES[key] = _compile_wall_pass(key)
+        _WALL_PASSES[key] = _compile_wall_pass(*key)
     return _WALL_PASSES[key]
 
 
-def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
-    """Define the wall pair pass with the generation switch captured as a constant."""
+def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tuple[int, int, int]):  # noqa: ANN202, N803
+    """Define the wall pair pass with the generation switch, the history layout and the
+    mechanics model ids captured as constants."""
+    NORMAL_ID, TANGENTIAL_ID, ROLLING_ID = MECHANICS  # noqa: N806
+    H_NORMAL = LAYOUT[HL.NORMAL]  # noqa: N806
+    H_SPRING = LAYOUT[HL.SPRING]  # noqa: N806
+    H_ROLL = LAYOUT[HL.ROLL]  # noqa: N806
+    H_COLLISION = LAYOUT[HL.COLLISION] if GENERATION else -1  # noqa: N806
 
     @njit(cache=True, parallel=True, error_model="numpy")
     def wall_pair_pass(
@@ -389,17 +411,21 @@ def _compile_wall_pass(GENERATION: bool):  # noqa: ANN202, N803
 
         Runs over chunks of WALL_CHUNK particles and their wall pairs (``wall_row_start``). The
         conduction from fixed-temperature walls is a pass of its own after this one
-        (:func:`thermodem.kernels.thermal.conduction_wall_pass_for`, compiled per model
-        combination: the wall pairs are few, and this pass stays one kernel for all of them).
-        ``layout``: the history offsets (see :func:`passes_for`). With ``generation`` the
-        dissipated energies go to the particle's accumulators, its share ``gen_partition[type,
-        wall material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
+        (:func:`thermodem.kernels.thermal.conduction_wall_pass_for`, compiled per conduction
+        model combination: the wall pairs are few). ``layout`` and the model ids: ignored,
+        compile-time constants (:func:`wall_pass_for`). With ``generation`` the dissipated
+        energies go to the particle's accumulators, its share ``gen_partition[type, wall
+        material]`` of a wall with a fixed temperature (all of it at an adiabatic wall), the
         wall's share to the chunk's ledger row.
         """
-        h_normal = layout[HL.NORMAL]
-        h_spring = layout[HL.SPRING]
-        h_roll = layout[HL.ROLL]
-        h_collision = layout[HL.COLLISION] if GENERATION else -1
+        # the model choice and history layout as compile-time constants (see wall_pass_for)
+        normal_id = NORMAL_ID
+        tangential_id = TANGENTIAL_ID
+        rolling_id = ROLLING_ID
+        h_normal = H_NORMAL
+        h_spring = H_SPRING
+        h_roll = H_ROLL
+        h_collision = H_COLLISION
         n = radius.shape[0]
         nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
         for c in prange(nchunks):

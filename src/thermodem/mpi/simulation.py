@@ -47,6 +47,7 @@ from thermodem.kernels import contact as C
 from thermodem.kernels import pair_pass as PP
 from thermodem.kernels.integrate import (
     CHECK_CHUNK,
+    advance_walls,
     final_kick,
     kick_drift,
     reduce_checks,
@@ -213,9 +214,7 @@ class DistributedSimulation(Simulation):
         self.time = (self.step_count + 1) * self.dt
         self.step_count += 1
         if self.wall_rows.shape[0]:
-            self.wall_rows[:, WL.COL_POINT : WL.COL_POINT + 3] += (
-                self.wall_rows[:, WL.COL_VELOCITY : WL.COL_VELOCITY + 3] * self.dt
-            )
+            advance_walls(self.wall_rows, WL.COL_POINT, WL.COL_VELOCITY, self.dt)
         self._compute_forces(kick=True)
         self._check_overlap()
 
@@ -254,13 +253,9 @@ class DistributedSimulation(Simulation):
         fused = heat_due and th.contact.active
         if heat_due:
             th.prepare(self.time)
-        if fused:
-            pair_pass, wall_pass = PP.passes_for(
-                True, th.radius_id, th.conduction_id, th.override, layout, False
-            )
-        else:
+        pair_pass, wall_pass = self._contact_passes(th is not None and th.contact.active)
+        if not fused:
             pair_heat = self._no_heat
-            pair_pass, wall_pass = PP.passes_for(False, 0, 0, 0, layout, False)
         gen = (False, *self._no_generation)
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
