@@ -60,7 +60,7 @@ def instrument() -> None:
         ("reduce_checks", "checks"),
         ("reset_forces", "force reset"),
         ("final_kick", "final kick"),
-        ("sum_rows", "ledger sums"),
+        ("ledger_totals", "ledger sums"),
     ):
         _wrap(S, attr, name)
     _wrap(S.Simulation, "rebuild", "neighbour rebuild")

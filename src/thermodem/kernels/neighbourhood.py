@@ -172,6 +172,32 @@ def member_constants(offsets, border, index, area, member_area, member_count):
             member_count[i] = float(border[i] - offsets[i])
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _row_sum(values, index, first, last):
+    """Σ values[index[e]] for e in [first, last), in four interleaved partial sums (entries
+    e ≡ 0, 1, 2, 3 mod 4 from ``first``, added up as (a + b) + (c + d)): four independent
+    addition chains instead of one, so the gathers overlap (a fixed order: the same bits for
+    any thread count)."""
+    a = 0.0
+    b = 0.0
+    c = 0.0
+    d = 0.0
+    e = first
+    while e + 4 <= last:
+        a += values[index[e]]
+        b += values[index[e + 1]]
+        c += values[index[e + 2]]
+        d += values[index[e + 3]]
+        e += 4
+    if e < last:
+        a += values[index[e]]
+    if e + 1 < last:
+        b += values[index[e + 1]]
+    if e + 2 < last:
+        c += values[index[e + 2]]
+    return (a + b) + (c + d)
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def neighbourhood_sums(position, radius, temperature, offsets, border, index, area, emission,
                        member_area, member_count, lower, upper, periodic, ratio, mode,
@@ -194,12 +220,10 @@ def neighbourhood_sums(position, radius, temperature, offsets, border, index, ar
             s3 = 0.0
             if krause:
                 s3 = member_area[i]
-                for e in range(offsets[i], border[i]):
-                    s2 += emission[index[e]]
+                s2 = _row_sum(emission, index, offsets[i], border[i])
             if zhou:
                 s0 = member_count[i]
-                for e in range(offsets[i], border[i]):
-                    s1 += temperature[index[e]]
+                s1 = _row_sum(temperature, index, offsets[i], border[i])
             limit = q2 * radius[i] * radius[i]
             x = position[i, 0]
             y = position[i, 1]
