@@ -320,14 +320,13 @@ def etc(
     docs/effective-conductivity.md)."""
     import json
 
-    import numba
-
     from thermodem.config.load import load_case
     from thermodem.engine.etc import effective_conductivity_of_case
+    from thermodem.engine.threads import apply_threads
 
     t = _threads(threads)
     if t:
-        numba.set_num_threads(t)
+        apply_threads(t)
 
     def go() -> list:
         if periodic:

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import numba
 import numpy as np
 
 from thermodem.config.schema import Case
@@ -40,6 +39,7 @@ from thermodem.engine import diagnostics as D
 from thermodem.engine import external_loads as EL
 from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
+from thermodem.engine.threads import apply_threads
 from thermodem.engine.validation import check_completeness, check_insertion_memory
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
@@ -113,7 +113,7 @@ class Simulation:
         self.requested_threads = None if threads is None else int(threads)
         self.threads = self.requested_threads or 1
         self.threads_reason = ""
-        numba.set_num_threads(self.threads)
+        apply_threads(self.threads)
         check_completeness(case)  # validation layer 2 (engine/validation.py)
         self.case = case
         sim = case.simulation
@@ -254,7 +254,7 @@ class Simulation:
         self.threads, self.threads_reason = choose_threads(
             mean, self.pairs.count, self.requested_threads
         )
-        numba.set_num_threads(self.threads)
+        apply_threads(self.threads)
         return self.threads
 
     # ---------------------------------------------- ranks (thermodem.mpi overrides these)
@@ -517,7 +517,7 @@ class Simulation:
         """Advance ``steps`` steps, or until simulated time ``until`` [s]."""
         if (steps is None) == (until is None):
             raise ValueError("give exactly one of steps= or until=")
-        numba.set_num_threads(self.threads)  # another simulation may have changed it
+        apply_threads(self.threads)  # another simulation may have changed it
         if until is not None:
             dt = self.dt
             if self.thermal is not None and self.thermal.settings.frozen_mechanics:

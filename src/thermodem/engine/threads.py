@@ -23,6 +23,10 @@ parallel kernels in the child (thermodem itself never forks; ``subprocess`` is f
 ``Simulation(threads=...)``) a simulation takes 1 thread below :data:`PARALLEL_MIN_PARTICLES`
 particles (and :data:`PARALLEL_MIN_PAIRS` listed pairs), and every thread Numba has above
 (:func:`choose_threads`). Results do not depend on the thread count (tests/unit/test_threads.py).
+
+**Variants.** On one thread the parallel kernels run as serial twins
+(:mod:`thermodem.kernels.variants`: no parfor to compile, no thread launch per call); every
+change of the count goes through :func:`apply_threads`, which switches both.
 """
 
 from __future__ import annotations
@@ -84,6 +88,18 @@ def threading_layer() -> str:
     numba.get_num_threads()  # launches the layer
     name = numba.threading_layer()
     return f"{name} ({_layer_note})" if _layer_note else name
+
+
+def apply_threads(threads: int) -> None:
+    """Run the following kernels on ``threads`` Numba threads: the serial twins of the
+    parallel kernels on one thread (:mod:`thermodem.kernels.variants`), else the parallel
+    kernels with ``numba.set_num_threads(threads)``."""
+    import numba
+
+    from thermodem.kernels.variants import set_serial
+
+    numba.set_num_threads(int(threads))
+    set_serial(int(threads) == 1)
 
 
 def available_threads() -> int:

@@ -56,6 +56,7 @@ from numba import njit, prange
 
 from thermodem.errors import ConfigError, RunNotice, SimulationError
 from thermodem.geometry import wall_layout as wl
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.thermal.voronoi import INPUT_FACE_AREA, INPUT_WIDTH, closure_face_area
 
 if TYPE_CHECKING:
@@ -475,7 +476,7 @@ def wall_of_face(sim: Simulation, planes: list[Plane], particle: np.ndarray,
 
 
 # ------------------------------------------------------------------------- provider
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def _largest_move(position, reference, global_id, lower, upper, periodic, part):
     """Largest displacement since ``reference`` (rows by global id; minimum image), by fixed
     chunks: the maximum does not depend on the thread count."""
@@ -501,7 +502,7 @@ def _largest_move(position, reference, global_id, lower, upper, periodic, part):
     return math.sqrt(best)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def closure_inputs(pair_i, pair_j, wall_i, radius, fields, porosity_column, inputs,
                    wall_inputs):  # fmt: skip
     """A_n of the porosity closure (Zhou et al. 2009) for every pair: the mean of the two

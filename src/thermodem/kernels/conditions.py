@@ -11,6 +11,8 @@ import math
 
 from numba import njit, prange
 
+from thermodem.kernels.variants import parallel_kernel
+
 CHUNK = 4096  # particles per chunk of the condition passes
 
 # kinds of entries of apply_conditions
@@ -63,7 +65,7 @@ def _region_class(ref, b, margin, lower, upper, periodic, naxes):
     return 1 if inside else 2
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def classify_conditions(
     reference, radius, static_mask, kinds, values, has_region, boxes, margin, lower, upper,
     periodic, fixed, source, bath, code, disc_thickness, naxes,
@@ -117,7 +119,7 @@ def classify_conditions(
             bath[i] = t_bath
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def apply_listed(
     listed, code, position, radius, mass, type_id, temperature, c_by_type, static_mask, kinds,
     values, has_region, boxes, fixed, source, bath, part, disc_thickness,
@@ -173,7 +175,7 @@ def apply_listed(
     return total
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def external_weights(position, radius, lower, upper, gaussian, centre, axis, sigma, weight, part):
     """Weights π R² (× exp(-r²/2σ²) for a Gaussian profile, r the distance from the line
     through ``centre`` along ``axis``) of the particles inside the box, 0 outside; returns
@@ -208,7 +210,7 @@ def external_weights(position, radius, lower, upper, gaussian, centre, axis, sig
     return total
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def add_weighted(source, weight, scale):
     """source += scale × weight."""
     for i in prange(source.shape[0]):

@@ -5,14 +5,15 @@ from __future__ import annotations
 
 import math
 
-from numba import njit, prange
+from numba import prange
 
 from thermodem.kernels.contact import H_DURATION, H_IMPACT_VELOCITY
 from thermodem.kernels.neighbors import pair_separation, wall_distance
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def pair_geometry(
     position, radius, mass, type_id, pair_i, pair_j, rows, normal_force, history, lower, upper,
     periodic, radius_id, radius_table, out_point, out_normal, out_overlap, out_radius,
@@ -45,7 +46,7 @@ def pair_geometry(
         )  # fmt: skip
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def wall_geometry(
     position, radius, mass, type_id, wall_pair_i, wall_pair_w, rows, normal_force, history,
     wall_kind, wall_rows, wall_material, radius_id, radius_table, out_point, out_normal,

@@ -50,6 +50,7 @@ from thermodem.geometry.wall_layout import (
     RECTANGLE,
 )
 from thermodem.kernels.neighbors import pair_separation, wall_distance
+from thermodem.kernels.variants import parallel_kernel
 
 #: Columns of the per-particle field array (the engine's ``fields``).
 F_POROSITY = 0  # local porosity ε [-]
@@ -92,7 +93,7 @@ FIELD_NAMES: tuple[str, ...] = (
 CHUNK = 4096  # particles per chunk of the parallel passes
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def fill_column(fields, column, value):
     """fields[column, :] = value."""
     n = fields.shape[1]
@@ -101,7 +102,7 @@ def fill_column(fields, column, value):
             fields[column, i] = value
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def zero_columns(fields, first, last):
     """fields[first:last, :] = 0."""
     n = fields.shape[1]
@@ -131,7 +132,7 @@ def interp_held(x, nodes, values):
     return values[lo] + w * (values[hi] - values[lo])
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def table_column(fields, column, nodes, values, at_particle, temperature):
     """fields[column, :] = table(T) with T the fluid temperature at the particle
     (``at_particle`` False) or the particle's temperature (True)."""
@@ -142,7 +143,7 @@ def table_column(fields, column, nodes, values, at_particle, temperature):
             fields[column, i] = interp_held(t, nodes, values)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def prandtl_columns(fields):
     """Pr = c_f μ_f / k_f and Pr^(1/3) from the property rows."""
     n = fields.shape[1]
@@ -179,7 +180,7 @@ def _bracket(axis, x):
     return lo, (x - axis[lo]) / (axis[hi] - axis[lo]), False
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def grid_sample(position, axis_x, axis_y, axis_z, values, out, first, part):
     """Trilinear interpolation of ``values`` (nx, ny, nz, nc) on the rectilinear grid of the
     three axes at every particle into ``out[first:first + nc, i]``; a position outside the
@@ -217,7 +218,7 @@ def grid_sample(position, axis_x, axis_y, axis_z, values, out, first, part):
     return total
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def relative_speed(velocity, fluid_velocity, uniform, fields):
     """fields[F_RELATIVE_SPEED, :] = |u_f - v_p| (``fluid_velocity``: (3, n), or (3, 1) with
     ``uniform``)."""
@@ -275,7 +276,7 @@ def point_in_fluid(kind, row, x0, x1, x2):
     return True
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def cell_fluid_volume(lower, edge, dims, wall_kind, wall_rows, samples, out):
     """Volume of every cell on the particles' side of all walls, by a midpoint rule of
     ``samples``³ points per cell (``out``: one value per cell, x fastest)."""
@@ -319,7 +320,8 @@ def _cell_index(x, lower, edge, dims):
     return c
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+# inlined into cell_porosity (its prange is the caller's: kernels/variants.py)
+@njit(cache=True, inline="always", error_model="numpy")
 def _bin_solid(position, radius, lower, edge, dims, solid, cell):
     """Solid volume of the particles by the cell of their centre: the cells in parallel,
     the sums serially (a fixed order)."""
@@ -334,7 +336,7 @@ def _bin_solid(position, radius, lower, edge, dims, solid, cell):
         solid[cell[i]] += 4.0 / 3.0 * math.pi * r * r * r
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def cell_porosity(position, radius, lower, edge, dims, fluid_volume, solid, cell, fields):
     """Porosity of the cell of each particle's centre, 1 - V_solid / V_cell, clipped to
     [0, 1]: V_solid the volume of the particles whose centre is in the cell, V_cell the
@@ -361,7 +363,7 @@ def lens_volume(a, b, d):
     return math.pi * s * s * (d * d + 2.0 * d * (a + b) - 3.0 * (a - b) * (a - b)) / (12.0 * d)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def shell_pass(position, radius, pair_i, pair_j, group_start, lower, upper, periodic,
                shell_ratio, sums):  # fmt: skip
     """Shell porosity: sums[i, 0] += the volume of the neighbours inside the sphere of radius
@@ -382,7 +384,7 @@ def shell_pass(position, radius, pair_i, pair_j, group_start, lower, upper, peri
                 sums[j, 0] += lens_volume(shell_ratio * rj, ri, d)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def zero_rows(values):
     """values[:, :] = 0 (parallel)."""
     n = values.shape[0]
@@ -494,7 +496,7 @@ def cap_overlap(r, d1, n1x, n1y, n1z, d2, n2x, n2y, n2z):
     return total
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def shell_porosity(
     position, radius, wall_kind, wall_rows, shell_ratio, lattice, solid, scratch, fields
 ):  # solid: (n, 4), the neighbours' volume in column 0
@@ -556,7 +558,7 @@ def shell_porosity(
             fields[F_POROSITY, i] = min(max(eps, 0.0), 1.0)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def wall_view(position, radius, wall_kind, wall_rows, range_ratio, view_factor, fields):
     """For every particle, the fixed-temperature walls whose surface gap is below
     range_ratio × R_i: Σ F_iw (each wall ``view_factor``) into F_WALL_VIEW and Σ F_iw T_w⁴

@@ -11,14 +11,15 @@ the accumulators after the thermal step has used them.
 
 from __future__ import annotations
 
-from numba import njit, prange
+from numba import prange
 
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.state.heat import M_GENERATION
 
 CHUNK = 4096  # particles per parallel chunk
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def generation_heat(energy, select, conversion_fraction, dt, by_mechanism):
     """Write χ E_g / Δt into the generation column of every selected mechanism g (the other
     generation columns are left as they are: zero)."""

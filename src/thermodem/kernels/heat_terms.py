@@ -41,6 +41,7 @@ from numba import njit, prange
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
 from thermodem.kernels.contact import H_DURATION, H_IMPACT_VELOCITY, STATE_TOUCHING
 from thermodem.kernels.neighbors import minimum_image, pair_separation, wall_distance
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.thermal.contact_radius import (
     contact_radius_dispatch,
     geometric_contact_radius,
@@ -90,7 +91,7 @@ def _row(table_row, k_col_i, k_col_j, k_i, k_j, scratch_row):
     return scratch_row
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def range_pair_pass(
     position, radius, temperature, type_id, pair_i, pair_j, group_start, lower, upper,
     periodic, evaluator, model_id, table, k_col_i, k_col_j, k_particle, scratch, column,
@@ -127,7 +128,7 @@ def range_pair_pass(
                     conductance_sum[j] += h
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def range_wall_pass(
     position, radius, temperature, type_id, wall_pair_w, wall_row_start, wall_kind, wall_rows,
     wall_material, evaluator, model_id, table, k_col_i, k_col_j, k_particle, k_wall, scratch,
@@ -161,7 +162,7 @@ def range_wall_pass(
                     conductance_sum[i] += h
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def contact_term_pair_pass(
     position, radius, mass, temperature, type_id, pair_i, pair_j, group_start, state,
     normal_force, history, lower, upper, periodic, radius_id, radius_table, evaluator,
@@ -207,7 +208,7 @@ def contact_term_pair_pass(
                     out_conductance[k] = h
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def contact_term_wall_pass(
     position, radius, mass, temperature, type_id, wall_pair_w, wall_row_start, state,
     normal_force, history, wall_kind, wall_rows, wall_material, radius_id, radius_table,
@@ -314,7 +315,7 @@ def _reuse_row(model_id, p, ri, rj, dist, h, area, tolerance, row):
     row[REUSE_AREA] = area
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def external_pair_pass(
     position, radius, type_id, pair_i, pair_j, inputs, lower, upper, periodic, evaluator,
     model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance, tolerance, reuse,
@@ -369,7 +370,7 @@ def external_pair_pass(
     return evaluated
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def external_wall_pass(
     position, radius, temperature, type_id, wall_i, wall_w, wall_offsets, inputs, wall_kind,
     wall_rows, wall_material, model_id, table, k_col_i, k_col_j, k_particle, k_wall, scratch,
@@ -407,7 +408,7 @@ def external_wall_pass(
                     conductance_sum[i] += h
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def csr_heat(
     offsets, entries, pair_i, pair_j, conductance, temperature, column, by_mechanism,
     conductance_sum,
@@ -436,7 +437,7 @@ def particle_term(evaluator, model_id, p, t_i, r_i, fields, i):
     return radiation_dispatch(model_id, p, t_i, r_i, fields, i)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def particle_pass(
     temperature, radius, type_id, fields, evaluator, model_id, table, column, evaluator2,
     model_id2, table2, column2, by_mechanism, conductance_sum,
@@ -464,7 +465,7 @@ def particle_pass(
                 conductance_sum[i] += g
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def pair_heat_from_conductance(
     pair_i, pair_j, group_start, conductance, temperature, column, by_mechanism,
     conductance_sum,
@@ -487,7 +488,7 @@ def pair_heat_from_conductance(
                     conductance_sum[j] += h
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def wall_heat_from_conductance(
     wall_pair_w, wall_row_start, wall_rows, conductance, temperature, column, by_mechanism,
     conductance_sum,
@@ -503,7 +504,7 @@ def wall_heat_from_conductance(
                 conductance_sum[i] += h
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def zero_heat(by_mechanism, conductance_sum):
     """Every mechanism column and the conductance sums to zero (before the terms add)."""
     for i in prange(by_mechanism.shape[1]):
@@ -512,7 +513,7 @@ def zero_heat(by_mechanism, conductance_sum):
         conductance_sum[i] = 0.0
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def largest_displacement(position, reference, lower, upper, periodic, part):
     """Largest displacement since the reference positions (minimum image on periodic axes),
     parallel over fixed chunks of PARTICLE_CHUNK (``part``: at least one scratch value per

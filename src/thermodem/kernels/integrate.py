@@ -19,10 +19,12 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from thermodem.kernels.variants import parallel_kernel
+
 CHECK_CHUNK = 4096
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def kick_drift(
     position,
     velocity,
@@ -104,7 +106,7 @@ def reduce_checks(chunk_check, n):
     return math.sqrt(best), -1, 0
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def reset_forces(
     force,
     torque,
@@ -137,7 +139,7 @@ def reset_forces(
             conductance_sum[i] = 0.0
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def external_power(velocity, angular_velocity, external_force, external_torque, scratch):
     """Σ_i F_ext,i · v_i + T_ext,i · ω_i [W] (constant external loads), summed per chunk of
     CHECK_CHUNK particles in parallel (into column 0 of ``scratch``, the chunk check array of
@@ -159,7 +161,7 @@ def external_power(velocity, angular_velocity, external_force, external_torque, 
     return total
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def final_kick(velocity, angular_velocity, force, torque, mass, inertia, dt, planar):
     """Second half kick of velocity Verlet with the forces and torques at t + dt
     (``planar``: v_z and ω_x, ω_y kept at zero)."""

@@ -48,6 +48,7 @@ from thermodem.kernels.fields import (
     F_NEIGHBOURS,
 )
 from thermodem.kernels.neighbors import minimum_image, pair_separation
+from thermodem.kernels.variants import parallel_kernel
 
 #: Kinds of a listed neighbour.
 MEMBER = 0
@@ -129,6 +130,7 @@ def _insertion_sort(index, lo, hi):
         index[f + 1] = v
 
 
+# a parallel kernel called from the serial member_fill: no serial twin (kernels/variants.py)
 @njit(cache=True, parallel=True, error_model="numpy")
 def _sort_rows(offsets, border, index):
     """The members and the border entries of each row by neighbour index (rows of ~15)."""
@@ -144,7 +146,7 @@ NB_KRAUSE = 1  # Σ ε_j A_j T_j⁴ / 2 and Σ ε_j A_j / 2 (krause2017)
 NB_ZHOU = 2  # n_p and Σ T_j (zhou2009)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def neighbourhood_weights(radius, temperature, type_id, emissivity, area, emission):
     """Per particle: area[i] = ε_i A_i / 2 and emission[i] = ε_i A_i T_i⁴ / 2, what it adds
     to the sums of the spheres it lies in (krause2017)."""
@@ -157,7 +159,7 @@ def neighbourhood_weights(radius, temperature, type_id, emissivity, area, emissi
             emission[i] = w * (t * t) * (t * t)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def member_constants(offsets, border, index, area, member_area, member_count):
     """The parts of the sums that do not change while the listing holds: Σ ε_j A_j / 2 and
     the count over each row's members (in row order: the same numbers as summing them at
@@ -198,7 +200,7 @@ def _row_sum(values, index, first, last):
     return (a + b) + (c + d)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def neighbourhood_sums(position, radius, temperature, offsets, border, index, area, emission,
                        member_area, member_count, lower, upper, periodic, ratio, mode,
                        fields):  # fmt: skip

@@ -20,7 +20,7 @@ Sign conventions: see :mod:`thermodem.kernels.contact`.
 
 from __future__ import annotations
 
-from numba import njit, prange
+from numba import prange
 
 from thermodem.geometry.wall_layout import (
     COL_AXIS,
@@ -47,6 +47,7 @@ from thermodem.kernels.contact import (
 )
 from thermodem.kernels.contact_conduction import _pp_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.state import history as HL
 from thermodem.state.heat import G_COLLISION, M_DIRECT
 
@@ -113,7 +114,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
     H_REUSE = LAYOUT[HL.REUSE]  # noqa: N806
     REUSABLE = REUSABLE and H_REUSE >= 0  # noqa: N806
 
-    @njit(cache=True, parallel=True, error_model="numpy")
+    @parallel_kernel(error_model="numpy")
     def particle_pair_pass(
         position,
         velocity,
@@ -371,7 +372,7 @@ def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tup
     H_ROLL = LAYOUT[HL.ROLL]  # noqa: N806
     H_COLLISION = LAYOUT[HL.COLLISION] if GENERATION else -1  # noqa: N806
 
-    @njit(cache=True, parallel=True, error_model="numpy")
+    @parallel_kernel(error_model="numpy")
     def wall_pair_pass(
         position,
         velocity,

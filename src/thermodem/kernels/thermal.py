@@ -20,6 +20,7 @@ from thermodem.geometry.wall_layout import COL_THERMAL_KIND
 from thermodem.kernels.contact import CHUNK, STATE_TOUCHING
 from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.state.heat import M_SOURCE
 
 _CONDUCTION_PASSES: dict[tuple[int, int, int], Any] = {}
@@ -40,7 +41,7 @@ def conduction_pair_pass_for(radius_id: int, conduction_id: int, override: int) 
 def _compile_conduction_pair_pass(RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int):  # noqa: N803, ANN202
     REUSABLE = reusable(CONDUCTION_ID)  # noqa: N806
 
-    @njit(cache=True, parallel=True, error_model="numpy")
+    @parallel_kernel(error_model="numpy")
     def conduction_pair_pass(
         position, radius, mass, temperature, type_id, pair_i, pair_j, npairs, state, normal_force,
         history, lower, upper, periodic, radius_id, radius_table, conduction_id, conduction_table,
@@ -227,7 +228,7 @@ def total_enthalpy(temperature, mass, type_id, table_t, table_c, table_n):
     return total
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def finish_heat(source, heat_rate, by_mechanism, columns):
     """Source column and total heat rate: the sum of the mechanism columns ``columns`` (the
     columns in use, ascending; the others are zero)."""
@@ -244,7 +245,7 @@ EULER_CHUNK = 4096
 EULER_FIXED = 4
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type_id,
                c_by_type, conductance_sum, fixed, dt, part, clear):  # fmt: skip
     """One fused per-particle thermal update with constant specific heats.

@@ -130,7 +130,7 @@ class DistributedSimulation(Simulation):
 
     def set_threads(self, threads: int | None = None) -> int:
         """One Numba thread per rank unless asked (``--threads``): the ranks share the cores."""
-        import numba
+        from thermodem.engine.threads import apply_threads
 
         if threads is not None:
             self.requested_threads = int(threads)
@@ -138,7 +138,7 @@ class DistributedSimulation(Simulation):
         self.threads_reason = (
             "requested" if self.requested_threads else f"one per rank on {self.size} MPI ranks"
         )
-        numba.set_num_threads(self.threads)
+        apply_threads(self.threads)
         return self.threads
 
     # ---------------------------------------------------------------- agreement of failures

@@ -51,6 +51,7 @@ from thermodem.kernels.fields import (
     F_RELATIVE_SPEED,
     F_SURFACE_VISCOSITY,
 )
+from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.registry import packed, register
 from thermodem.state.materials import PairContext
 
@@ -300,7 +301,7 @@ def convection_dispatch(model_id, p, t_i, r_i, fields, i):
 
 
 # ------------------------------------------------------------ dimensionless numbers, ranges
-@njit(cache=True, parallel=True, error_model="numpy")
+@parallel_kernel(error_model="numpy")
 def convection_numbers(
     fields, radius, temperature, type_id, model_id, table, gravity, beta_mode, beta,
     with_nusselt, out,

@@ -1,0 +1,102 @@
+"""Parallel kernels with a serial twin for one-thread runs.
+
+A kernel compiled with ``parallel=True`` costs more to compile than the same loop compiled
+serially (the parfor lowering and fusion: 3 of the particle pair pass's 7 s, 2 of the wall
+pass's 3.5 s on a 2-core VM) and each call launches the threading layer even with one thread
+(~0.9 µs per call with OpenMP). Small cases run on one thread
+(:func:`thermodem.engine.threads.choose_threads`), so for them thermodem runs the same
+Python function compiled without ``parallel``: ``prange`` is then ``range`` and the loop
+order, hence every sum, is the one of the parallel kernel on one thread (the parallel
+kernels are written so that their result does not depend on the thread count; tests check
+1 vs 2 threads bit-identical, and serial vs parallel).
+
+:func:`parallel_kernel` replaces ``@njit(cache=True, parallel=True, ...)``. It returns a
+:class:`ParallelKernel`, called like the dispatcher; which variant runs follows the thread
+count set through :func:`thermodem.engine.threads.apply_threads` (serial iff one thread).
+Each variant is compiled on its first call only, and cached on disk under its own name
+(``<qualname>__serial``): Numba keys a cached kernel on its file, name, line, bytecode and
+closure constants but not on ``parallel``, so two variants with one name would load each
+other's machine code.
+
+A :class:`ParallelKernel` is called from Python only (the orchestration); a kernel that
+another compiled function calls stays a plain ``njit`` function.
+"""
+
+from __future__ import annotations
+
+import types
+from collections.abc import Callable
+from typing import Any
+
+from numba import njit
+
+
+class _Mode:
+    """Which variant runs: the serial one iff ``serial``."""
+
+    serial = False
+
+
+def set_serial(serial: bool) -> None:
+    """Run the serial twins (``True``, a one-thread run) or the parallel kernels."""
+    _Mode.serial = bool(serial)
+
+
+def serial_mode() -> bool:
+    """Whether the serial twins run."""
+    return _Mode.serial
+
+
+class ParallelKernel:
+    """A ``parallel=True`` dispatcher and its serial twin (made on first use)."""
+
+    def __init__(self, dispatcher: Any, options: dict) -> None:
+        self.parallel = dispatcher
+        self._serial = None
+        self._options = options
+        self.__name__ = dispatcher.py_func.__name__
+        self.__qualname__ = dispatcher.py_func.__qualname__
+        self.__doc__ = dispatcher.py_func.__doc__
+
+    @property
+    def py_func(self) -> Callable:
+        """The Python function both variants compile."""
+        return self.parallel.py_func
+
+    @property
+    def serial(self) -> Any:
+        """The serial twin: the same function (code, globals, closure) under the name
+        ``<qualname>__serial``, compiled without ``parallel``."""
+        if self._serial is None:
+            f = self.parallel.py_func
+            twin = types.FunctionType(
+                f.__code__, f.__globals__, f.__name__, f.__defaults__, f.__closure__
+            )
+            twin.__qualname__ = f.__qualname__ + "__serial"
+            twin.__module__ = f.__module__
+            twin.__doc__ = f.__doc__
+            twin.__kwdefaults__ = f.__kwdefaults__
+            self._serial = njit(cache=True, parallel=False, **self._options)(twin)
+        return self._serial
+
+    def __call__(self, *args: Any) -> Any:
+        if _Mode.serial:
+            s = self._serial
+            if s is None:
+                s = self.serial
+            return s(*args)
+        return self.parallel(*args)
+
+    def __repr__(self) -> str:
+        return f"<ParallelKernel {self.__qualname__}>"
+
+
+def parallel_kernel(**options: Any) -> Callable[[Callable], ParallelKernel]:
+    """Decorator: ``@parallel_kernel(error_model="numpy")`` compiles the function with
+    ``njit(cache=True, parallel=True, **options)`` and gives it a serial twin (see the module
+    docstring)."""
+
+    def wrap(f: Callable) -> ParallelKernel:
+        return ParallelKernel(njit(cache=True, parallel=True, **options)(f), options)
+
+    return wrap

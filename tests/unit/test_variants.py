@@ -1,0 +1,92 @@
+"""Serial twins of the parallel kernels (kernels/variants.py).
+
+On one thread the parallel kernels run compiled without ``parallel``; the result must be the
+one of the parallel kernel (tests/unit/test_threads.py compares whole runs on 1 thread, now
+serial, with 2 threads, bit for bit). Here: the twin is a separate compiled function with a
+cache entry of its own (Numba does not key its cache on ``parallel``: with one name the
+twins would load each other's machine code), it keeps a factory's closure constants, the
+thread count switches the variant, and serial and parallel give identical sums.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+from numba import prange
+
+from thermodem.engine.threads import apply_threads
+from thermodem.kernels import variants as V
+
+
+@V.parallel_kernel(error_model="numpy")
+def _chunk_sums(values, out):
+    chunk = 64
+    for c in prange(out.shape[0]):
+        total = 0.0
+        for k in range(c * chunk, min(values.shape[0], (c + 1) * chunk)):
+            total += values[k] * values[k]
+        out[c] = total
+
+
+def _scaled(factor):
+    @V.parallel_kernel()
+    def scale(values, out):
+        for k in prange(values.shape[0]):
+            out[k] = factor * values[k]
+
+    return scale
+
+
+@pytest.fixture
+def restore_threads():
+    previous = numba.get_num_threads()
+    yield
+    apply_threads(previous)
+
+
+def test_serial_twin_is_its_own_compiled_function(restore_threads):
+    values = np.random.default_rng(3).random(1000)
+    parallel = np.zeros(16)
+    serial = np.zeros(16)
+    _chunk_sums.parallel(values, parallel)
+    _chunk_sums.serial(values, serial)
+    assert np.array_equal(parallel, serial)
+    expected = [np.sum(values[c * 64 : (c + 1) * 64] ** 2) for c in range(16)]
+    np.testing.assert_allclose(serial, expected, rtol=1e-14)
+    assert _chunk_sums.serial is not _chunk_sums.parallel
+    assert _chunk_sums.serial.targetoptions.get("parallel") in (None, False)
+    assert _chunk_sums.parallel.targetoptions["parallel"]
+    # their own cache entries (index files named after the qualname)
+    assert _chunk_sums.serial.py_func.__qualname__ == "_chunk_sums__serial"
+    names = {d._cache._impl.filename_base for d in (_chunk_sums.serial, _chunk_sums.parallel)}
+    assert len(names) == 2
+
+
+def test_twin_keeps_the_closure_constants():
+    values = np.arange(5.0)
+    out = np.zeros(5)
+    double, triple = _scaled(2.0), _scaled(3.0)
+    double.serial(values, out)
+    assert np.array_equal(out, 2.0 * values)
+    triple.serial(values, out)
+    assert np.array_equal(out, 3.0 * values)
+    triple.parallel(values, out)
+    assert np.array_equal(out, 3.0 * values)
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
+def test_thread_count_switches_the_variant(restore_threads):
+    values = np.ones(10)
+    apply_threads(1)
+    assert V.serial_mode() and numba.get_num_threads() == 1
+    apply_threads(2)
+    assert not V.serial_mode() and numba.get_num_threads() == 2
+    twin = _scaled(5.0)
+    out = np.zeros(10)
+    twin(values, out)  # two threads: the parallel kernel compiles, the twin does not
+    assert twin._serial is None and twin.parallel.signatures
+    apply_threads(1)
+    twin(values, out)
+    assert twin._serial is not None and twin._serial.signatures
+    assert np.array_equal(out, 5.0 * values)
