@@ -8,7 +8,8 @@ geometric contact radius, the particles with centre z < 1.5 mm held at 400 K (se
 region or by their material), the rest at 300 K, adiabatic walls, heat every step (case
 ``heat``: no fixed particles, T = 300 K + 1000 K/m × z instead). ``--indirect`` adds an
 indirect_conduction model on the range pair set (the issue-10 benchmark: rong_horio1999
-with layer_thickness_ratio 0.25 and 0.5, i.e. gaps of 0.5 R̄ and 1.0 R̄). 500
+with layer_thickness_ratio 0.5 and 1.0, i.e. conducting gaps up to δ_f = 0.5 R̄ and 1.0 R̄
+for these equal spheres: Rong & Horio's range is 2 R_p + δ_f > d). 500
 untimed steps, then the timed steps; throughput = N × steps / loop seconds.
 
     python bench/bench_shared_bed.py [--threads 1 2] [--steps 1000] [--warmup 500]

@@ -130,13 +130,16 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
         k_i, k_j = term.k_columns if th.override else (-1, -1)
         scratch = th._term_rows(rows_needed)
         if term.target == "range":
-            heat_terms.range_pair_pass(
+            range_pair_pass, range_wall_pass = heat_terms.range_passes_for(
+                term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0
+            )
+            range_pair_pass(
                 p.position, p.radius, p.temperature, p.type_id, pb.i, pb.j, pb.group_start,
                 sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table,
                 k_i, k_j, th.k_p, scratch, term.column, by_mech, sums, True, pair_h,
                 term.needs_contact_radius,
             )  # fmt: skip
-            heat_terms.range_wall_pass(
+            range_wall_pass(
                 p.position, p.radius, p.temperature, p.type_id, wb.j, sim.wall_row_start,
                 sim.wall_kind, sim.wall_rows, sim.wall_material, term.evaluator, term.model_id,
                 term.table, k_i, k_j, th.k_p, th.k_w, scratch, term.wall_column, by_mech, sums,

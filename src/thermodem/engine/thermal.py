@@ -643,13 +643,16 @@ class ThermalEngine:
         k_i, k_j = term.k_columns if self.override else (-1, -1)
         rows = max(rs.ngroups, p.count // passes.WALL_CHUNK + 1)
         scratch = self._term_rows(rows)
-        passes.range_pair_pass(
+        range_pair_pass, range_wall_pass = passes.range_passes_for(
+            term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0
+        )
+        range_pair_pass(
             p.position, p.radius, p.temperature, p.type_id, rs.i, rs.j, rs.group_start,
             sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table, k_i,
             k_j, self.k_p, scratch, term.column, by_mech, self.conductance_sum, store, pair_h,
             term.needs_contact_radius,
         )  # fmt: skip
-        passes.range_wall_pass(
+        range_wall_pass(
             p.position, p.radius, p.temperature, p.type_id, rs.wall_w, rs.wall_row_start,
             sim.wall_kind, sim.wall_rows, sim.wall_material, term.evaluator, term.model_id,
             term.table, k_i, k_j, self.k_p, self.k_w, scratch, term.wall_column, by_mech,
