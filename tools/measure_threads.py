@@ -108,7 +108,7 @@ def main() -> None:
             times: dict[int, list[float]] = {k: [] for k in (1, 2)}
             for _ in range(args.rounds):
                 for threads in counts:
-                    numba.set_num_threads(threads)
+                    sim.set_threads(threads)  # (run() applies the simulation's count)
                     t0 = time.perf_counter()
                     sim.run(steps=args.steps)
                     times[threads].append(1e3 * (time.perf_counter() - t0) / args.steps)

@@ -548,3 +548,26 @@ def test_pair_buffer_growth_keeps_the_history(monkeypatch):
     fixed = run(100_000)
     assert max(kept) == 0, kept
     assert np.array_equal(grown, fixed)
+
+
+def test_order_within_groups_is_a_stable_sort_by_group_then_lower_index():
+    """The range set's in-group order (kernels/slabs.py), one group at a time, against a
+    stable NumPy sort of the whole list by (group, lower particle index)."""
+    from thermodem.kernels import slabs
+
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        n = int(rng.integers(0, 2000))
+        groups = int(rng.integers(1, 30))
+        pair_i = rng.integers(0, 300, n + 5).astype(np.int32)  # (5 slots past the count)
+        pair_j = rng.integers(0, 300, n + 5).astype(np.int32)
+        cuts = np.sort(rng.integers(0, n + 1, groups - 1))
+        group_start = np.concatenate([[0], cuts, [n]]).astype(np.int64)
+        lower = np.minimum(pair_i[:n], pair_j[:n]).astype(np.int64)
+        group = np.repeat(np.arange(groups), np.diff(group_start))
+        order = np.lexsort((lower, group))  # stable: ties keep their order
+        a, b = pair_i.copy(), pair_j.copy()
+        slabs.order_within_groups(a, b, n, group_start)
+        assert np.array_equal(a[:n], pair_i[:n][order])
+        assert np.array_equal(b[:n], pair_j[:n][order])
+        assert np.array_equal(a[n:], pair_i[n:]) and np.array_equal(b[n:], pair_j[n:])

@@ -223,14 +223,11 @@ class RangePairSet:
 def nbr_order_within_groups(
     pair_i: np.ndarray, pair_j: np.ndarray, count: int, group_start: np.ndarray
 ) -> None:
-    """Sort the pairs of each group (in place) by their lower particle index (stable)."""
+    """Sort the pairs of each group (in place) by their lower particle index (stable;
+    :func:`thermodem.kernels.slabs.order_within_groups`)."""
     if count == 0:
         return
-    lower = np.minimum(pair_i[:count], pair_j[:count]).astype(np.int64)
-    group = np.repeat(np.arange(group_start.shape[0] - 1), np.diff(group_start))
-    order = np.argsort(group * (int(lower.max()) + 1) + lower, kind="stable")
-    pair_i[:count] = pair_i[:count][order]
-    pair_j[:count] = pair_j[:count][order]
+    slabs.order_within_groups(pair_i, pair_j, count, group_start)
 
 
 def _buffer(values: Any) -> np.ndarray:

@@ -22,6 +22,7 @@ rebuild, so that the groups share the work evenly between threads.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from thermodem.kernels.neighbors import _axis_cell
@@ -115,3 +116,21 @@ def sort_pairs_by_group(
         out_j[fill[g]] = pair_j[k]
         where[k] = fill[g]
         fill[g] += 1
+
+
+@njit(cache=True, error_model="numpy")
+def order_within_groups(pair_i, pair_j, count, group_start):
+    """Sort the pairs of each slab group (in place) by their lower particle index, stably
+    (so the pass walks the particle arrays forwards). One group at a time: the scratch is a
+    group's size, not the list's (the whole-list NumPy sort took ~40 B per pair at its peak)."""
+    for g in range(group_start.shape[0] - 1):
+        a = group_start[g]
+        b = min(group_start[g + 1], count)
+        if b - a < 2:
+            continue
+        lower = np.minimum(pair_i[a:b], pair_j[a:b])
+        order = np.argsort(lower, kind="mergesort")
+        sorted_i = pair_i[a:b][order]
+        sorted_j = pair_j[a:b][order]
+        pair_i[a:b] = sorted_i
+        pair_j[a:b] = sorted_j
