@@ -209,6 +209,7 @@ def timed(
         ),  # fmt: skip
         threads=threads,
     )
+    tiny.serial_kernels = False  # load the large bed's kernel variants (engine/threads.py)
     tiny.run(steps=5)
     baseline = rss_bytes()
     sim = Simulation(
