@@ -175,7 +175,24 @@ class ThermalEngine:
         self.initial_energy = 0.0
         self.boundary_columns = np.nonzero(heat.BOUNDARY)[0]
         self.in_use = self._mechanisms_in_use()
-        self.sum_columns = np.array(sorted({*self.in_use, heat.M_SOURCE}), np.int64)
+        sums = {*self.in_use, heat.M_SOURCE}
+        if not self.conditions.has_sources:  # the source column stays zero: not summed
+            sums.discard(heat.M_SOURCE)
+        self.sum_columns = np.array(sorted(sums), np.int64)
+        #: the explicit update turns the generation accumulators into heat itself
+        #: (kernels/thermal.py: euler_step), instead of a conversion pass and a clearing pass
+        self.fuse_generation = (
+            self.generation.active and self.implicit is None and not self.has_c_table
+        )
+        self.gen_selected = np.array(
+            self.generation.mechanisms if self.fuse_generation else [], np.int64
+        )
+        self._no_gen_energy = np.zeros((1, 1))
+        #: some term adds conductances (the explicit limit; else conductance_sum stays zero)
+        self.conducts = bool(self.contact.active or self.terms)
+        #: the columns the explicit update sums (the fused generation is added apart)
+        fused = set(self.generation.columns) if self.fuse_generation else set()
+        self.euler_columns = np.array([m for m in self.sum_columns if m not in fused], np.int64)
 
     def _mechanisms_in_use(self) -> list[int]:
         """Mechanism columns this case's terms and conditions can write (reported always)."""
@@ -495,7 +512,8 @@ class ThermalEngine:
     def evaluate_terms(self, time: float) -> None:
         """Add the heat of every term other than the contact conduction (at this state and
         ``time``; the per-particle fields are filled first), and the heat generation."""
-        self.generation_rates()
+        if not self.fuse_generation:  # (else the explicit update converts them)
+            self.generation_rates()
         if not self.terms:
             return
         sim = self.sim
@@ -729,6 +747,8 @@ class ThermalEngine:
     def finish(self, time: float) -> np.ndarray:
         """Source column and total heat rate after the passes; returns the fixed mask."""
         p = self.sim.particles
+        if self.fuse_generation:  # the generation columns for the readers of the rates
+            self.generation_rates()
         kernels.finish_heat(self.source, p.heat_rate, p.heat_columns, self.sum_columns)
         self.rates_pending = False
         return self.fixed
@@ -784,9 +804,12 @@ class ThermalEngine:
             rows = n // kernels.EULER_CHUNK + 1
             if self.euler_partials.shape[0] < rows:
                 self.euler_partials = np.zeros((rows, self.euler_partials.shape[1]))
+            gen_energy = p.generation_energy if self.fuse_generation else self._no_gen_energy
             limit, where, absorbed, bad = kernels.euler_step(
-                temperature, heat_rate, by_mech, self.sum_columns, source, mass, type_id,
-                self.specific_heat_by_type, conductance, fixed, dt, self.euler_partials, clear,
+                temperature, heat_rate, by_mech, self.euler_columns, source,
+                self.conditions.has_sources, mass, type_id, self.specific_heat_by_type,
+                conductance, self.conducts, fixed, dt, self.euler_partials, clear, gen_energy,
+                self.gen_selected, self.generation.conversion_fraction / dt,
             )  # fmt: skip
             # (with MPI ghosts after the owned particles the force reset zeroes them all)
             self.rates_cleared = clear and n == p.count
@@ -815,7 +838,8 @@ class ThermalEngine:
             self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
-        self._generation_used()
+        if not self.fuse_generation:  # (else the update emptied the accumulators)
+            self._generation_used()
         if bad_gid >= 0:
             raise SimulationError(
                 f"temperature of particle {bad_gid} became {bad_temperature:.6g} K at step "

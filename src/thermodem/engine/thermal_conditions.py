@@ -109,6 +109,8 @@ class ThermalConditions:
         self._weight = np.zeros(0)
         self._part = np.zeros(1)
         self.active = bool(entries or settings.external_source)
+        #: some entry or external source gives heat (else the source column stays zero)
+        self.has_sources = bool(np.any(self.kinds != FIXED) or settings.external_source)
 
     def invalidate(self) -> None:
         """The particles were reordered or inserted (a neighbour-list build, a pour, a

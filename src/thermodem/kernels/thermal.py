@@ -21,7 +21,7 @@ from thermodem.kernels.contact import CHUNK, STATE_TOUCHING
 from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.kernels.variants import parallel_kernel
-from thermodem.state.heat import M_SOURCE
+from thermodem.state.heat import M_GENERATION, M_SOURCE
 
 _CONDUCTION_PASSES: dict[tuple[int, int, int], Any] = {}
 
@@ -246,24 +246,34 @@ EULER_FIXED = 4
 
 
 @parallel_kernel(error_model="numpy")
-def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type_id,
-               c_by_type, conductance_sum, fixed, dt, part, clear):  # fmt: skip
+def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on, mass, type_id,
+               c_by_type, conductance_sum, conductances, fixed, dt, part, clear, gen_energy,
+               gen_selected, gen_scale):  # fmt: skip
     """One fused per-particle thermal update with constant specific heats.
 
-    Fills the source column and the total heat rate (the sum of the mechanism columns in use,
-    ``columns``, ascending: the others are zero), finds the explicit Euler limit min m c / ΣH
-    over free particles, applies T += dt Q / (m c) to free particles, and sums per chunk the
-    heat absorbed by fixed particles and every mechanism column in use [W]
-    (``part[c, EULER_FIXED + m]``). With ``clear`` it then zeroes the particle's mechanism
-    columns in use and conductance sum, which the contact pass of the same step adds to next
-    (instead of a separate zeroing pass over the particles; they are in the cache here).
-    Returns (limit, limit index, absorbed, first bad index or -1).
+    Fills the source column (with ``source_on``; without sources it stays zero), forms the
+    total heat rate: the heat generation χ E_g / Δt of the mechanisms ``gen_selected``
+    (indices g into the accumulators ``gen_energy``; empty without generation; ``gen_scale``
+    = χ / Δt, the step's own length, so that the heat applied is χ E_g exactly), emptying
+    the accumulators (kernels/generation.py's conversion, fused here: no conversion pass and
+    no clearing pass; the generation columns are not written, ``columns`` must not hold them:
+    ThermalEngine.finish forms them for the readers of the rates), plus the sum of the
+    mechanism columns ``columns`` (the others in use, ascending), finds the
+    explicit Euler limit min m c / ΣH over free particles, applies T += dt Q / (m c) to free
+    particles, and sums per chunk the heat absorbed by fixed particles and every mechanism
+    column in use [W] (``part[c, EULER_FIXED + m]``); ``conductances``: some term adds to
+    ``conductance_sum`` (else it is neither read nor cleared, and there is no limit). With
+    ``clear`` it then zeroes the
+    particle's mechanism columns in use and conductance sum, which the contact pass of the
+    same step adds to next (instead of a separate zeroing pass over the particles; they are
+    in the cache here). Returns (limit, limit index, absorbed, first bad index or -1).
     Parallel over fixed chunks of EULER_CHUNK particles whose partial results are combined in
     chunk order, so the sums do not depend on the number of threads (``part``: at least
     n // EULER_CHUNK + 1 rows of EULER_FIXED + the number of mechanisms, scratch).
     """
     n = temperature.shape[0]
     nmech = by_mechanism.shape[0]
+    ngen = gen_selected.shape[0]
     nchunks = (n + EULER_CHUNK - 1) // EULER_CHUNK
     for c in prange(nchunks):
         limit = math.inf
@@ -274,18 +284,26 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, mass, type
         for m in range(nmech):
             row[EULER_FIXED + m] = 0.0
         for i in range(c * EULER_CHUNK, min(n, (c + 1) * EULER_CHUNK)):
-            by_mechanism[M_SOURCE, i] = source[i]
+            if source_on:
+                by_mechanism[M_SOURCE, i] = source[i]
             q = 0.0
+            for s in range(ngen):
+                mech = gen_selected[s]
+                qm = gen_scale * gen_energy[i, mech]
+                gen_energy[i, mech] = 0.0
+                q += qm
+                row[EULER_FIXED + M_GENERATION + mech] += qm
             for m in columns:
                 qm = by_mechanism[m, i]
                 q += qm
                 row[EULER_FIXED + m] += qm
             heat_rate[i] = q
-            g = conductance_sum[i]
+            g = conductance_sum[i] if conductances else 0.0
             if clear:  # (the other columns are never written: zero)
                 for m in columns:
                     by_mechanism[m, i] = 0.0
-                conductance_sum[i] = 0.0
+                if conductances:
+                    conductance_sum[i] = 0.0
             if fixed[i]:
                 absorbed += q
                 continue
