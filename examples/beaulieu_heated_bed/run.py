@@ -97,12 +97,13 @@ def measured(depth: float) -> np.ndarray:
                       delimiter=",", skiprows=1)  # fmt: skip
 
 
-def simulate(dt: float = 10.0, scheme: str = "backward_euler") -> dict:
-    """Run the case; return times, probe temperatures [°C], RMS per depth and the timings."""
+def simulate(dt: float = 10.0, scheme: str = "backward_euler", threads: int | None = None) -> dict:
+    """Run the case; return times, probe temperatures [°C], RMS per depth and the timings
+    (``threads``: Numba threads, None: chosen by thermodem)."""
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
-    sim = Simulation(case_from_dict(case(dt, scheme)))
+    sim = Simulation(case_from_dict(case(dt, scheme)), threads=threads)
     sel = probes(sim)
     times = [0.0]
     curves = [[float(sim.particles.temperature[s].mean()) - 273.15 for s in sel]]
@@ -158,6 +159,7 @@ def main() -> None:
     )
     ap.add_argument("--dt", type=float, default=10.0, help="thermal time step [s]")
     ap.add_argument("--scheme", default="backward_euler")
+    ap.add_argument("--threads", type=int, default=None, help="Numba threads (default: chosen)")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument(
         "--write-case",
@@ -175,7 +177,7 @@ def main() -> None:
         (HERE / "beaulieu.yaml").write_text(text)
         print(HERE / "beaulieu.yaml")
         return
-    result = simulate(REDUCED_DT if args.reduced else args.dt, args.scheme)
+    result = simulate(REDUCED_DT if args.reduced else args.dt, args.scheme, args.threads)
     tm = result["timings"]
     print(f"{result['particles']} particles, probes {result['probe_counts']}; assembly "
           f"{tm.assembly:.2f} s, AMG setup {tm.preconditioner:.2f} s, solve {tm.solve:.2f} s, "
