@@ -107,6 +107,8 @@ class ThermalEngine:
                 )
             self.specific_heat_by_type[t] = c or 0.0
         self.conditions = ThermalConditions(sim, settings)
+        #: some wall has a fixed temperature (adiabatic walls take part in no heat pass)
+        self.walls_conduct = any(fn is not None for fn in self.conditions.wall_functions)
         self._conditions_key: tuple = ()
         #: the external pair set of terms with target "external" (set_external_term)
         self.external: ExternalPairSet | None = None
@@ -409,6 +411,8 @@ class ThermalEngine:
         self._wall_heat()
 
     def _wall_conductances(self) -> None:
+        if not self.walls_conduct:  # adiabatic walls: every wall pair's H stays 0
+            return
         sim = self.sim
         p, wb = sim.particles, sim.walls
         kernels.conduction_wall_pass_for(self.radius_id, self.conduction_id, self.override)(
@@ -420,6 +424,8 @@ class ThermalEngine:
         )  # fmt: skip
 
     def _wall_heat(self) -> None:
+        if not self.walls_conduct:
+            return
         sim = self.sim
         p = sim.particles
         passes.wall_heat_from_conductance(
