@@ -176,6 +176,7 @@ class ThermalEngine:
             self.implicit = ImplicitSolver(self)
         self.initial_energy = 0.0
         self.boundary_columns = np.nonzero(heat.BOUNDARY)[0]
+        self.boundary_keys = [f"heat_in_{heat.HEAT_MECHANISMS[m]}" for m in self.boundary_columns]
         self.in_use = self._mechanisms_in_use()
         sums = {*self.in_use, heat.M_SOURCE}
         if not self.conditions.has_sources:  # the source column stays zero: not summed
@@ -840,8 +841,9 @@ class ThermalEngine:
                 time,
                 self.limit_particle,
             )
-        for m, q in zip(self.boundary_columns, boundary, strict=True):
-            self.cumulative[f"heat_in_{heat.HEAT_MECHANISMS[m]}"] += float(q) * dt
+        cumulative = self.cumulative
+        for key, q in zip(self.boundary_keys, boundary.tolist(), strict=True):
+            cumulative[key] += q * dt
         self.cumulative["fixed_absorbed"] += absorbed * dt
         self.thermal_steps += 1
         if not self.fuse_generation:  # (else the update emptied the accumulators)
