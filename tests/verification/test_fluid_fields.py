@@ -208,6 +208,33 @@ def test_cell_porosity_by_hand(tmp_path: Path) -> None:
     assert eps[:3] == pytest.approx([1 - 3 * v / (0.5 * (4 * s) ** 3)] * 3, rel=1e-14)
 
 
+def test_cell_porosity_follows_a_particle_into_another_cell(tmp_path: Path) -> None:
+    """The porosities are recomputed only when a particle changes cell
+    (engine/fields.py): moving the lone particle of the last cell into the first one
+    changes both cells' porosity; a move within a cell changes nothing."""
+    s = R
+    pos = np.array([[2.5 * s, 1.2 * s, 1.2 * s], [2.5 * s, 2.9 * s, 1.2 * s],
+                    [3.0 * s, 2.0 * s, 3.0 * s], [6.0 * s, 6.0 * s, 6.0 * s]])  # fmt: skip
+    radiation = {"model": "surroundings", "environment_temperature": 300.0, "exposure": "fraction"}
+    thermal = {"radiation": radiation, "porosity": {"kind": "cell", "cell_size": 4 * s}}
+    case = _case(_write(tmp_path / "p.txt", pos, radius=0.5 * s), thermal, lower=(0, 0, 0),
+                 upper=(8 * s, 8 * s, 8 * s))  # fmt: skip
+    case["materials"]["grain"]["emissivity"] = 0.9
+    sim = Simulation(case_from_dict(case))
+    p = sim.particles
+    v = 4 / 3 * math.pi * (0.5 * s) ** 3
+    cell = (4 * s) ** 3
+    last = int(np.flatnonzero(p.global_id == 3)[0])
+    p.position[last] = [6.5 * s, 5.5 * s, 6.2 * s]  # within its cell
+    sim.thermal.compute_rates(sim.time)
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
+    assert eps[3] == pytest.approx(1 - v / cell, rel=1e-14)
+    p.position[last] = [1.0 * s, 3.0 * s, 2.0 * s]  # into the first cell
+    sim.thermal.compute_rates(sim.time)
+    eps = _gid(sim, sim.thermal.fields[fk.F_POROSITY])
+    assert eps == pytest.approx([1 - 4 * v / cell] * 4, rel=1e-14)
+
+
 def _sphere_volume_beyond_planes(rs: float, cuts: list[float]) -> float:
     """Volume of a sphere (radius rs, centre 0) with x >= -cuts[0] and z >= -cuts[1] (an
     independent quadrature: slices in z of a disc cut by the line x = -cuts[0])."""

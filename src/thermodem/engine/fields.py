@@ -220,6 +220,9 @@ class FieldProvider:
         self.cell_fluid = np.zeros(0)
         self.cell_solid = np.zeros(0)
         self.cell_of = np.zeros(0, np.int64)
+        #: cell_of and the porosity column of ``_porosity_for`` hold for the current cells
+        self.cells_valid = False
+        self._porosity_for: np.ndarray | None = None
         self._cell_walls = np.zeros((0, wall_cols.WALL_WIDTH))
         # validity ranges of the convection correlation
         self.ranges: list[tuple[str, float, float]] = []
@@ -315,7 +318,9 @@ class FieldProvider:
 
     # ---------------------------------------------------------------------- update
     def invalidate(self) -> None:
-        """The particles were reordered or inserted (the neighbourhood set holds indices)."""
+        """The particles were reordered or inserted (the neighbourhood set and the cells of
+        the cell porosity hold indices)."""
+        self.cells_valid = False
         if self.neighbourhood is not None:
             self.neighbourhood.invalidate()
 
@@ -583,8 +588,21 @@ class FieldProvider:
             fk.cell_fluid_volume(sim.lower, self.cell_edge, self.cell_dims, sim.wall_kind,
                                  sim.wall_rows, 4, self.cell_fluid)  # fmt: skip
             self._cell_walls = geometry
+            self.cells_valid = False
         if self.cell_of.shape[0] != p.count:
             self.cell_of = np.zeros(p.count, np.int64)
+            self.cells_valid = False
+        # the porosities change only when a particle changes cell (or the cells, the order
+        # of the particles or the array change): a pass over the cell indices, not the sums
+        if (
+            self.cells_valid
+            and fields is self._porosity_for
+            and fk.cell_moves(p.position, sim.lower, self.cell_edge, self.cell_dims,
+                              self.cell_of, self._part()) == 0
+        ):  # fmt: skip
+            return
+        self.cells_valid = True
+        self._porosity_for = fields
         fk.cell_porosity(p.position, p.radius, sim.lower, self.cell_edge, self.cell_dims,
                          self.cell_fluid, self.cell_solid, self.cell_of, fields)  # fmt: skip
 

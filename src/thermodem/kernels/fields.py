@@ -337,6 +337,24 @@ def _bin_solid(position, radius, lower, edge, dims, solid, cell):
 
 
 @parallel_kernel(error_model="numpy")
+def cell_moves(position, lower, edge, dims, cell, part):
+    """How many particles have their centre in another cell than ``cell[i]`` (the cells of
+    the last :func:`cell_porosity`); ``part``: scratch of at least n // CHUNK + 1 entries."""
+    n = position.shape[0]
+    nchunks = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunks):
+        moves = 0
+        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            if _cell_index(position[i], lower, edge, dims) != cell[i]:
+                moves += 1
+        part[c] = moves
+    total = 0
+    for c in range(nchunks):
+        total += int(part[c])
+    return total
+
+
+@parallel_kernel(error_model="numpy")
 def cell_porosity(position, radius, lower, edge, dims, fluid_volume, solid, cell, fields):
     """Porosity of the cell of each particle's centre, 1 - V_solid / V_cell, clipped to
     [0, 1]: V_solid the volume of the particles whose centre is in the cell, V_cell the
