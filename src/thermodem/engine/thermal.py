@@ -193,9 +193,12 @@ class ThermalEngine:
         self._no_gen_energy = np.zeros((1, 1))
         #: some term adds conductances (the explicit limit; else conductance_sum stays zero)
         self.conducts = bool(self.contact.active or self.terms)
-        #: the columns the explicit update sums (the fused generation is added apart)
-        fused = set(self.generation.columns) if self.fuse_generation else set()
-        self.euler_columns = np.array([m for m in self.sum_columns if m not in fused], np.int64)
+        #: the columns the explicit update sums (the fused generation is added apart; the
+        #: wall conduction column stays zero with adiabatic walls)
+        apart = set(self.generation.columns) if self.fuse_generation else set()
+        if not self.walls_conduct:  # (only the wall conduction passes write it)
+            apart.add(heat.M_WALL_DIRECT)
+        self.euler_columns = np.array([m for m in self.sum_columns if m not in apart], np.int64)
 
     def _mechanisms_in_use(self) -> list[int]:
         """Mechanism columns this case's terms and conditions can write (reported always)."""
