@@ -91,26 +91,16 @@ def threading_layer() -> str:
     return f"{name} ({_layer_note})" if _layer_note else name
 
 
-#: Below this mean particle count a one-thread simulation runs the serial twins of the
-#: parallel kernels (:func:`serial_twins`).
-SERIAL_MAX_PARTICLES = 300
-
-
 def serial_twins(threads: int, particles: float) -> bool:
     """Whether a simulation of ``particles`` particles (mean over the run) on ``threads``
-    threads runs the serial twins of the parallel kernels: on one thread, below
-    :data:`SERIAL_MAX_PARTICLES` only. The twins save compile time (no parfor lowering: a
-    cold start of a small case ~8 s shorter) and the thread launch per call, but they run
-    slower: the particle pair pass compiled serially takes about twice the time of the
-    same loop compiled with ``parallel`` and run on one Numba thread (50k shared bed:
-    13.8 against 6.8 ms per step; jammed cubic beds, mechanics / heat, µs per step twin
-    against parallel kernels on 1 thread: 252 particles 94/56 and 140/107, 512 particles
-    156/88 and 213/151, 1000 particles 276/154 and 360/228; the cause is not pinned down:
-    marking the twin's arguments noalias, as the parfor lowering does, changed nothing).
-    So the twins serve the small cases (tests, first examples), where compilation is most
-    of the wall time, and a larger system on one thread runs the parallel kernels
-    (docs/architecture.md, "Threads")."""
-    return int(threads) == 1 and particles < SERIAL_MAX_PARTICLES
+    threads runs the serial twins of the parallel kernels: on one thread for small systems
+    only. Measured on the shared 50,000-sphere bed (1 thread, in-process A/B): the particle
+    pair pass's serial twin takes 13.8 ms per step against 6.8 ms for the parallel kernel on
+    one Numba thread (the same loop; the cause is not pinned down: marking the twin's
+    arguments noalias, as the parfor lowering does, changed nothing), so a large system on one
+    thread runs the parallel kernels; a small one saves their compilation and the thread launch per
+    call (docs/architecture.md, "Threads")."""
+    return int(threads) == 1 and particles < PARALLEL_MIN_PARTICLES
 
 
 def apply_threads(threads: int, serial: bool | None = None) -> None:
