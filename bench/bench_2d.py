@@ -128,7 +128,6 @@ def timed_2d(n: int, steps: int, threads: int) -> dict:
     bed = settle(n)
     width, _, _ = geometry(n)
     tiny = Simulation(case_from_dict(case_2d(n, None, 5e-6, 0.5, 0.02, 50)), threads=threads)
-    tiny.serial_kernels = False  # load the large bed's kernel variants (engine/threads.py)
     tiny.run(steps=5)
     baseline = rss_bytes()
     sim = Simulation(case_from_dict(case_2d(n, str(bed), 5e-6, 0.5, TILES * width)), threads)

@@ -159,7 +159,6 @@ def timed(n: int, steps: int, threads: int, case: str, substeps: int, bed: Path)
                                            "glass")  # fmt: skip
         save_particle_file(tiny_bed, tiny_particles)
     tiny = Simulation(case_from_dict(case_dict(n, str(tiny_bed), case, substeps)), threads=threads)
-    tiny.serial_kernels = False  # load the large bed's kernel variants (engine/threads.py)
     tiny.run(steps=2 * substeps + 5)  # every kernel of the case compiled or loaded
     baseline = rss_bytes()
     sim = Simulation(case_from_dict(case_dict(n, str(bed), case, substeps)), threads=threads)

@@ -209,7 +209,6 @@ def timed(
         ),  # fmt: skip
         threads=threads,
     )
-    tiny.serial_kernels = False  # load the large bed's kernel variants (engine/threads.py)
     tiny.run(steps=5)
     baseline = rss_bytes()
     sim = Simulation(

@@ -197,10 +197,8 @@ def timed(kind: str, threads: int, steps: int, warmup: int, indirect: dict | Non
         step_phases.instrument()
 
     # baseline: interpreter, libraries and the compiled kernels, loaded on a tiny bed
-    tiny = Simulation(case_from_dict(case_dict(kind, indirect, substeps, True, terms)),
-                      threads=threads)  # fmt: skip
-    tiny.serial_kernels = False  # load the large bed's kernel variants (engine/threads.py)
-    tiny.run(steps=5)
+    Simulation(case_from_dict(case_dict(kind, indirect, substeps, True, terms)),
+               threads=threads).run(steps=5)  # fmt: skip
     baseline = rss_bytes()
     sim = Simulation(case_from_dict(case_dict(kind, indirect, substeps, False, terms)),
                      threads=threads)  # fmt: skip

@@ -111,9 +111,6 @@ def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulatio
         )
     sim = Simulation(case_from_dict(case), threads=threads)
     assert sim.threads == threads and sim.threads_reason == "as requested"
-    # one thread: the serial twins (a bed this size runs the parallel kernels on one thread,
-    # engine/threads.serial_twins; the twins must give the same results all the same)
-    sim.serial_kernels = threads == 1
     seen: list[int] = []
     sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
     return sim, seen
@@ -212,12 +209,6 @@ def test_simulation_sets_its_thread_count(tmp_path):
     sim.run(steps=1)
     assert numba.get_num_threads() == expected
     assert sim.set_threads(2) == 2 and numba.get_num_threads() == 2
-    from thermodem.kernels import variants as V
-
-    assert sim.set_threads(1) == 1 and not sim.serial_kernels and not V.serial_mode()
-    sim.run(steps=1)  # 4624 particles on one thread: the parallel kernels, not the twins
-    assert numba.get_num_threads() == 1 and not V.serial_mode()
-    assert sim.set_threads(2) == 2
     sim.set_threads(None)  # keeps the request
     assert sim.threads == 2
 

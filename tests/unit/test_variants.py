@@ -90,19 +90,3 @@ def test_thread_count_switches_the_variant(restore_threads):
     twin(values, out)
     assert twin._serial is not None and twin._serial.signatures
     assert np.array_equal(out, 5.0 * values)
-
-
-def test_large_systems_on_one_thread_run_the_parallel_kernels(restore_threads):
-    """The serial twins are for small systems: on the 50k bed the particle pair pass's twin
-    took twice the time of the parallel kernel on one thread (engine/threads.serial_twins)."""
-    from thermodem.engine.threads import PARALLEL_MIN_PARTICLES, serial_twins
-
-    assert serial_twins(1, 125)
-    assert not serial_twins(1, PARALLEL_MIN_PARTICLES)
-    assert not serial_twins(2, 125)
-    apply_threads(1, serial=False)
-    assert not V.serial_mode() and numba.get_num_threads() == 1
-    apply_threads(1, serial=True)
-    assert V.serial_mode()
-    apply_threads(2, serial=True)  # (two threads always run the parallel kernels)
-    assert not V.serial_mode()

@@ -39,7 +39,7 @@ from thermodem.engine import diagnostics as D
 from thermodem.engine import external_loads as EL
 from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
-from thermodem.engine.threads import apply_threads, serial_twins
+from thermodem.engine.threads import apply_threads
 from thermodem.engine.validation import check_completeness, check_insertion_memory
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
@@ -224,9 +224,6 @@ class Simulation:
         self.max_overlap_ratio = 0.0
         self.contact_count = 0
         self.callbacks: list[tuple[int, Callable[[Simulation], None]]] = []
-        # the kernel variants for this size before the first kernel call on the particles
-        self.serial_kernels = serial_twins(self.threads, self._mean_particles())
-        apply_threads(self.threads, self.serial_kernels)
         self._compute_forces(kick=False, contact_dt=0.0)
         self.initial_energy = self.total_energy()
         if self.thermal is not None:
@@ -243,29 +240,22 @@ class Simulation:
         the listed pairs (:func:`thermodem.engine.threads.choose_threads`). Returns it; the
         reason is in ``threads_reason``. Results do not depend on it."""
         from thermodem.engine.threads import choose_threads
+        from thermodem.engine.validation import poured_particles
 
         if threads is not None:
             self.requested_threads = int(threads)
-        mean = self._mean_particles()
-        self.threads, self.threads_reason = choose_threads(
-            mean, self.pairs.count, self.requested_threads
-        )
-        self.serial_kernels = serial_twins(self.threads, mean)
-        apply_threads(self.threads, self.serial_kernels)
-        return self.threads
-
-    def _mean_particles(self) -> float:
-        """The mean particle count over the rest of the run (pours included), at least the
-        current count."""
-        from thermodem.engine.validation import poured_particles
-
         end = self.case.simulation.end_time
         remaining = max(end - self.time, 0.0)
         particle_seconds = self.particles.count * remaining
         for pourer in self.pourers:
             particle_seconds += poured_particles(pourer.entry, self.time, end)[1]
         mean = particle_seconds / remaining if remaining > 0 else float(self.particles.count)
-        return max(mean, float(self.particles.count))
+        mean = max(mean, float(self.particles.count))
+        self.threads, self.threads_reason = choose_threads(
+            mean, self.pairs.count, self.requested_threads
+        )
+        apply_threads(self.threads)
+        return self.threads
 
     # ---------------------------------------------- ranks (thermodem.mpi overrides these)
     @property
@@ -527,7 +517,7 @@ class Simulation:
         """Advance ``steps`` steps, or until simulated time ``until`` [s]."""
         if (steps is None) == (until is None):
             raise ValueError("give exactly one of steps= or until=")
-        apply_threads(self.threads, self.serial_kernels)  # another simulation may have changed it
+        apply_threads(self.threads)  # another simulation may have changed it
         if until is not None:
             dt = self.dt
             if self.thermal is not None and self.thermal.settings.frozen_mechanics:

@@ -24,10 +24,9 @@ parallel kernels in the child (thermodem itself never forks; ``subprocess`` is f
 particles (and :data:`PARALLEL_MIN_PAIRS` listed pairs), and every thread Numba has above
 (:func:`choose_threads`). Results do not depend on the thread count (tests/unit/test_threads.py).
 
-**Variants.** On one thread a small system runs the serial twins of the parallel kernels
-(:mod:`thermodem.kernels.variants`: no parfor to compile, no thread launch per call;
-:func:`serial_twins` says when); every change of the count goes through
-:func:`apply_threads`, which switches both.
+**Variants.** On one thread the parallel kernels run as serial twins
+(:mod:`thermodem.kernels.variants`: no parfor to compile, no thread launch per call); every
+change of the count goes through :func:`apply_threads`, which switches both.
 """
 
 from __future__ import annotations
@@ -91,28 +90,16 @@ def threading_layer() -> str:
     return f"{name} ({_layer_note})" if _layer_note else name
 
 
-def serial_twins(threads: int, particles: float) -> bool:
-    """Whether a simulation of ``particles`` particles (mean over the run) on ``threads``
-    threads runs the serial twins of the parallel kernels: on one thread for small systems
-    only. Measured on the shared 50,000-sphere bed (1 thread, in-process A/B): the particle
-    pair pass's serial twin takes 13.8 ms per step against 6.8 ms for the parallel kernel on
-    one Numba thread (the same loop; the cause is not pinned down: marking the twin's
-    arguments noalias, as the parfor lowering does, changed nothing), so a large system on one
-    thread runs the parallel kernels; a small one saves their compilation and the thread launch per
-    call (docs/architecture.md, "Threads")."""
-    return int(threads) == 1 and particles < PARALLEL_MIN_PARTICLES
-
-
-def apply_threads(threads: int, serial: bool | None = None) -> None:
+def apply_threads(threads: int) -> None:
     """Run the following kernels on ``threads`` Numba threads: the serial twins of the
-    parallel kernels (:mod:`thermodem.kernels.variants`) when ``serial`` (default: on one
-    thread), else the parallel kernels with ``numba.set_num_threads(threads)``."""
+    parallel kernels on one thread (:mod:`thermodem.kernels.variants`), else the parallel
+    kernels with ``numba.set_num_threads(threads)``."""
     import numba
 
     from thermodem.kernels.variants import set_serial
 
     numba.set_num_threads(int(threads))
-    set_serial(int(threads) == 1 if serial is None else bool(serial) and int(threads) == 1)
+    set_serial(int(threads) == 1)
 
 
 def available_threads() -> int:

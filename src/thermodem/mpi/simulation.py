@@ -130,7 +130,7 @@ class DistributedSimulation(Simulation):
 
     def set_threads(self, threads: int | None = None) -> int:
         """One Numba thread per rank unless asked (``--threads``): the ranks share the cores."""
-        from thermodem.engine.threads import apply_threads, serial_twins
+        from thermodem.engine.threads import apply_threads
 
         if threads is not None:
             self.requested_threads = int(threads)
@@ -138,8 +138,7 @@ class DistributedSimulation(Simulation):
         self.threads_reason = (
             "requested" if self.requested_threads else f"one per rank on {self.size} MPI ranks"
         )
-        self.serial_kernels = serial_twins(self.threads, self.particles.count)
-        apply_threads(self.threads, self.serial_kernels)
+        apply_threads(self.threads)
         return self.threads
 
     # ---------------------------------------------------------------- agreement of failures
