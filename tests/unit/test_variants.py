@@ -45,6 +45,7 @@ def restore_threads():
     apply_threads(previous)
 
 
+@pytest.mark.filterwarnings("ignore::numba.core.errors.NumbaPerformanceWarning")
 def test_serial_twin_is_its_own_compiled_function(restore_threads):
     values = np.random.default_rng(3).random(1000)
     parallel = np.zeros(16)
@@ -55,7 +56,13 @@ def test_serial_twin_is_its_own_compiled_function(restore_threads):
     expected = [np.sum(values[c * 64 : (c + 1) * 64] ** 2) for c in range(16)]
     np.testing.assert_allclose(serial, expected, rtol=1e-14)
     assert _chunk_sums.serial is not _chunk_sums.parallel
-    assert _chunk_sums.serial.targetoptions.get("parallel") in (None, False)
+    # Numba's parallel pipeline with every parallel transformation off: no parfor, the
+    # loops in order on the calling thread (kernels/variants.py: NO_PARFORS)
+    assert _chunk_sums.serial.targetoptions["parallel"] == V.NO_PARFORS
+    assert not any(V.NO_PARFORS.values())
+    metadata = _chunk_sums.serial.get_metadata(_chunk_sums.serial.signatures[0])
+    if metadata and metadata.get("parfor_diagnostics") is not None:  # (compiled, not loaded)
+        assert len(metadata["parfor_diagnostics"].initial_parfors) == 0
     assert _chunk_sums.parallel.targetoptions["parallel"]
     # their own cache entries (index files named after the qualname)
     assert _chunk_sums.serial.py_func.__qualname__ == "_chunk_sums__serial"
@@ -90,3 +97,22 @@ def test_thread_count_switches_the_variant(restore_threads):
     twin(values, out)
     assert twin._serial is not None and twin._serial.signatures
     assert np.array_equal(out, 5.0 * values)
+
+
+def test_twin_compiles_without_a_warning(restore_threads):
+    """The twin asks Numba's parallel pipeline for no parallel transformation, and Numba
+    warns when it finds none: a user must not see that warning (the first call hides it)."""
+    import warnings
+
+    from numba.core.errors import NumbaPerformanceWarning
+
+    factor = float(np.random.default_rng().uniform(1.0, 2.0))  # a new closure: compiled now
+    kernel = _scaled(factor)
+    values = np.arange(4.0)
+    out = np.zeros(4)
+    apply_threads(1)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        kernel(values, out)
+    assert np.array_equal(out, factor * values)
+    assert not [w for w in seen if issubclass(w.category, NumbaPerformanceWarning)]

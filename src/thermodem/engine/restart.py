@@ -116,7 +116,6 @@ DERIVED: tuple[str, ...] = (
     "requested_threads",
     "threads",
     "threads_reason",
-    "serial_kernels",
 )
 #: Attributes of the thermal engine that are never saved (objects, back references).
 THERMAL_SKIP: tuple[str, ...] = ("sim", "settings", "wall_functions")
