@@ -283,6 +283,22 @@ def format_error(err: dict[str, Any], data: Any) -> str:
         return f"{dotted}: at most {ctx['max_length']} values allowed (got {_shown(value)})"
     if kind == "too_short" and "min_length" in ctx:
         return f"{dotted}: at least {ctx['min_length']} values needed (got {_shown(value)})"
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        # 'Input should be a valid dictionary or instance of SimulationSettings': the class
+        # name means nothing in a case file; say what the key holds instead
+        keys = _allowed_keys(where)
+        kinds = _kinds_at(where)
+        allowed = f"; allowed keys: {', '.join(keys)}" if keys else ""
+        if not keys and kinds:
+            allowed = f" with a kind: {', '.join(kinds)}"
+        return f"{dotted}: should be a mapping of keys (key: value){allowed} (got {_shown(value)})"
+    if kind == "list_type":
+        if isinstance(value, dict):
+            return (
+                f"{dotted}: should be a list, one entry per item (lines starting with '- ', or "
+                f"[...]); got a mapping {_shown(value)}: put '- ' before its first key"
+            )
+        return f"{dotted}: should be a list [...] (got {_shown(value)})"
     msg = _improve_named(msg)
     # messages raised by model validators carry their own key path ('walls.0.material: ...')
     own = re.match(r"^([A-Za-z_][\w]*(?:\.[\w]+)*): ", msg)
