@@ -419,7 +419,10 @@ class ThermalSettings(StrictModel):
     @model_validator(mode="after")
     def _frozen(self) -> ThermalSettings:
         if self.frozen_mechanics and self.time_step is None:
-            raise ValueError("frozen_mechanics needs thermal.time_step [s]")
+            raise ValueError(
+                "frozen_mechanics needs thermal.time_step [s] (missing): the step of the heat "
+                "with the mechanics frozen, e.g. time_step: 1.0e-3"
+            )
         if self.scheme != "explicit" and not self.frozen_mechanics:
             raise ValueError(
                 f"thermal.scheme = {self.scheme!r} needs thermal.frozen_mechanics: true (the "
@@ -468,8 +471,21 @@ class WallThermal(StrictModel):
             raise ValueError(f"temperature must be > 0 K, got {self.temperature}")
         if isinstance(self.temperature, list):
             times = [t for t, _ in self.temperature]
-            if len(times) < 1 or any(b <= a for a, b in zip(times, times[1:], strict=False)):
-                raise ValueError("temperature table times must increase strictly")
-            if any(not temp > 0 for _, temp in self.temperature):
-                raise ValueError("temperature table values must be > 0 K")
+            if not times:
+                raise ValueError(
+                    "temperature table is empty; give rows [t [s], T [K]], e.g. "
+                    "[[0.0, 300.0], [1.0, 400.0]], or a number"
+                )
+            for k, (a, b) in enumerate(zip(times, times[1:], strict=False)):
+                if not b > a:
+                    raise ValueError(
+                        f"temperature table times must increase strictly; row {k + 1} has "
+                        f"t = {b:g} s after t = {a:g} s in row {k} (got times {times})"
+                    )
+            for k, (t, temp) in enumerate(self.temperature):
+                if not temp > 0:
+                    raise ValueError(
+                        f"temperature table values must be > 0 K; row {k} [t = {t:g} s] has "
+                        f"T = {temp:g}"
+                    )
         return self
