@@ -316,6 +316,7 @@ class Case(StrictModel):
                 raise ValueError(
                     f"walls.{k}.material: unknown material {w.material!r}; allowed: {allowed}"
                 )
+        self._check_wall_names()
         for k, e in enumerate(self.insertion):
             if e.material not in known:
                 raise ValueError(
@@ -345,6 +346,7 @@ class Case(StrictModel):
                             f"thermal.{key}.{k}.select.material: unknown material {m!r}; "
                             f"allowed: {allowed}"
                         )
+            self._check_thermal_selections(th)
             self._check_conductance_reuse(th)
             self._check_voronoi_reuse(th)
             self._probe_temperature_expressions(th)
@@ -357,6 +359,83 @@ class Case(StrictModel):
                             f"allowed: {allowed}"
                         )
         return self
+
+    def _check_wall_names(self) -> None:
+        """Wall labels (``name``, else ``KINDINDEX``; a box's faces ``NAME.x-`` ...) are
+        unique: they name the walls in walls.pvd, in ``thermodem export`` and in the failure
+        messages ('particle 4 and wall lid')."""
+        seen: dict[str, int] = {}
+        axes = "xy" if self.simulation.planar else "xyz"
+        for k, w in enumerate(self.walls):
+            label = w.name or f"{w.kind}{k}"
+            labels = [label]
+            if w.kind == "box":
+                labels = [f"{label}.{a}{side}" for a in axes for side in "-+"]
+            for name in labels:
+                if name in seen:
+                    first = seen[name]
+                    raise ValueError(
+                        f"walls.{k}.name: {name!r} is also the name of walls.{first}"
+                        f"{'' if self.walls[first].name else ' (its default name)'}; wall names label "
+                        "the walls in walls.pvd, exports and messages, so they must be unique"
+                    )
+                seen[name] = k
+
+    def _region_misses_domain(self, region: Any) -> str | None:
+        """The axis on which a box region lies wholly outside the domain (no particle can ever
+        be in it: particles leaving the domain stop the run, periodic ones are wrapped), or
+        None."""
+        dom = self.domain
+        for a, axis in enumerate("xy" if self.simulation.planar else "xyz"):
+            if region.upper[a] < dom.lower[a] or region.lower[a] > dom.upper[a]:
+                return (
+                    f"on the {axis} axis ({region.lower[a]:g} .. {region.upper[a]:g} against "
+                    f"{dom.lower[a]:g} .. {dom.upper[a]:g})"
+                )
+        return None
+
+    def _check_thermal_selections(self, th: ThermalSettings) -> None:
+        """A thermal condition that can never take a particle is refused: its material is
+        that of no insertion entry, its region lies outside the domain, or an id is < 0;
+        an external source's region outside the domain likewise."""
+        particle_materials = sorted({e.material for e in self.insertion})
+        dom = f"[{list(self.domain.lower)}, {list(self.domain.upper)}]"
+        for key in ("fixed_temperature", "heat_flux", "volumetric_source"):
+            for k, entry in enumerate(getattr(th, key)):
+                sel, where = entry.select, f"thermal.{key}.{k}.select"
+                if sel.ids is not None and any(i < 0 for i in sel.ids):
+                    raise ValueError(
+                        f"{where}.ids: must be >= 0 (global particle ids, numbered from 0 in "
+                        f"insertion order), got {sel.ids}"
+                    )
+                if (
+                    sel.material is not None
+                    and particle_materials
+                    and sel.material not in particle_materials
+                ):
+                    raise ValueError(
+                        f"{where}.material: {sel.material!r} is the material of no particle, so "
+                        f"the entry selects nothing (a selection takes particles, not walls: give "
+                        f"a wall its own thermal key); particle materials: "
+                        f"{', '.join(particle_materials)}"
+                    )
+                if sel.region is not None:
+                    miss = self._region_misses_domain(sel.region)
+                    if miss is not None:
+                        raise ValueError(
+                            f"{where}.region: [{list(sel.region.lower)}, "
+                            f"{list(sel.region.upper)}] lies outside the domain {dom} {miss}, "
+                            "so it can never hold a particle: move the region into the domain"
+                        )
+        for k, source in enumerate(th.external_source):
+            miss = self._region_misses_domain(source.region)
+            if miss is not None:
+                raise ValueError(
+                    f"thermal.external_source.{k}.region: [{list(source.region.lower)}, "
+                    f"{list(source.region.upper)}] lies outside the domain {dom} {miss}, so "
+                    f"no particle can receive its power ({source.power:g} W): move the region "
+                    "into the domain"
+                )
 
     def _check_region_in_domain(self, k: int, entry: Any) -> None:
         """The box or cylinder an entry fills must lie inside the domain (particles outside it
