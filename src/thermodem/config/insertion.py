@@ -505,13 +505,39 @@ class PourInsertion(_EntryBase):
     )
 
     @model_validator(mode="after")
-    def _check(self) -> PourInsertion:
+    def _check(self, info: ValidationInfo) -> PourInsertion:
         if self.end_time is not None and not self.end_time > self.start_time:
             raise ValueError(
                 f"pour insertion: end_time={self.end_time!r} must be > "
                 f"start_time={self.start_time!r} (or omitted to pour until the end of the run)"
             )
+        self._check_region_fits(box_axes(info))
         return self
+
+    def _check_region_fits(self, axes: str) -> None:
+        """The largest particle fits in the region (else the first batch would fail in the
+        middle of the run)."""
+        r_max = self.distribution.max_radius_bound
+        if r_max is None:
+            return
+        region = self.region
+        if region.kind == "box":
+            for a, axis in enumerate(_AXES):
+                extent = region.upper[a] - region.lower[a]
+                if axis in axes and extent < 2.0 * r_max:
+                    raise ValueError(
+                        f"region: the box is {extent:.6g} m wide along {axis}, smaller than the "
+                        f"diameter 2 r_max = {2.0 * r_max:.6g} m of the largest particle, so no "
+                        "particle can be poured; enlarge the region or use smaller radii"
+                    )
+            return
+        planar = axes == "xy"  # a circle in the plane: its length is not used
+        if region.radius < r_max or (not planar and region.length < 2.0 * r_max):
+            raise ValueError(
+                f"region: a particle of radius r_max = {r_max:.6g} m does not fit in the "
+                f"cylinder of radius {region.radius:.6g} m and length {region.length:.6g} m, so "
+                "no particle can be poured; enlarge the region or use smaller radii"
+            )
 
 
 class FileInsertion(_EntryBase):
