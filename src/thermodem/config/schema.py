@@ -374,10 +374,11 @@ class Case(StrictModel):
             for name in labels:
                 if name in seen:
                     first = seen[name]
+                    default = "" if self.walls[first].name else " (its default name)"
                     raise ValueError(
-                        f"walls.{k}.name: {name!r} is also the name of walls.{first}"
-                        f"{'' if self.walls[first].name else ' (its default name)'}; wall names label "
-                        "the walls in walls.pvd, exports and messages, so they must be unique"
+                        f"walls.{k}.name: {name!r} is also the name of walls.{first}{default}; "
+                        "wall names label the walls in walls.pvd, exports and messages, so they "
+                        "must be unique"
                     )
                 seen[name] = k
 
