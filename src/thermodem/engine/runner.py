@@ -74,8 +74,11 @@ from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
     check_completeness,
     check_resources,
+    check_thermal_selections,
+    check_wall_overlaps,
     estimate_resources,
     format_duration,
+    insertion_warnings,
     total_steps,
 )
 from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
@@ -458,7 +461,9 @@ def run_case(
         run_id = status.data["run_id"]
         try:
             sim = Simulation(case, threads=threads)
-            for warning in check_simulation_time_step(sim):
+            check_wall_overlaps(sim)
+            notes = check_thermal_selections(sim) + insertion_warnings(case)
+            for warning in notes + check_simulation_time_step(sim):
                 runlog.warn(warning)
             _header(runlog, sim, threads, output)
             run = _make_run(

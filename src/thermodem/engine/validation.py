@@ -383,6 +383,180 @@ def check_resources(estimate: ResourceEstimate) -> list[str]:
     return warnings
 
 
+# ------------------------------------------------------------------ the built simulation
+def wall_row_owners(case: Case) -> list[int]:
+    """The index in ``case.walls`` of every run-time wall row (a box gives several)."""
+    from thermodem.geometry.walls import row_count
+
+    planar = case.simulation.planar
+    return [k for k, w in enumerate(case.walls) for _ in range(row_count(w, planar))]
+
+
+def wall_distances(kind: int, row: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Distance of the centres ``x`` (n, 3) to one wall row, as the contact kernel measures
+    it (``kernels/neighbors.py: wall_distance``): signed along a plane's normal, unsigned to a
+    rectangle, signed towards the particles' side of a cylinder's mantle, inf beyond the ends
+    of a finite cylinder."""
+    from thermodem.geometry import wall_layout as WL
+
+    p = row[WL.COL_POINT : WL.COL_POINT + 3]
+    r = x - p
+    if kind == WL.PLANE:
+        return r @ row[WL.COL_NORMAL : WL.COL_NORMAL + 3]
+    if kind == WL.RECTANGLE:
+        n = row[WL.COL_NORMAL : WL.COL_NORMAL + 3]
+        u = row[WL.COL_U : WL.COL_U + 3]
+        v = np.cross(n, u)
+        a = np.clip(r @ u, -row[WL.COL_HALF_U], row[WL.COL_HALF_U])
+        b = np.clip(r @ v, -row[WL.COL_HALF_V], row[WL.COL_HALF_V])
+        q = p + a[:, None] * u + b[:, None] * v
+        return np.linalg.norm(x - q, axis=1)
+    if kind == WL.CYLINDER:
+        axis = row[WL.COL_AXIS : WL.COL_AXIS + 3]
+        h = r @ axis
+        rho = np.linalg.norm(r - h[:, None] * axis, axis=1)
+        d = row[WL.COL_RADIUS] - rho if row[WL.COL_SIDE] > 0.0 else rho - row[WL.COL_RADIUS]
+        return np.where(np.abs(h) > row[WL.COL_HALF_LENGTH], np.inf, d)
+    return np.full(x.shape[0], np.inf)
+
+
+def check_wall_overlaps(sim: Simulation) -> None:
+    """Refuse a start where a particle overlaps a wall by more than
+    ``simulation.max_overlap_ratio`` of its radius (the run would stop at its first step with
+    an overlap error blaming the stiffness): the insertion does not screen walls, so this is a
+    wall placed across the particles, or a one-sided plane or a cylinder facing away from
+    them. ConfigError naming the wall, the particle and the likely cause."""
+    from thermodem.geometry import wall_layout as WL
+
+    p = sim.particles
+    if p.count == 0 or sim.wall_rows.shape[0] == 0:
+        return
+    case = sim.case
+    limit = case.simulation.max_overlap_ratio
+    owners = wall_row_owners(case)
+    x, radius = p.position[: p.count], p.radius[: p.count]
+    for w in range(sim.wall_rows.shape[0]):
+        kind, row = int(sim.wall_kind[w]), sim.wall_rows[w]
+        d = wall_distances(kind, row, x)
+        ratio = (radius - d) / radius
+        bad = np.flatnonzero(ratio > limit)
+        if bad.size == 0:
+            continue
+        i = int(bad[np.argmax(ratio[bad])])
+        k = owners[w] if w < len(owners) else w
+        label = sim.wall_labels[w]
+        if kind == WL.PLANE and d[i] < 0.0:
+            normal = [float(c) for c in row[WL.COL_NORMAL : WL.COL_NORMAL + 3]]
+            why = (
+                f"its centre lies {-d[i]:.6g} m behind the plane, which is one-sided: its "
+                f"normal {normal} must point towards the particles (is it flipped?)"
+            )
+        elif kind == WL.CYLINDER and d[i] < 0.0:
+            inside = row[WL.COL_SIDE] > 0.0
+            why = (
+                f"its centre lies {'outside' if inside else 'inside'} the mantle of radius "
+                f"{row[WL.COL_RADIUS]:.6g} m (inside: {'true' if inside else 'false'} holds the "
+                f"particles {'inside' if inside else 'outside'} it)"
+            )
+        else:
+            why = "the wall passes through it"
+        more = f" ({bad.size - 1} more particle(s) too)" if bad.size > 1 else ""
+        position = [round(float(c), 9) for c in x[i]]
+        raise ConfigError(
+            f"walls.{k} ({label}): particle {int(p.global_id[i])} at {position} (radius "
+            f"{float(radius[i]):.6g} m) overlaps it by {float(ratio[i]):.3g} × its radius at "
+            f"the start{more}, more than simulation.max_overlap_ratio = {limit:g}, so the run "
+            f"would stop at its first step: {why}. The insertion does not keep particles clear "
+            "of walls: move the wall or the insertion region"
+        )
+
+
+def check_thermal_selections(sim: Simulation) -> list[str]:
+    """The thermal conditions' selections on the particles present at the start: an entry
+    that takes none of them is refused when it can take none later either (no region, no
+    pour entry: material and ids are fixed); a selection with global ids beyond the
+    particles is refused likewise. A region or a pour that may bring particles later gives a
+    warning. Returns the warnings."""
+    from thermodem.engine.external_loads import selected
+
+    th = sim.case.thermal
+    if th is None:
+        return []
+    p = sim.particles
+    pours = any(e.kind == "pour" for e in sim.case.insertion)
+    warnings: list[str] = []
+    for key in ("fixed_temperature", "heat_flux", "volumetric_source"):
+        for k, entry in enumerate(getattr(th, key)):
+            sel, where = entry.select, f"thermal.{key}.{k}.select"
+            shown = sel.model_dump(mode="json", exclude_none=True)
+            if sel.ids is not None and not pours:
+                missing = [i for i in sel.ids if i >= p.count]
+                if missing:
+                    raise ConfigError(
+                        f"{where}.ids: {missing} are no particle: the {p.count} particles have "
+                        f"the global ids 0 ... {p.count - 1} (in insertion order) and none is "
+                        "poured later"
+                    )
+            if selected(sel, p, sim.material_index).any():
+                continue
+            if sel.region is None and not pours:
+                raise ConfigError(
+                    f"{where}: selects no particle ({shown}); material and ids are fixed and no "
+                    "particle is poured later, so it never will"
+                )
+            later = (
+                "its region is evaluated at every thermal step: particles that move into it "
+                "are taken"
+                if sel.region is not None
+                else "particles poured later may be taken"
+            )
+            warnings.append(f"{where}: selects no particle at the start ({shown}); {later}")
+    return warnings
+
+
+def insertion_warnings(case: Case) -> list[str]:
+    """Pour entries that pour nothing before ``simulation.end_time``."""
+    end = case.simulation.end_time
+    dt = case.simulation.time_step
+    out = []
+    for k, e in enumerate(case.insertion):
+        if e.kind != "pour":
+            continue
+        first = e.start_time + e.interval
+        if e.end_time is not None:
+            first = min(first, e.end_time)
+        stop = end if e.end_time is None else min(e.end_time, end)
+        if first - 0.5 * dt > end:
+            out.append(
+                f"insertion.{k}: its first batch is due at t = {first:g} s (start_time "
+                f"{e.start_time:g} s + interval {e.interval:g} s), after simulation.end_time = "
+                f"{end:g} s: nothing is poured in this run"
+            )
+        elif e.rate * max(0.0, stop - e.start_time) < 1.0:
+            out.append(
+                f"insertion.{k}: rate {e.rate:g}/s from t = {e.start_time:g} s to {stop:g} s "
+                "asks for less than one particle: nothing is poured in this run"
+            )
+    return out
+
+
+def output_interval_warnings(case: Case) -> list[str]:
+    """Output intervals longer than ``simulation.end_time``: frames (rows, checkpoints) only at
+    the start and the end. A value in steps (LIGGGHTS' dump every N steps) is the usual cause.
+    """
+    end = case.simulation.end_time
+    out = []
+    for key in ("interval", "timeseries_interval", "checkpoint_interval"):
+        value = getattr(case.output, key)
+        if value is not None and value > end:
+            out.append(
+                f"output.{key} = {value:g} s is longer than simulation.end_time = {end:g} s: "
+                "written at the start and the end only (intervals are simulated seconds, not "
+                "steps)"
+            )
+    return out
+
+
 @dataclass
 class Validation:
     case: Case
@@ -400,7 +574,10 @@ def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> V
     case = load_case(path)
     check_completeness(case)
     sim = Simulation(case, threads=threads)
-    warnings = check_simulation_time_step(sim)
+    check_wall_overlaps(sim)
+    warnings = check_thermal_selections(sim)
+    warnings += insertion_warnings(case) + output_interval_warnings(case)
+    warnings += check_simulation_time_step(sim)
     estimate = estimate_resources(sim, threads)
     warnings += check_resources(estimate)
     return Validation(case, sim, warnings, estimate)

@@ -1,0 +1,130 @@
+"""Mistakes of a new user that are not a broken case on their own (the corpus in
+tests/cases/broken covers those): warnings that `validate` and `run` print for a case that runs
+but does not do what it says, and the refusals that need a run directory or a checkpoint."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import yaml
+from typer.testing import CliRunner
+
+from thermodem.cli import app
+
+CASE = {
+    "simulation": {"time_step": 1.0e-5, "end_time": 0.001},
+    "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
+    "materials": {
+        "glass": {
+            "density": 2500,
+            "youngs_modulus": 1.0e7,
+            "poisson_ratio": 0.3,
+            "thermal_conductivity": 1.0,
+            "specific_heat": 800,
+        }
+    },
+    "walls": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "glass"}],
+    "insertion": [
+        {
+            "kind": "lattice",
+            "material": "glass",
+            "distribution": {"kind": "mono", "radius": 0.001},
+            "lower": [0, 0, 0],
+            "upper": [0.006, 0.006, 0.006],
+            "count": [2, 2, 2],
+        }
+    ],
+}
+
+POUR = {
+    "kind": "pour",
+    "material": "glass",
+    "distribution": {"kind": "mono", "radius": 0.001},
+    "region": {"kind": "box", "lower": [0, 0, 0.006], "upper": [0.01, 0.01, 0.01]},
+    "rate": 1000.0,
+    "interval": 1.0,
+}
+
+
+def _write(tmp_path: Path, **sections) -> Path:  # noqa: ANN003
+    data = json.loads(json.dumps(CASE))
+    data.update(sections)
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def _cli(*args: str):  # noqa: ANN202
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def test_a_pour_that_pours_nothing_before_the_end_is_told(tmp_path: Path) -> None:
+    case = _write(tmp_path, insertion=[CASE["insertion"][0], POUR])
+    result = _cli("validate", case)
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: insertion.1: its first batch is due at t = 1 s (start_time 0 s + interval "
+        "1 s), after simulation.end_time = 0.001 s: nothing is poured in this run"
+    ) in result.output
+    result = _cli("run", case, "--output", tmp_path / "out", "--steps", "2", "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert "warning: insertion.1: its first batch is due at t = 1 s" in result.output
+    assert "insertion.1: its first batch" in (tmp_path / "out" / "run.log").read_text()
+
+
+def test_a_pour_rate_below_one_particle_is_told(tmp_path: Path) -> None:
+    pour = {**POUR, "rate": 10.0, "interval": 1.0e-4}
+    result = _cli("validate", _write(tmp_path, insertion=[pour]))
+    assert result.exit_code == 0, result.output
+    assert "insertion.0: rate 10/s from t = 0 s to 0.001 s asks for less than one particle" in (
+        result.output
+    )
+
+
+def test_an_output_interval_in_steps_is_told(tmp_path: Path) -> None:
+    """LIGGGHTS dumps every N steps; thermodem's intervals are simulated seconds."""
+    result = _cli("validate", _write(tmp_path, output={"interval": 1000, "checkpoint_interval": 5}))
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: output.interval = 1000 s is longer than simulation.end_time = 0.001 s: written "
+        "at the start and the end only (intervals are simulated seconds, not steps)"
+    ) in result.output
+    assert "warning: output.checkpoint_interval = 5 s is longer" in result.output
+    assert "warning: output.timeseries_interval" not in result.output
+
+
+def test_a_region_selection_empty_at_the_start_is_a_warning(tmp_path: Path) -> None:
+    region = {"lower": [0.008, 0.008, 0.008], "upper": [0.01, 0.01, 0.01]}
+    thermal = {"heat_flux": [{"select": {"region": region}, "flux": 100.0}]}
+    result = _cli("validate", _write(tmp_path, thermal=thermal))
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: thermal.heat_flux.0.select: selects no particle at the start ({'region': "
+        "{'lower': [0.008, 0.008, 0.008], 'upper': [0.01, 0.01, 0.01]}}); its region is "
+        "evaluated at every thermal step"
+    ) in result.output
+
+
+def test_a_selection_that_never_selects_is_refused_by_run_before_a_step(tmp_path: Path) -> None:
+    select = {"material": "glass", "ids": [8]}
+    thermal = {"fixed_temperature": [{"select": select, "temperature": 400.0}]}
+    out = tmp_path / "out"
+    result = _cli("run", _write(tmp_path, thermal=thermal), "--output", out, "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "error: thermal.fixed_temperature.0.select.ids: [8] are no particle" in result.output
+    status = json.loads((out / "status.json").read_text())
+    assert status["status"] == "failed" and status["refused_input"] is True
+    assert not (out / "checkpoints").exists() or not any((out / "checkpoints").iterdir())
+
+
+def test_a_particle_behind_a_plane_is_refused_by_run_before_a_step(tmp_path: Path) -> None:
+    walls = [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, -1], "material": "glass"}]
+    out = tmp_path / "out"
+    result = _cli("run", _write(tmp_path, walls=walls), "--output", out, "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "error: walls.0 (plane0): particle 4" in result.output
+    assert "its normal [0.0, 0.0, -1.0] must point towards the particles" in result.output
+    assert "Traceback" not in result.output
+    assert json.loads((out / "status.json").read_text())["refused_input"] is True
+
