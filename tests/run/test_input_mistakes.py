@@ -128,3 +128,28 @@ def test_a_particle_behind_a_plane_is_refused_by_run_before_a_step(tmp_path: Pat
     assert "Traceback" not in result.output
     assert json.loads((out / "status.json").read_text())["refused_input"] is True
 
+
+def test_run_restart_with_an_end_time_before_the_checkpoint_is_refused(tmp_path: Path) -> None:
+    case = _write(tmp_path)
+    first = tmp_path / "first"
+    result = _cli("run", case, "--output", first, "--steps", "5", "--no-progress")
+    assert result.exit_code == 0, result.output
+    ckpt = first / "checkpoints" / "checkpoint_000000005.h5"
+    data = yaml.safe_load(case.read_text())
+    data["simulation"]["end_time"] = 2.0e-5  # before the checkpoint's 5e-5 s
+    shorter = tmp_path / "shorter.yaml"
+    shorter.write_text(yaml.safe_dump(data))
+    again = tmp_path / "again"
+    result = _cli("run", shorter, "--restart", ckpt, "--output", again, "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert (
+        "error: simulation.end_time = 2e-05 s is not after the time of the checkpoint"
+    ) in result.output
+    assert "5e-05 s (step 5): there is nothing to run" in result.output
+    assert not again.exists()
+    # the stored case of the final checkpoint ends at its time: nothing to run either
+    result = _cli("run", "--restart", ckpt, "--output", again, "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "is not after the time of the checkpoint" in result.output
+    result = _cli("run", "--restart", ckpt, "--output", again, "--steps", "2", "--no-progress")
+    assert result.exit_code == 0, result.output

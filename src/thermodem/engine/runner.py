@@ -584,6 +584,12 @@ def run_from_checkpoint(
     output = Path(output)
     ckpt = read_checkpoint(checkpoint)
     case = case or ckpt.case()
+    if not case.simulation.end_time > ckpt.time:
+        raise ConfigError(
+            f"simulation.end_time = {case.simulation.end_time:g} s is not after the time of "
+            f"the checkpoint {ckpt.path}, {ckpt.time:.6g} s (step {ckpt.step}): there is "
+            "nothing to run; give a later end time in the case or with --end-time T"
+        )
     sim = restored_simulation(ckpt, threads, case)
     check_output_path(output)
     if output.is_dir():
