@@ -335,16 +335,18 @@ def _parse_checked(path: Path, material: str = "", planar: bool = False) -> _Par
     if nonfinite.size:
         i, j = (int(v) for v in nonfinite[0])
         raise ValueError(
-            f"{where}, line {lines[i]}, column {header[j]!r}: value {data[i, j]!r} is not finite"
+            f"{where}, line {lines[i]}, column {header[j]!r}: value {float(data[i, j])!r} is not "
+            "finite"
         )
     for name in ("radius", "diameter", "temperature"):
         if name in col:
             bad = np.flatnonzero(data[:, col[name]] <= 0.0)
             if bad.size:
                 i = int(bad[0])
+                unit = "K" if name == "temperature" else "m"
                 raise ValueError(
                     f"{where}, line {lines[i]}, column {header[col[name]]!r}: value "
-                    f"{data[i, col[name]]!r} must be > 0"
+                    f"{float(data[i, col[name]])!r} must be > 0 [{unit}]"
                 )
     return _assemble(data, col, bool(vel_cols), material, lines, path)
 
