@@ -292,6 +292,15 @@ def format_error(err: dict[str, Any], data: Any) -> str:
         if not keys and kinds:
             allowed = f" with a kind: {', '.join(kinds)}"
         return f"{dotted}: should be a mapping of keys (key: value){allowed} (got {_shown(value)})"
+    if kind == "tuple_type":
+        # 'Input should be a valid tuple': a case file has lists
+        tp = _unwrap(where.tp) if where is not None else None
+        args = [a for a in get_args(tp) if a is not Ellipsis] if tp is not None else []
+        fixed = tp is not None and get_origin(tp) is tuple and Ellipsis not in get_args(tp)
+        count = f"{len(args)} " if fixed and args else ""
+        numbers = all(_unwrap(a) is float for a in args)
+        example = ", e.g. [0.0, 0.0, 1.0]" if fixed and len(args) == 3 and numbers else ""
+        return f"{dotted}: should be a list of {count}values{example} (got {_shown(value)})"
     if kind == "list_type":
         if isinstance(value, dict):
             return (
