@@ -74,6 +74,7 @@ from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
     check_completeness,
     check_resources,
+    check_step_count,
     check_thermal_selections,
     check_wall_overlaps,
     estimate_resources,
@@ -461,6 +462,7 @@ def run_case(
         run_id = status.data["run_id"]
         try:
             sim = Simulation(case, threads=threads)
+            check_step_count(sim)
             check_wall_overlaps(sim)
             notes = check_thermal_selections(sim) + insertion_warnings(case)
             for warning in notes + check_simulation_time_step(sim):

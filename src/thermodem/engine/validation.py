@@ -514,6 +514,23 @@ def check_thermal_selections(sim: Simulation) -> list[str]:
     return warnings
 
 
+def check_step_count(sim: Simulation) -> None:
+    """``thermodem run`` makes ``round(end_time / time_step)`` steps (thermal steps with frozen
+    mechanics): refuse an end time that gives none (the run said 'done: 0 steps')."""
+    if total_steps(sim) - sim.step_count >= 1:
+        return
+    th = sim.thermal
+    frozen = th is not None and th.settings.frozen_mechanics
+    key = "thermal.time_step" if frozen else "simulation.time_step"
+    dt = th.settings.time_step if frozen else sim.dt
+    end = sim.case.simulation.end_time
+    raise ConfigError(
+        f"simulation.end_time: {end:g} s gives no step of {key} = {dt:g} s after t = "
+        f"{sim.time:g} s (the run makes round((end_time - t) / time_step) steps); the end time "
+        f"is in seconds: give at least {sim.time + dt:g}"
+    )
+
+
 def insertion_warnings(case: Case) -> list[str]:
     """Pour entries that pour nothing before ``simulation.end_time``."""
     end = case.simulation.end_time
@@ -574,6 +591,7 @@ def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> V
     case = load_case(path)
     check_completeness(case)
     sim = Simulation(case, threads=threads)
+    check_step_count(sim)
     check_wall_overlaps(sim)
     warnings = check_thermal_selections(sim)
     warnings += insertion_warnings(case) + output_interval_warnings(case)
