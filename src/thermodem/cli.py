@@ -392,11 +392,14 @@ def info(directory: Path = typer.Argument(..., help="output directory")) -> None
 def plot(
     directory: Path = typer.Argument(..., help="output directory"),
     out: Path | None = typer.Option(None, "--out", help="where the PNGs go (default DIR/plots)"),
+    overwrite: bool = typer.Option(
+        False, "--overwrite", help="replace figures of the same names in --out"
+    ),
 ) -> None:
     """PNG figures of timeseries.csv: energies, contacts, temperatures and heat."""
     from thermodem.io.plots import plot_directory
 
-    for path in _guarded(plot_directory, directory, out):
+    for path in _guarded(plot_directory, directory, out, overwrite):
         typer.echo(str(path))
 
 

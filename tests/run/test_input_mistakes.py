@@ -153,3 +153,30 @@ def test_run_restart_with_an_end_time_before_the_checkpoint_is_refused(tmp_path:
     assert "is not after the time of the checkpoint" in result.output
     result = _cli("run", "--restart", ckpt, "--output", again, "--steps", "2", "--no-progress")
     assert result.exit_code == 0, result.output
+
+
+def test_plot_never_replaces_the_users_figures_and_refuses_a_file(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = _cli("run", _write(tmp_path), "--output", out, "--steps", "3", "--no-progress")
+    assert result.exit_code == 0, result.output
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "energies.png").write_bytes(b"my own figure")
+    result = _cli("plot", out, "--out", mine)
+    assert result.exit_code == 2, result.output
+    assert "already holds energies.png, which this would replace; give --overwrite" in (
+        result.output
+    )
+    assert (mine / "energies.png").read_bytes() == b"my own figure"
+    result = _cli("plot", out, "--out", mine, "--overwrite")
+    assert result.exit_code == 0, result.output
+    assert (mine / "energies.png").read_bytes()[:4] == b"\x89PNG"
+    for _ in range(2):  # DIR/plots is thermodem's: plotted again without --overwrite
+        assert _cli("plot", out).exit_code == 0
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    for target, text in ((a_file, "is a file, not a directory"),
+                         (a_file / "sub", "is under the file")):  # fmt: skip
+        result = _cli("plot", out, "--out", target)
+        assert result.exit_code == 2, result.output
+        assert text in result.output and "Traceback" not in result.output

@@ -50,10 +50,45 @@ def _plot(ax, t: np.ndarray, data: dict[str, np.ndarray], names: list[str], ylab
     return drawn
 
 
+#: Every figure :func:`plot_directory` may write.
+FIGURES = ("energies.png", "contacts.png", "temperature.png", "heat.png", "generation.png")
+
+
+def _plot_target(directory: Path, out: str | os.PathLike[str] | None, overwrite: bool) -> Path:
+    """The directory the figures go to, made; ConfigError for a path under a file, and for
+    figures of the same names in a directory of the user's choice (``--out``) unless
+    ``overwrite`` (``DIR/plots`` is thermodem's own and is replaced)."""
+    target = Path(out) if out is not None else directory / "plots"
+    for parent in (target, *target.parents):
+        if parent.exists():
+            if not parent.is_dir():
+                where = "is a file" if parent == target else f"is under the file {str(parent)!r}"
+                raise ConfigError(
+                    f"--out {str(target)!r} {where}, not a directory; choose another --out"
+                )
+            break
+    own = out is None or target.resolve() == (directory / "plots").resolve()
+    if not own and not overwrite and target.is_dir():
+        existing = [name for name in FIGURES if (target / name).exists()]
+        if existing:
+            raise ConfigError(
+                f"--out {str(target)!r} already holds {', '.join(existing)}, which this would "
+                "replace; give --overwrite to replace them, or another --out"
+            )
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"--out {str(target)!r} cannot be made: {exc.strerror}") from None
+    return target
+
+
 def plot_directory(
-    directory: str | os.PathLike[str], out: str | os.PathLike[str] | None = None
+    directory: str | os.PathLike[str],
+    out: str | os.PathLike[str] | None = None,
+    overwrite: bool = False,
 ) -> list[Path]:
-    """Write the figures; returns their paths. ConfigError without a readable time series."""
+    """Write the figures; returns their paths. ConfigError without a readable time series, or
+    for an ``out`` that is a file or holds figures of the same names (unless ``overwrite``)."""
     from thermodem.engine.runner import TIMESERIES_FILE, read_timeseries
 
     directory = Path(directory)
@@ -63,8 +98,7 @@ def plot_directory(
     data = read_timeseries(path)
     if "time" not in data or data["time"].size == 0:
         raise ConfigError(f"{path} has no rows yet")
-    target = Path(out) if out is not None else directory / "plots"
-    target.mkdir(parents=True, exist_ok=True)
+    target = _plot_target(directory, out, overwrite)
     t = data["time"]
     written: list[Path] = []
 
