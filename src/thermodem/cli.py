@@ -329,6 +329,20 @@ def etc(
         apply_threads(t)
 
     def go() -> list:
+        import math
+
+        if not (math.isfinite(temperature) and temperature > 0.0):
+            raise ConfigError(f"--temperature {temperature!r}: must be a finite temperature > 0 K")
+        if not (math.isfinite(difference) and difference != 0.0):
+            raise ConfigError(f"--difference {difference!r}: must be finite and not 0 [K]")
+        if not temperature + difference > 0.0:
+            raise ConfigError(
+                f"--difference {difference!r}: the hot layer would be at "
+                f"{temperature + difference:g} K; temperatures must stay > 0 K"
+            )
+        for s in layer or ():
+            if not (math.isfinite(s) and s > 0.0):
+                raise ConfigError(f"--layer {s!r}: must be a finite thickness > 0 [m]")
         if periodic:
             return effective_conductivity_of_case(load_case(case), axes, periodic=True)
         return effective_conductivity_of_case(

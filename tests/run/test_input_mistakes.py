@@ -180,3 +180,31 @@ def test_plot_never_replaces_the_users_figures_and_refuses_a_file(tmp_path: Path
         result = _cli("plot", out, "--out", target)
         assert result.exit_code == 2, result.output
         assert text in result.output and "Traceback" not in result.output
+
+
+def test_export_under_a_file_is_refused(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert (
+        _cli("run", _write(tmp_path), "--output", out, "--steps", "2", "--no-progress").exit_code
+        == 0
+    )
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    result = _cli("export", out, "--out", a_file / "particles.csv")
+    assert result.exit_code == 2, result.output
+    assert "a_file is a file, not a directory; choose another --out" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_etc_refuses_impossible_temperatures_and_layers(tmp_path: Path) -> None:
+    case = _write(tmp_path, thermal={})
+    for args, text in (
+        (["--temperature", "-5"], "--temperature -5.0: must be a finite temperature > 0 K"),
+        (["--difference", "0"], "--difference 0.0: must be finite and not 0 [K]"),
+        (["--difference", "nan"], "--difference nan: must be finite and not 0 [K]"),
+        (["--temperature", "10", "--difference", "-20"], "the hot layer would be at -10 K"),
+        (["--layer", "-0.002"], "--layer -0.002: must be a finite thickness > 0 [m]"),
+    ):
+        result = _cli("etc", case, *args)
+        assert result.exit_code == 2, (args, result.output)
+        assert text in result.output, (args, result.output)

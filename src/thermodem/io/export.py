@@ -159,7 +159,17 @@ def write_csv(table: ParticleTable, out: Path | None, overwrite: bool = True) ->
         raise ConfigError(f"--out {out}: is a directory; give a file name")
     if out.exists() and not overwrite:
         raise ConfigError(f"--out {out}: the file exists; give --overwrite to replace it")
-    out.parent.mkdir(parents=True, exist_ok=True)
+    for parent in out.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ConfigError(
+                    f"--out {out}: {parent} is a file, not a directory; choose another --out"
+                )
+            break
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"--out {out}: its directory cannot be made: {exc.strerror}") from None
     tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
     tmp.write_text(buffer.getvalue())
     os.replace(tmp, out)
