@@ -852,10 +852,18 @@ class ThermalEngine:
         if not self.fuse_generation:  # (else the update emptied the accumulators)
             self._generation_used()
         if bad_gid >= 0:
+            if dt > 0.5 * self.limit:
+                cause = f"thermal time step {dt:.4g} s against the limit {self.limit:.4g} s"
+            else:  # a stable step: the heat itself (a source, flux or generation) is too large
+                q = float(heat_rate[bad]) if 0 <= bad < heat_rate.shape[0] else math.nan
+                cause = (
+                    f"its heat rate {q:.4g} W for its heat capacity (a heat source, flux or "
+                    f"generation too large; the thermal time step {dt:.4g} s is within the "
+                    f"limit {self.limit:.4g} s)"
+                )
             raise SimulationError(
                 f"temperature of particle {bad_gid} became {bad_temperature:.6g} K at step "
-                f"{sim.step_count} (t = {time:.6g} s); likely cause: thermal time step "
-                f"{dt:.4g} s against the limit {self.limit:.4g} s",
+                f"{sim.step_count} (t = {time:.6g} s); likely cause: {cause}",
                 sim.step_count,
                 time,
                 bad_gid,
