@@ -34,7 +34,6 @@ from typing import Any
 from numba import njit
 from numba.core.errors import NumbaPerformanceWarning
 
-
 #: ``parallel`` option of the twins: Numba's parallel pipeline with every parallel
 #: transformation off (no parfor, so no gufunc and no thread launch: the loops run in order
 #: on the calling thread). Measured: the twin compiled with ``parallel=False`` ran the
