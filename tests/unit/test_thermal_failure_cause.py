@@ -15,12 +15,21 @@ def _case(flux: float) -> dict:
         "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0, 0, 0]},
         "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
         "materials": {
-            "grain": {"density": 2500.0, "youngs_modulus": 1e7, "poisson_ratio": 0.3,
-                      "thermal_conductivity": 1.0, "specific_heat": 800.0}
+            "grain": {
+                "density": 2500.0,
+                "youngs_modulus": 1e7,
+                "poisson_ratio": 0.3,
+                "thermal_conductivity": 1.0,
+                "specific_heat": 800.0,
+            }
         },  # fmt: skip
         "insertion": [
-            {"kind": "list", "material": "grain", "positions": [[0.005, 0.005, 0.005]],
-             "radii": [1e-3]}
+            {
+                "kind": "list",
+                "material": "grain",
+                "positions": [[0.005, 0.005, 0.005]],
+                "radii": [1e-3],
+            }
         ],  # fmt: skip
         "thermal": {
             "direct_conduction": "none",
