@@ -10,6 +10,8 @@ thread count switches the variant, and serial and parallel give identical sums.
 
 from __future__ import annotations
 
+import os
+
 import numba
 import numpy as np
 import pytest
@@ -58,11 +60,11 @@ def test_serial_twin_is_its_own_compiled_function(restore_threads):
     assert _chunk_sums.serial is not _chunk_sums.parallel
     # Numba's parallel pipeline with every parallel transformation off: no parfor, the
     # loops in order on the calling thread (kernels/variants.py: NO_PARFORS)
-    assert _chunk_sums.serial.targetoptions["parallel"] == V.NO_PARFORS
-    assert not any(V.NO_PARFORS.values())
-    metadata = _chunk_sums.serial.get_metadata(_chunk_sums.serial.signatures[0])
-    if metadata and metadata.get("parfor_diagnostics") is not None:  # (compiled, not loaded)
-        assert len(metadata["parfor_diagnostics"].initial_parfors) == 0
+    # Numba's ParallelOptions pops the keys of the dict it gets: each twin has its own copy
+    # and the module's dict keeps every switch (a shared, emptied dict turned every twin
+    # after the first into a full parallel kernel)
+    assert len(V.NO_PARFORS) == 8 and not any(V.NO_PARFORS.values())
+    assert _chunk_sums.serial.targetoptions["parallel"] is not V.NO_PARFORS
     assert _chunk_sums.parallel.targetoptions["parallel"]
     # their own cache entries (index files named after the qualname)
     assert _chunk_sums.serial.py_func.__qualname__ == "_chunk_sums__serial"
@@ -116,3 +118,46 @@ def test_twin_compiles_without_a_warning(restore_threads):
         kernel(values, out)
     assert np.array_equal(out, factor * values)
     assert not [w for w in seen if issubclass(w.category, NumbaPerformanceWarning)]
+
+
+@pytest.mark.filterwarnings("ignore::numba.core.errors.NumbaPerformanceWarning")
+def test_every_twin_compiles_without_a_parfor(tmp_path):
+    """Compiled fresh in a subprocess (an empty cache, so the parfor diagnostics exist):
+    two kernels' twins, one after the other, have no parfor; the parallel kernels do."""
+    import subprocess
+    import sys
+    import textwrap
+
+    script = textwrap.dedent(
+        """
+        import numpy as np
+        from numba import prange
+        from thermodem.kernels import variants as V
+
+        @V.parallel_kernel()
+        def first(values, out):
+            for k in prange(values.shape[0]):
+                out[k] = 2.0 * values[k]
+
+        @V.parallel_kernel()
+        def second(values, out):
+            for k in prange(values.shape[0]):
+                out[k] = 3.0 * values[k]
+
+        values, out = np.arange(100.0), np.zeros(100)
+        for kernel in (first, second):
+            kernel.serial(values, out)
+            kernel.parallel(values, out)
+            counts = []
+            for variant in (kernel.serial, kernel.parallel):
+                metadata = variant.get_metadata(variant.signatures[0])
+                counts.append(len(metadata["parfor_diagnostics"].initial_parfors))
+            print(kernel.__name__, *counts)
+        """
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    path = tmp_path / "twins.py"  # a file: Numba caches no function defined in ``-c``
+    path.write_text(script)
+    done = subprocess.run([sys.executable, str(path)], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["first", "0", "1", "second", "0", "1"]

@@ -100,7 +100,9 @@ class ParallelKernel:
             twin.__module__ = f.__module__
             twin.__doc__ = f.__doc__
             twin.__kwdefaults__ = f.__kwdefaults__
-            self._serial = njit(cache=True, parallel=NO_PARFORS, **self._options)(twin)
+            # a copy: Numba's ParallelOptions pops the keys of the dict it is given, so a
+            # shared dict would leave every later twin with all transformations on
+            self._serial = njit(cache=True, parallel=dict(NO_PARFORS), **self._options)(twin)
         return self._serial
 
     def __call__(self, *args: Any) -> Any:
