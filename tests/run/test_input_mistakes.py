@@ -208,3 +208,38 @@ def test_etc_refuses_impossible_temperatures_and_layers(tmp_path: Path) -> None:
         result = _cli("etc", case, *args)
         assert result.exit_code == 2, (args, result.output)
         assert text in result.output, (args, result.output)
+
+
+def test_a_pour_of_an_unbounded_lognormal_is_refused_before_the_run(tmp_path: Path) -> None:
+    """It was accepted, and a batch that drew a particle larger than the region stopped the
+    run with a ValueError traceback from Pourer.emit."""
+    pour = {**POUR, "interval": 1.0e-5, "rate": 1.0e5}
+    pour["distribution"] = {"kind": "lognormal", "median": 0.0005, "sigma": 1.5}
+    case = _write(tmp_path, insertion=[pour])
+    for args in (("validate", case), ("run", case, "--output", tmp_path / "o", "--no-progress")):
+        result = _cli(*args)
+        assert result.exit_code == 2, result.output
+        assert (
+            "insertion.0.distribution.max_radius: missing; a pour needs a largest "
+            "radius, but the lognormal distribution (median 0.0005 m, sigma 1.5) is unbounded"
+        ) in result.output
+        assert "e.g. max_radius: 0.045" in result.output
+        assert "Traceback" not in result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_random_box_too_thin_names_its_sizes_as_plain_numbers(tmp_path: Path) -> None:
+    entry = {
+        "kind": "random_box",
+        "material": "glass",
+        "distribution": {"kind": "mono", "radius": 0.003},
+        "lower": [0, 0, 0],
+        "upper": [0.004, 0.01, 0.01],
+        "count": 1,
+    }
+    result = _cli("validate", _write(tmp_path, insertion=[entry]))
+    assert result.exit_code == 2, result.output
+    assert (
+        "a particle of radius 0.003 m does not fit in the box, which is 0.004 m wide along x"
+    ) in result.output
+    assert "np.float64" not in result.output

@@ -149,7 +149,12 @@ def test_section_parses_every_kind(tmp_path):
             {
                 "kind": "pour",
                 "material": "a",
-                "distribution": {"kind": "lognormal", "median": 0.01, "sigma": 0.2},
+                "distribution": {
+                    "kind": "lognormal",
+                    "median": 0.01,
+                    "sigma": 0.2,
+                    "max_radius": 0.02,  # a pour needs a largest radius
+                },
                 "region": {
                     "kind": "cylinder",
                     "base_centre": [0, 0, 1],

@@ -519,7 +519,18 @@ class PourInsertion(_EntryBase):
         middle of the run)."""
         r_max = self.distribution.max_radius_bound
         if r_max is None:
-            return
+            dist = self.distribution
+            median = math.exp(dist.mu)
+            cut = median * math.exp(3.0 * dist.sigma)
+            raise ValueError(
+                f"distribution.max_radius: missing; a pour needs a largest radius, but the "
+                f"{dist.kind} distribution (median {median:.6g} m, sigma {dist.sigma:g}) is "
+                "unbounded, so a batch could draw a particle larger than the region in the "
+                "middle of the run. Set max_radius, the cut-off of the distribution (as DEM codes "
+                f"cut size distributions off), e.g. max_radius: {cut:.3g} (the median × "
+                "e^(3 sigma): 99.87 % of an uncut distribution lies below it); min_radius "
+                "optional"
+            )
         region = self.region
         if region.kind == "box":
             for a, axis in enumerate(_AXES):

@@ -230,6 +230,11 @@ class _Obstacles:
 # --------------------------------------------------------------------------------------------
 
 
+def _m(value: float) -> str:
+    """A length for a message: ``0.002 m`` (not ``np.float64(0.002) m``)."""
+    return f"{float(value):.6g} m"
+
+
 class _Box:
     """Axis-aligned box: candidate centres keep a distance r from every face."""
 
@@ -245,8 +250,8 @@ class _Box:
         for a, axis in enumerate(_AXES):
             if extent[a] < 2.0 * r_max:
                 raise ValueError(
-                    f"{what}: a particle of radius {r_max!r} m does not fit in the box, which is "
-                    f"{extent[a]!r} m wide along {axis}; enlarge the box or use smaller radii"
+                    f"{what}: a particle of radius {_m(r_max)} does not fit in the box, which is "
+                    f"{_m(extent[a])} wide along {axis}; enlarge the box or use smaller radii"
                 )
 
     def volume(self) -> float:
@@ -285,8 +290,8 @@ class _Cylinder:
     def check_fits(self, r_max: float, what: str) -> None:
         if self.radius < r_max or self.length < 2.0 * r_max:
             raise ValueError(
-                f"{what}: a particle of radius {r_max!r} m does not fit in the cylinder of "
-                f"radius {self.radius!r} m and length {self.length!r} m; enlarge the cylinder "
+                f"{what}: a particle of radius {_m(r_max)} does not fit in the cylinder of "
+                f"radius {_m(self.radius)} and length {_m(self.length)}; enlarge the cylinder "
                 "or use smaller radii"
             )
 
@@ -321,8 +326,8 @@ class _Rect(_Box):
         for a, axis in enumerate(_AXES[:2]):
             if extent[a] < 2.0 * r_max:
                 raise ValueError(
-                    f"{what}: a particle of radius {r_max!r} m does not fit in the box, which is "
-                    f"{extent[a]!r} m wide along {axis}; enlarge the box or use smaller radii"
+                    f"{what}: a particle of radius {_m(r_max)} does not fit in the box, which is "
+                    f"{_m(extent[a])} wide along {axis}; enlarge the box or use smaller radii"
                 )
 
     def volume(self) -> float:
@@ -352,8 +357,8 @@ class _Circle:
     def check_fits(self, r_max: float, what: str) -> None:
         if self.radius < r_max:
             raise ValueError(
-                f"{what}: a particle of radius {r_max!r} m does not fit in the circle of "
-                f"radius {self.radius!r} m; enlarge the region or use smaller radii"
+                f"{what}: a particle of radius {_m(r_max)} does not fit in the circle of "
+                f"radius {_m(self.radius)}; enlarge the region or use smaller radii"
             )
 
     def volume(self) -> float:
