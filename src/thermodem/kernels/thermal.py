@@ -21,7 +21,9 @@ from thermodem.kernels.contact import CHUNK, STATE_TOUCHING
 from thermodem.kernels.contact_conduction import _pp_conductance, _pw_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
 from thermodem.kernels.variants import parallel_kernel
-from thermodem.state.heat import M_GENERATION, M_SOURCE
+from thermodem.state.heat import GENERATION, M_GENERATION, M_SOURCE
+
+assert len(GENERATION) == 6  # (euler_step reads the six accumulators unrolled)
 
 _CONDUCTION_PASSES: dict[tuple[int, int, int], Any] = {}
 
@@ -253,7 +255,8 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on,
 
     Fills the source column (with ``source_on``; without sources it stays zero), forms the
     total heat rate: the heat generation χ E_g / Δt of the mechanisms ``gen_selected``
-    (indices g into the accumulators ``gen_energy``; empty without generation; ``gen_scale``
+    (indices g into the accumulators ``gen_energy``, shape (n, 6); empty without generation,
+    and with generation all six accumulators are read: the unselected stay zero; ``gen_scale``
     = χ / Δt, the step's own length, so that the heat applied is χ E_g exactly), emptying
     the accumulators (kernels/generation.py's conversion, fused here: no conversion pass and
     no clearing pass; the generation columns are not written, ``columns`` must not hold them:
@@ -273,7 +276,7 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on,
     """
     n = temperature.shape[0]
     nmech = by_mechanism.shape[0]
-    ngen = gen_selected.shape[0]
+    generation = gen_selected.shape[0] > 0
     nchunks = (n + EULER_CHUNK - 1) // EULER_CHUNK
     for c in prange(nchunks):
         limit = math.inf
@@ -283,16 +286,34 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on,
         row = part[c]
         for m in range(nmech):
             row[EULER_FIXED + m] = 0.0
+        # the generation sums of the chunk in scalars (a sum into ``row`` per particle and
+        # mechanism chained every addition through memory: 0.28 -> 0.11 ms per step for
+        # 50,000 particles); all six accumulators are read, the unselected ones stay zero
+        s0 = s1 = s2 = s3 = s4 = s5 = 0.0
         for i in range(c * EULER_CHUNK, min(n, (c + 1) * EULER_CHUNK)):
             if source_on:
                 by_mechanism[M_SOURCE, i] = source[i]
             q = 0.0
-            for s in range(ngen):
-                mech = gen_selected[s]
-                qm = gen_scale * gen_energy[i, mech]
-                gen_energy[i, mech] = 0.0
-                q += qm
-                row[EULER_FIXED + M_GENERATION + mech] += qm
+            if generation:
+                q0 = gen_scale * gen_energy[i, 0]
+                q1 = gen_scale * gen_energy[i, 1]
+                q2 = gen_scale * gen_energy[i, 2]
+                q3 = gen_scale * gen_energy[i, 3]
+                q4 = gen_scale * gen_energy[i, 4]
+                q5 = gen_scale * gen_energy[i, 5]
+                gen_energy[i, 0] = 0.0
+                gen_energy[i, 1] = 0.0
+                gen_energy[i, 2] = 0.0
+                gen_energy[i, 3] = 0.0
+                gen_energy[i, 4] = 0.0
+                gen_energy[i, 5] = 0.0
+                s0 += q0
+                s1 += q1
+                s2 += q2
+                s3 += q3
+                s4 += q4
+                s5 += q5
+                q = q0 + q1 + q2 + q3 + q4 + q5
             for m in columns:
                 qm = by_mechanism[m, i]
                 q += qm
@@ -317,6 +338,13 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on,
             temperature[i] = t
             if bad < 0 and not (t > 0.0 and math.isfinite(t)):
                 bad = i
+        if generation:
+            row[EULER_FIXED + M_GENERATION] = s0
+            row[EULER_FIXED + M_GENERATION + 1] = s1
+            row[EULER_FIXED + M_GENERATION + 2] = s2
+            row[EULER_FIXED + M_GENERATION + 3] = s3
+            row[EULER_FIXED + M_GENERATION + 4] = s4
+            row[EULER_FIXED + M_GENERATION + 5] = s5
         row[0] = limit
         row[1] = where
         row[2] = absorbed
