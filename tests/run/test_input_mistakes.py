@@ -4,9 +4,14 @@ but does not do what it says, and the refusals that need a run directory or a ch
 
 from __future__ import annotations
 
+import importlib.util
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
+import pytest
 import yaml
 from typer.testing import CliRunner
 
@@ -243,3 +248,60 @@ def test_a_random_box_too_thin_names_its_sizes_as_plain_numbers(tmp_path: Path) 
         "a particle of radius 0.003 m does not fit in the box, which is 0.004 m wide along x"
     ) in result.output
     assert "np.float64" not in result.output
+
+
+def test_a_pour_region_through_a_wall_is_refused_before_the_run(tmp_path: Path) -> None:
+    """Poured particles were not checked against the walls: a region reaching through the
+    floor put particles into it (the run stopped blaming the stiffness, or threw them out)."""
+    floor = [{"kind": "plane", "point": [0, 0, 0.007], "normal": [0, 0, 1], "material": "glass",
+              "name": "floor"}]  # fmt: skip
+    case = _write(tmp_path, walls=floor, insertion=[POUR])
+    result = _cli("validate", case)
+    assert result.exit_code == 2, result.output
+    assert (
+        "error: insertion.0.region: a particle of radius 0.001 m poured with its centre at "
+        "[0.001, 0.001, 0.007] would overlap walls.0 (floor) at the start: the wall passes 0 m "
+        "from that centre. Poured particles must start clear of every wall"
+    ) in result.output
+    out = tmp_path / "out"
+    result = _cli("run", case, "--output", out, "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "insertion.0.region: a particle of radius 0.001 m" in result.output
+    assert json.loads((out / "status.json").read_text())["refused_input"] is True
+    # a region wholly behind a one-sided plane, and one outside a box of walls
+    flipped = [{**floor[0], "point": [0, 0, 0.002], "normal": [0, 0, -1]}]
+    result = _cli("validate", _write(tmp_path, walls=flipped, insertion=[POUR]))
+    assert result.exit_code == 2, result.output
+    assert "m behind the plane, which is one-sided (its normal [0.0, 0.0, -1.0]" in (result.output)
+    box = [{"kind": "box", "lower": [0, 0, 0], "upper": [0.01, 0.01, 0.005],
+            "material": "glass"}]  # fmt: skip
+    result = _cli("validate", _write(tmp_path, walls=box, insertion=[POUR]))
+    assert result.exit_code == 2, result.output
+    assert "would start outside the box walls.0 (box0), above its z range 0 .. 0.005 m" in (
+        result.output
+    )
+    # clear of the walls: accepted
+    assert _cli("validate", _write(tmp_path, walls=CASE["walls"], insertion=[POUR])).exit_code == 0
+
+
+MPIEXEC = Path(sys.executable).parent / "mpiexec"
+
+
+@pytest.mark.skipif(
+    importlib.util.find_spec("mpi4py") is None or not MPIEXEC.exists(),
+    reason="mpi4py and the mpich wheel (test extras) are not installed",
+)
+def test_mpi_run_makes_the_checks_of_the_serial_run(tmp_path: Path) -> None:
+    """mpiexec -n 2 thermodem run refuses what the serial run refuses before a step (the
+    flipped plane ran and stopped at step 1 with exit 1)."""
+    walls = [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, -1], "material": "glass"}]
+    out = tmp_path / "out"
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PMI_", "OMPI_", "PMIX_"))}
+    cmd = [str(MPIEXEC), "-n", "2", str(Path(sys.executable).parent / "thermodem"), "run",
+           str(_write(tmp_path, walls=walls)), "--output", str(out), "--no-progress"]  # fmt: skip
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert res.stderr.count("error: walls.0 (plane0): particle") == 1, res.stderr
+    assert "its normal [0.0, 0.0, -1.0] must point towards the particles" in res.stderr
+    assert "Traceback" not in res.stdout + res.stderr
+    assert json.loads((out / "status.json").read_text())["refused_input"] is True

@@ -74,12 +74,9 @@ from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
     check_completeness,
     check_resources,
-    check_step_count,
-    check_thermal_selections,
-    check_wall_overlaps,
     estimate_resources,
     format_duration,
-    insertion_warnings,
+    pre_run_checks,
     total_steps,
 )
 from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
@@ -462,10 +459,7 @@ def run_case(
         run_id = status.data["run_id"]
         try:
             sim = Simulation(case, threads=threads)
-            check_step_count(sim)
-            check_wall_overlaps(sim)
-            notes = check_thermal_selections(sim) + insertion_warnings(case)
-            for warning in notes + check_simulation_time_step(sim):
+            for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
                 runlog.warn(warning)
             _header(runlog, sim, threads, output)
             run = _make_run(

@@ -429,12 +429,13 @@ def check_wall_overlaps(sim: Simulation) -> None:
     from thermodem.geometry import wall_layout as WL
 
     p = sim.particles
-    if p.count == 0 or sim.wall_rows.shape[0] == 0:
+    n = sim.owned_count  # (on several MPI ranks: this rank's particles, not its ghosts)
+    if n == 0 or sim.wall_rows.shape[0] == 0:
         return
     case = sim.case
     limit = case.simulation.max_overlap_ratio
     owners = wall_row_owners(case)
-    x, radius = p.position[: p.count], p.radius[: p.count]
+    x, radius = p.position[:n], p.radius[:n]
     for w in range(sim.wall_rows.shape[0]):
         kind, row = int(sim.wall_kind[w]), sim.wall_rows[w]
         d = wall_distances(kind, row, x)
@@ -483,6 +484,7 @@ def check_thermal_selections(sim: Simulation) -> list[str]:
     if th is None:
         return []
     p = sim.particles
+    count = sim.global_count  # (on several MPI ranks: every rank's particles together)
     pours = any(e.kind == "pour" for e in sim.case.insertion)
     warnings: list[str] = []
     for key in ("fixed_temperature", "heat_flux", "volumetric_source"):
@@ -490,14 +492,15 @@ def check_thermal_selections(sim: Simulation) -> list[str]:
             sel, where = entry.select, f"thermal.{key}.{k}.select"
             shown = sel.model_dump(mode="json", exclude_none=True)
             if sel.ids is not None and not pours:
-                missing = [i for i in sel.ids if i >= p.count]
+                missing = [i for i in sel.ids if i >= count]
                 if missing:
                     raise ConfigError(
-                        f"{where}.ids: {missing} are no particle: the {p.count} particles have "
-                        f"the global ids 0 ... {p.count - 1} (in insertion order) and none is "
+                        f"{where}.ids: {missing} are no particle: the {count} particles have "
+                        f"the global ids 0 ... {count - 1} (in insertion order) and none is "
                         "poured later"
                     )
-            if selected(sel, p, sim.material_index).any():
+            taken = selected(sel, p, sim.material_index)[: sim.owned_count]
+            if sim.sum_over_ranks(float(np.count_nonzero(taken))) > 0.0:
                 continue
             if sel.region is None and not pours:
                 raise ConfigError(
@@ -557,6 +560,166 @@ def insertion_warnings(case: Case) -> list[str]:
     return out
 
 
+def _radius_range(dist: Any) -> tuple[float, float]:
+    """(smallest, largest) radius a (bounded) distribution can draw [m]; 0 for a smallest
+    radius without a bound (a lognormal without min_radius)."""
+    if dist.kind == "mono":
+        return float(dist.radius), float(dist.radius)
+    if dist.kind == "discrete":
+        radii = [r for r, f in zip(dist.radii, dist.fractions, strict=True) if f > 0]
+        return float(min(radii)), float(max(radii))
+    return float(getattr(dist, "min_radius", None) or 0.0), float(dist.max_radius_bound)
+
+
+def _pour_centres(region: Any, r: float, planar: bool) -> np.ndarray:
+    """Where the centre of a poured particle of radius ``r`` may be: points spanning the
+    region shrunk by ``r`` (its corners and a grid of 9 per axis; a cylinder: rings of 36
+    angles at 5 radii and 9 heights), as the pour samples them (geometry/random_fill.py)."""
+    from thermodem.geometry.random_fill import _Box, _Circle, _region_of
+
+    shape = _region_of(region, planar)
+    if isinstance(shape, _Box):  # (and the 2D rectangle)
+        axes = [
+            np.linspace(lo + r, hi - r, 9) for lo, hi in zip(shape.lower, shape.upper, strict=True)
+        ]
+        if planar:
+            axes[2] = np.zeros(1)
+        grid = np.meshgrid(*axes, indexing="ij")
+        return np.column_stack([g.ravel() for g in grid])
+    theta = np.linspace(0.0, 2.0 * np.pi, 36, endpoint=False)
+    rho = np.linspace(0.0, max(shape.radius - r, 0.0), 5)
+    ring = (rho[:, None] * np.cos(theta)).ravel(), (rho[:, None] * np.sin(theta)).ravel()
+    if isinstance(shape, _Circle):
+        out = np.zeros((ring[0].size, 3))
+        out[:, 0] = shape.centre[0] + ring[0]
+        out[:, 1] = shape.centre[1] + ring[1]
+        return out
+    h = np.linspace(r, max(shape.length - r, r), 9)
+    pts = (
+        shape.base
+        + h[:, None, None] * shape.axis
+        + ring[0][None, :, None] * shape.e1
+        + ring[1][None, :, None] * shape.e2
+    )
+    return pts.reshape(-1, 3)
+
+
+def check_pour_walls(sim: Simulation) -> None:
+    """Refuse a pour whose region reaches through a wall or lies behind it: a poured particle
+    would start overlapping the wall (the run would stop blaming the stiffness, or throw it
+    out at speed), or on the far side of it. Checked against the walls at their start
+    positions, for the smallest and the largest radius of the distribution (the points of
+    :func:`_pour_centres`; exact for planes, whose distance is linear). ConfigError naming
+    the entry, the wall, a point and the cause."""
+    from thermodem.geometry import wall_layout as WL
+
+    rows = sim.wall_rows.shape[0]
+    if rows == 0:
+        return
+    case = sim.case
+    owners = wall_row_owners(case)
+    span = float(np.max(np.subtract(case.domain.upper, case.domain.lower)))
+    for k, entry in enumerate(case.insertion):
+        if entry.kind != "pour":
+            continue
+        for r in sorted(set(_radius_range(entry.distribution))):
+            x = _pour_centres(entry.region, r, sim.planar)
+            for w in range(rows):
+                kind, row = int(sim.wall_kind[w]), sim.wall_rows[w]
+                d = wall_distances(kind, row, x)
+                depth = r - d
+                i = int(np.argmax(depth))
+                if not depth[i] > 1e-9 * span:
+                    continue
+                wall = owners[w] if w < len(owners) else w
+                where = [round(float(c), 9) for c in x[i]]
+                if kind == WL.PLANE and d[i] < 0.0:
+                    normal = [float(c) for c in row[WL.COL_NORMAL : WL.COL_NORMAL + 3]]
+                    why = (
+                        f"that point lies {-d[i]:.6g} m behind the plane, which is one-sided "
+                        f"(its normal {normal} points to the particles' side)"
+                    )
+                elif kind == WL.CYLINDER and d[i] < 0.0:
+                    inside = row[WL.COL_SIDE] > 0.0
+                    why = (
+                        f"that point lies {'outside' if inside else 'inside'} the mantle of "
+                        f"radius {row[WL.COL_RADIUS]:.6g} m, on the side without particles"
+                    )
+                else:
+                    why = f"the wall passes {max(float(d[i]), 0.0):.6g} m from that centre"
+                raise ConfigError(
+                    f"insertion.{k}.region: a particle of radius {r:.6g} m poured with its "
+                    f"centre at {where} would overlap walls.{wall} ({sim.wall_labels[w]}) at "
+                    f"the start: {why}. Poured particles must start clear of every wall (the "
+                    "region is checked against the walls at their start positions): move the "
+                    "region inside the walls, or move the wall"
+                )
+            _check_pour_in_boxes(case, k, x, r, span)
+
+
+def _check_pour_in_boxes(case: Case, k: int, x: np.ndarray, r: float, span: float) -> None:
+    """A box wall holds particles inside: its faces are two-sided rectangles, so a particle
+    poured outside the box (on its lid, beside it) stays outside. Refuse centres ``x`` of
+    pour entry ``k`` outside a box (above an ``open_top`` box is inside: they fall in)."""
+    axes = "xy" if case.simulation.planar else "xyz"
+    top = len(axes) - 1
+    for b, wall in enumerate(case.walls):
+        if wall.kind != "box":
+            continue
+        for a, axis in enumerate(axes):
+            below = wall.lower[a] - x[:, a]
+            above = x[:, a] - wall.upper[a]
+            if wall.open_top and a == top:
+                above = np.zeros_like(above)
+            out = np.maximum(below, above)
+            i = int(np.argmax(out))
+            if out[i] > 1e-9 * span:
+                where = [round(float(c), 9) for c in x[i]]
+                side = "below" if below[i] > 0 else "above"
+                raise ConfigError(
+                    f"insertion.{k}.region: a particle of radius {r:.6g} m poured with its "
+                    f"centre at {where} would start outside the box walls.{b} "
+                    f"({wall.name or f'box{b}'}), {side} its {axis} range {wall.lower[a]:g} .. "
+                    f"{wall.upper[a]:g} m: a box holds the particles inside it (its faces are "
+                    "two-sided), so move the region into the box (above an open_top box is "
+                    "fine: the particles fall in)"
+                )
+
+
+def on_every_rank(sim: Simulation, check: Any) -> Any:
+    """``check(sim)`` of this rank's particles; on several MPI ranks a refusal on any rank
+    is every rank's ConfigError (the lowest such rank's message), so that no rank runs on
+    while another stops. Returns this rank's result."""
+    comm = getattr(sim, "comm", None)
+    if comm is None:
+        return check(sim)
+    error, result = None, None
+    try:
+        result = check(sim)
+    except ConfigError as exc:
+        error = str(exc)
+    first = next((e for e in comm.allgather(error) if e is not None), None)
+    if first is not None:
+        raise ConfigError(first)
+    return result
+
+
+def pre_run_checks(sim: Simulation) -> list[str]:
+    """Every check of a built simulation before the first step of a fresh run: ``thermodem
+    validate``, ``thermodem run`` (:func:`thermodem.engine.runner.run_case`) and its MPI
+    runner (:func:`thermodem.mpi.runner.run_distributed`; collective there: every rank calls
+    it, and a refusal on one rank is every rank's). Raises ConfigError; returns the warnings
+    (the time-step ones last)."""
+    from thermodem.engine.checks import check_simulation_time_step
+
+    case = sim.case
+    check_step_count(sim)
+    on_every_rank(sim, check_wall_overlaps)
+    check_pour_walls(sim)
+    notes = check_thermal_selections(sim) + insertion_warnings(case)
+    return notes + list(on_every_rank(sim, check_simulation_time_step))
+
+
 def output_interval_warnings(case: Case) -> list[str]:
     """Output intervals longer than ``simulation.end_time``: frames (rows, checkpoints) only at
     the start and the end. A value in steps (LIGGGHTS' dump every N steps) is the usual cause.
@@ -585,17 +748,13 @@ class Validation:
 def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> Validation:
     """Layers 1-3 for a case file; raises ConfigError at the first layer that fails."""
     from thermodem.config.load import load_case
-    from thermodem.engine.checks import check_simulation_time_step
     from thermodem.engine.simulation import Simulation
 
     case = load_case(path)
     check_completeness(case)
     sim = Simulation(case, threads=threads)
-    check_step_count(sim)
-    check_wall_overlaps(sim)
-    warnings = check_thermal_selections(sim)
-    warnings += insertion_warnings(case) + output_interval_warnings(case)
-    warnings += check_simulation_time_step(sim)
+    warnings = pre_run_checks(sim)
+    warnings += output_interval_warnings(case)
     estimate = estimate_resources(sim, threads)
     warnings += check_resources(estimate)
     return Validation(case, sim, warnings, estimate)

@@ -32,7 +32,12 @@ from thermodem.config.schema import Case
 from thermodem.engine import runner as R
 from thermodem.engine.checks import check_simulation_time_step
 from thermodem.engine.progress import Progress
-from thermodem.engine.validation import check_completeness, format_duration
+from thermodem.engine.validation import (
+    check_completeness,
+    format_duration,
+    on_every_rank,
+    pre_run_checks,
+)
 from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
 from thermodem.io.checkpoint import (
     Checkpoint,
@@ -372,11 +377,13 @@ def run_distributed(
     try:
         try:
             sim = _build(case, threads, rebalance_threshold, ckpt)
-            warned = _time_step_check(sim)
+            # the checks of the serial runner before the first step (engine/runner.py:
+            # run_case, run_from_checkpoint), collective: a refusal on one rank is every rank's
+            warned = _time_step_check(sim) if ckpt is not None else pre_run_checks(sim)
         except ConfigError as exc:
             if root:
                 runlog.file_only(f"error: {exc}")
-                status.update(status="failed", message=str(exc))
+                status.update(status="failed", message=str(exc), refused_input=True)
             raise
         run = None
         if root:
@@ -498,17 +505,7 @@ def restart_distributed(
 def _time_step_check(sim: DistributedSimulation) -> list[str]:
     """The time-step check of every rank's particles (engine/checks.py): a refusal on any
     rank is every rank's ConfigError (the lowest such rank's message); rank 0's warnings."""
-    error = None
-    warned: list[str] = []
-    try:
-        warned = list(check_simulation_time_step(sim))
-    except ConfigError as exc:
-        error = str(exc)
-    errors = sim.comm.allgather(error)
-    first = next((e for e in errors if e is not None), None)
-    if first is not None:
-        raise ConfigError(first)
-    return warned
+    return list(on_every_rank(sim, check_simulation_time_step))
 
 
 def _read_on_all(comm: Any, path: str | os.PathLike[str]) -> Checkpoint:
