@@ -305,3 +305,23 @@ def test_mpi_run_makes_the_checks_of_the_serial_run(tmp_path: Path) -> None:
     assert "its normal [0.0, 0.0, -1.0] must point towards the particles" in res.stderr
     assert "Traceback" not in res.stdout + res.stderr
     assert json.loads((out / "status.json").read_text())["refused_input"] is True
+
+
+def test_thermal_null_is_told_it_runs_mechanics_only(tmp_path: Path) -> None:
+    """An explicit null is the absent section (as thermal.fluid: null, and as
+    case.resolved.yaml wrote it): a warning, not an error; it ran silently."""
+    case = _write(tmp_path, thermal=None)
+    text = "warning: thermal: null (an empty 'thermal:' key) means no thermal section: this "
+    result = _cli("validate", case)
+    assert result.exit_code == 0, result.output
+    assert text + "case runs mechanics only, without heat; write thermal: {}" in result.output
+    out = tmp_path / "out"
+    result = _cli("run", case, "--output", out, "--steps", "2", "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert text in result.output and "thermal: null" in (out / "run.log").read_text()
+    # the resolved case leaves the absent section out (no warning when it is run again)
+    assert "thermal" not in yaml.safe_load((out / "case.resolved.yaml").read_text())
+    result = _cli("validate", out / "case.resolved.yaml")
+    assert result.exit_code == 0 and "thermal: null" not in result.output
+    # without the key: nothing said
+    assert "thermal: null" not in _cli("validate", _write(tmp_path)).output

@@ -41,10 +41,12 @@ _PLANAR_ONLY = ("thickness", "particle_shape")
 
 
 def _omitted(value: BaseModel) -> tuple[str, ...]:
-    from thermodem.config.schema import SimulationSettings
+    from thermodem.config.schema import Case, SimulationSettings
 
     if isinstance(value, SimulationSettings) and not value.planar:
         return _PLANAR_ONLY
+    if isinstance(value, Case) and value.thermal is None:
+        return ("thermal",)  # absent: mechanics only (an explicit null is warned about)
     return ()
 
 

@@ -716,8 +716,21 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_step_count(sim)
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
-    notes = check_thermal_selections(sim) + insertion_warnings(case)
+    notes = section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
+
+
+def section_warnings(case: Case) -> list[str]:
+    """``thermal: null`` (an empty ``thermal:`` key, its settings commented out or indented
+    wrongly) is the absent section, so the case runs mechanics only: said, since it reads
+    like the heat with every default (``thermal: {}``)."""
+    if case.thermal is not None or "thermal" not in case.model_fields_set:
+        return []
+    return [
+        "thermal: null (an empty 'thermal:' key) means no thermal section: this case runs "
+        "mechanics only, without heat; write thermal: {} for the heat with every default, or "
+        "remove the key"
+    ]
 
 
 def output_interval_warnings(case: Case) -> list[str]:
