@@ -15,7 +15,8 @@ part of the drum and flow for ``--settle`` seconds while the drum turns; that st
   ``conduction+generation`` with it (the generation's cost on top of conduction).
 
     python bench/bench_drum.py --n 50000 --steps 300 --threads 1 2 \\
-        [--cases mechanics generation conduction conduction+generation] [--substeps 1] [--json]
+        [--cases mechanics generation conduction conduction+generation] [--substeps 1] \\
+        [--rounds 3] [--json]
 
 Prints particle-steps per second (wall clock, and per CPU second of the process, which is less
 sensitive to other processes on a shared machine) and the peak memory above the interpreter's
@@ -194,6 +195,12 @@ def main() -> None:
     ap.add_argument("--cases", nargs="*", default=list(CASES), choices=CASES)
     ap.add_argument("--substeps", type=int, default=1)
     ap.add_argument("--settle", type=float, default=0.1, help="seconds of flow before timing")
+    ap.add_argument(
+        "--rounds",
+        type=int,
+        default=1,
+        help="rounds of every case in turn; medians and per-round overheads",
+    )
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -202,18 +209,40 @@ def main() -> None:
         res = timed(args.n, args.steps, args.threads[0], args.cases[0], args.substeps, bed)
         print(json.dumps(res))
         return
-    results = []
-    for case in args.cases:
-        for th in args.threads:
-            env = dict(os.environ, NUMBA_NUM_THREADS=str(th))
-            cmd = [sys.executable, __file__, "--child", "--n", str(args.n), "--steps",
-                   str(args.steps), "--threads", str(th), "--cases", case, "--substeps",
-                   str(args.substeps), "--settle", str(args.settle)]  # fmt: skip
-            out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
-            results.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    rounds = []
+    for _ in range(args.rounds):  # interleaved: a slow spell of the machine hits every case
+        results = []
+        for case in args.cases:
+            for th in args.threads:
+                env = dict(os.environ, NUMBA_NUM_THREADS=str(th))
+                cmd = [sys.executable, __file__, "--child", "--n", str(args.n), "--steps",
+                       str(args.steps), "--threads", str(th), "--cases", case, "--substeps",
+                       str(args.substeps), "--settle", str(args.settle)]  # fmt: skip
+                out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
+                results.append(json.loads(out.stdout.strip().splitlines()[-1]))
+        rounds.append(results)
+        if args.rounds > 1 and not args.json:
+            print(f"round {len(rounds)}:")
+            report(results)
     if args.json:
-        print(json.dumps(results, indent=2))
+        print(json.dumps(rounds if args.rounds > 1 else rounds[0], indent=2))
         return
+    if args.rounds == 1:
+        report(rounds[0])
+        return
+    print(f"median of {args.rounds} rounds:")
+    median = []
+    for k, r in enumerate(rounds[0]):
+        row = dict(r)
+        for key in ("particle_steps_per_s", "particle_steps_per_cpu_s", "load",
+                    "bytes_per_particle_above_baseline"):  # fmt: skip
+            row[key] = float(np.median([rnd[k][key] for rnd in rounds]))
+        median.append(row)
+    report(median)
+
+
+def report(results: list[dict]) -> None:
+    """One line per case and thread count, with the overhead against mechanics."""
     mech = {r["threads"]: r for r in results if r["case"] == "mechanics"}
     for r in results:
         ref = mech.get(r["threads"])
