@@ -308,6 +308,7 @@ def test_thermal_options_and_a_moving_plate_on_2_ranks(tmp_path: Path) -> None:
     steps = 300
     case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=steps * DT)
     glass = case["materials"]["glass"]
+    del glass["specific_heat"]  # (the table replaces it)
     glass["specific_heat_table"] = [[300.0, 800.0], [400.0, 900.0]]
     glass.update(microhardness=3e9, surface_roughness=1e-6, surface_slope=0.1,
                  thermal_accommodation=0.8, youngs_modulus_real=7e10)  # fmt: skip

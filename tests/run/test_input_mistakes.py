@@ -325,3 +325,34 @@ def test_thermal_null_is_told_it_runs_mechanics_only(tmp_path: Path) -> None:
     assert result.exit_code == 0 and "thermal: null" not in result.output
     # without the key: nothing said
     assert "thermal: null" not in _cli("validate", _write(tmp_path)).output
+
+
+def test_a_constant_and_a_table_of_one_property_are_refused(tmp_path: Path) -> None:
+    """Both were accepted and the table replaced the constant silently."""
+    table = [[300.0, 1.0], [400.0, 2.0]]
+    glass = {**CASE["materials"]["glass"], "thermal_conductivity_table": table}
+    result = _cli("validate", _write(tmp_path, materials={"glass": glass}, thermal={}))
+    assert result.exit_code == 2, result.output
+    assert (
+        "materials.glass.thermal_conductivity: 1 W/(m K) is given together with "
+        "thermal_conductivity_table [[300.0, 1.0], [400.0, 2.0]]; the table replaces the "
+        "constant at run time"
+    ) in result.output
+    glass = {**CASE["materials"]["glass"], "specific_heat_table": [[300.0, 700.0]]}
+    result = _cli("validate", _write(tmp_path, materials={"glass": glass}, thermal={}))
+    assert result.exit_code == 2, result.output
+    assert "materials.glass.specific_heat: 800 J/(kg K) is given together with" in result.output
+    # the table alone runs; its resolved case (which wrote the filled-in constant too) and a
+    # checkpoint's stored case of an earlier version are read again
+    glass = {k: v for k, v in CASE["materials"]["glass"].items() if k != "thermal_conductivity"}
+    case = _write(tmp_path, materials={"glass": {**glass, "thermal_conductivity_table": table}},
+                  thermal={})  # fmt: skip
+    out = tmp_path / "out"
+    result = _cli("run", case, "--output", out, "--steps", "2", "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert _cli("validate", out / "case.resolved.yaml").exit_code == 0
+    from thermodem.config.load import case_from_dict
+
+    old = {**yaml.safe_load(case.read_text())}
+    old["materials"]["glass"]["thermal_conductivity"] = 1.0  # as earlier versions stored it
+    assert case_from_dict(old, stored=True).materials["glass"].thermal_conductivity == 1.0

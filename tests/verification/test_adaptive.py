@@ -141,7 +141,9 @@ def test_ledger_closes_with_a_wall_a_source_and_a_fixed_particle(tmp_path: Path)
 
 def test_temperature_dependent_properties_conserve_enthalpy(tmp_path: Path) -> None:
     """k(T) and c(T) tables: Picard in each stage; the pair exchange conserves Σ m h(T)."""
-    mats = {"glass": dict(MATERIAL, thermal_conductivity_table=[[300.0, 1.0], [400.0, 3.0]],
+    constants = ("thermal_conductivity", "specific_heat")  # (a table replaces its constant)
+    glass = {k: v for k, v in MATERIAL.items() if k not in constants}
+    mats = {"glass": dict(glass, thermal_conductivity_table=[[300.0, 1.0], [400.0, 3.0]],
                           specific_heat_table=[[300.0, 700.0], [400.0, 1100.0]])}  # fmt: skip
     thermal = {"time_step": 2.0, "implicit": {"error_tolerance": 1e-3}}
     sim = _sim(_write(tmp_path / "two.txt", [300.0, 400.0]), thermal, materials=mats)

@@ -188,7 +188,12 @@ def test_without_reuse_the_engine_equals_the_exact_model(tmp_path: Path) -> None
         ),
         (
             {},
-            {"steel": dict(GLASS, thermal_conductivity_table=[[300, 20.0], [400, 18.0]])},
+            {
+                "steel": {
+                    **{k: v for k, v in GLASS.items() if k != "thermal_conductivity"},
+                    "thermal_conductivity_table": [[300, 20.0], [400, 18.0]],
+                }
+            },
             "steel have a thermal_conductivity_table",
         ),
     ],

@@ -190,6 +190,7 @@ def test_a_wall_temperature_that_changes_starts_a_new_basis(tmp_path: Path) -> N
 
 
 def test_exponential_refuses_temperature_dependent_properties(tmp_path: Path) -> None:
-    mats = {"glass": dict(MATERIAL, thermal_conductivity_table=[[300.0, 1.0], [400.0, 3.0]])}
+    glass = {k: v for k, v in MATERIAL.items() if k != "thermal_conductivity"}
+    mats = {"glass": dict(glass, thermal_conductivity_table=[[300.0, 1.0], [400.0, 3.0]])}
     with pytest.raises(ConfigError, match="thermal.scheme = 'exponential'.*table"):
         _sim(_chain(tmp_path, 3), {"time_step": 1.0}, materials=mats)

@@ -241,6 +241,7 @@ def test_temperature_dependent_specific_heat_integrates_enthalpy_exactly(tmp_pat
             "volumetric_source": [{"select": {"ids": [0]}, "power_density": 2e5}],
         },
     )
+    del case["materials"]["glass"]["specific_heat"]  # (the table replaces it)
     case["materials"]["glass"]["specific_heat_table"] = [[300.0, c0], [500.0, c0 + b * 200.0]]
     sim = Simulation(case_from_dict(case))
     u0 = sim.thermal.thermal_energy()
@@ -256,6 +257,7 @@ def test_temperature_dependent_conductivity_uses_each_particles_k(tmp_path: Path
     d = 1.95e-3
     path = _write(tmp_path / "two.txt", [(0.0, 0.0, 0.0, R, 300.0), (d, 0.0, 0.0, R, 400.0)])
     case = _case(path, {"frozen_mechanics": True, "time_step": 0.1})
+    del case["materials"]["glass"]["thermal_conductivity"]  # (the table replaces it)
     case["materials"]["glass"]["thermal_conductivity_table"] = [[300.0, 1.0], [400.0, 3.0]]
     sim = Simulation(case_from_dict(case))
     q = sim.particles.heat_rate_by_mechanism[np.argsort(sim.particles.global_id), 0]

@@ -42,11 +42,18 @@ _PLANAR_ONLY = ("thickness", "particle_shape")
 
 def _omitted(value: BaseModel) -> tuple[str, ...]:
     from thermodem.config.schema import Case, SimulationSettings
+    from thermodem.state.materials import Material
 
     if isinstance(value, SimulationSettings) and not value.planar:
         return _PLANAR_ONLY
     if isinstance(value, Case) and value.thermal is None:
         return ("thermal",)  # absent: mechanics only (an explicit null is warned about)
+    if isinstance(value, Material):  # a table's first value, filled in as the reference
+        return tuple(
+            name
+            for name in ("thermal_conductivity", "specific_heat")
+            if getattr(value, f"{name}_table") and name not in value.model_fields_set
+        )
     return ()
 
 

@@ -12,6 +12,7 @@ from thermodem.config.messages import format_validation_error
 from thermodem.config.planar import validation_context
 from thermodem.config.schema import Case
 from thermodem.errors import ConfigError
+from thermodem.state.materials import STORED_CASE_KEY
 
 
 def _format_validation_error(exc: ValidationError, data: Any = None) -> str:
@@ -89,14 +90,18 @@ def _parse_yaml(text: str) -> Any:
         loader.dispose()
 
 
-def case_from_dict(data: Any, source: str = "<case>") -> Case:
-    """Validate a mapping into a Case, raising ConfigError with key paths."""
+def case_from_dict(data: Any, source: str = "<case>", *, stored: bool = False) -> Case:
+    """Validate a mapping into a Case, raising ConfigError with key paths. ``stored``: the
+    case of a checkpoint, read as it was written (state/materials.py: STORED_CASE_KEY)."""
     if not isinstance(data, dict):
         raise ConfigError(
             f"{source}: the case must be a mapping of sections, got {type(data).__name__}"
         )
+    context = validation_context(data)
+    if stored:
+        context = {**(context or {}), STORED_CASE_KEY: True}
     try:  # a 2D case is validated in the context {"dimension": 2} (config/planar.py)
-        return Case.model_validate(data, context=validation_context(data))
+        return Case.model_validate(data, context=context)
     except ValidationError as exc:
         raise ConfigError(
             f"{source}: invalid case\n{_format_validation_error(exc, data)}"

@@ -167,7 +167,7 @@ class Checkpoint:
                 f"checkpoint {self.path}: the stored case is not valid YAML "
                 f"({_yaml_problem(exc)}); the file is damaged"
             ) from None
-        return case_from_dict(data, f"{self.path} (stored case)")
+        return case_from_dict(data, f"{self.path} (stored case)", stored=True)
 
 
 def _read_group(group: Any) -> dict[str, np.ndarray]:

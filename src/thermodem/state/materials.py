@@ -10,10 +10,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.state.gas import GasProperties
+
+#: Validation context key of a case stored in a checkpoint (``Checkpoint.case``): read as it
+#: was written (the resolved case of earlier versions gave a table's constant too).
+STORED_CASE_KEY = "stored_case"
 
 
 class Material(StrictModel):
@@ -67,7 +71,21 @@ class Material(StrictModel):
         return v
 
     @model_validator(mode="after")
-    def _reference_values(self) -> Material:
+    def _reference_values(self, info: ValidationInfo) -> Material:
+        # a constant and a table of one property: the table replaces the constant at run time,
+        # so one of the two would be ignored (a case stored by an earlier version, which wrote
+        # the table's first value as the constant, is read as it was)
+        stored = bool(info.context and info.context.get(STORED_CASE_KEY))
+        for name, unit in (("thermal_conductivity", "W/(m K)"), ("specific_heat", "J/(kg K)")):
+            table = getattr(self, f"{name}_table")
+            if table and name in self.model_fields_set and not stored:
+                rows = [list(row) for row in table]
+                raise ValueError(
+                    f"{name}: {getattr(self, name):g} {unit} is given together with "
+                    f"{name}_table {rows}; the table replaces the constant at run time ({name} "
+                    f"of T), so one of them would be ignored: give {name}_table alone for a "
+                    f"temperature-dependent {name}, or {name} alone for a constant one"
+                )
         # the constant is the reference a model's parameter row is packed with; at run time
         # the conductivity / heat capacity columns of the row are replaced by table values
         if self.thermal_conductivity_table and self.thermal_conductivity is None:
