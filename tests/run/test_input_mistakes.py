@@ -356,3 +356,27 @@ def test_a_constant_and_a_table_of_one_property_are_refused(tmp_path: Path) -> N
     old = {**yaml.safe_load(case.read_text())}
     old["materials"]["glass"]["thermal_conductivity"] = 1.0  # as earlier versions stored it
     assert case_from_dict(old, stored=True).materials["glass"].thermal_conductivity == 1.0
+
+
+def test_temperatures_that_look_like_celsius_are_warned_about(tmp_path: Path) -> None:
+    """initial_temperature: 25 (°C by mistake) ran at 25 K without a word; every temperature
+    key below 200 K is told (a warning: cryogenic cases run)."""
+    walls = [{**CASE["walls"][0], "thermal": {"kind": "fixed", "temperature": [[0, 300], [1, 80]]}}]
+    thermal = {"fixed_temperature": [{"select": {"ids": [0]}, "temperature": 100.0}]}
+    case = _write(tmp_path, simulation={**CASE["simulation"], "initial_temperature": 25},
+                  walls=walls, thermal=thermal)  # fmt: skip
+    result = _cli("validate", case)
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: simulation.initial_temperature: 25 K is below 200 K, colder than any natural "
+        "temperature on Earth (the record is 184 K): temperatures are in kelvin, is it a value "
+        "in °C? (25 °C = 298.15 K); a cryogenic case can ignore this"
+    ) in result.output
+    assert "warning: walls.0.thermal.temperature (row 1): 80 K is below 200 K" in result.output
+    assert "warning: thermal.fixed_temperature.0.temperature: 100 K is below" in result.output
+    out = tmp_path / "out"
+    result = _cli("run", case, "--output", out, "--steps", "2", "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert "simulation.initial_temperature: 25 K is below 200 K" in (out / "run.log").read_text()
+    # kelvin: nothing said
+    assert "is below 200 K" not in _cli("validate", _write(tmp_path, thermal={})).output

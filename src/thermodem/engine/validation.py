@@ -717,6 +717,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
     notes = section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
+    notes += temperature_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
 
 
@@ -730,6 +731,107 @@ def section_warnings(case: Case) -> list[str]:
         "thermal: null (an empty 'thermal:' key) means no thermal section: this case runs "
         "mechanics only, without heat; write thermal: {} for the heat with every default, or "
         "remove the key"
+    ]
+
+
+#: A temperature below this [K] is told as a likely value in °C: colder than any natural
+#: temperature on Earth (the record is 184 K), while the Celsius values of a case (room
+#: temperature to a few hundred °C) all lie below it. Cryogenic cases are legitimate: a
+#: warning, never an error.
+CELSIUS_SUSPECT_BELOW = 200.0
+
+
+def _expression_minimum(expression: str, names: tuple[str, ...], grid: tuple) -> float:
+    """The smallest value of a temperature expression on ``grid`` (NaN if it fails)."""
+    from thermodem.engine.expressions import compile_expression
+
+    try:
+        values = np.asarray(compile_expression(expression, names)(*grid), dtype=np.float64)
+        return float(np.min(values))
+    except (ValueError, ArithmeticError, TypeError):
+        return math.nan
+
+
+def temperature_warnings(sim: Simulation) -> list[str]:
+    """Every temperature key of the case (and the particles' start temperatures, which files
+    give) below :data:`CELSIUS_SUSPECT_BELOW`: a warning each naming the key and the value
+    (``initial_temperature: 25`` meant in °C is 25 K). Expressions and tables: their
+    smallest value (an initial temperature on a grid spanning the domain, a wall temperature
+    from t = 0 to the end time)."""
+    case = sim.case
+    th = case.thermal
+    found: list[tuple[str, float]] = []
+
+    def add(key: str, value: Any) -> None:
+        if value is not None and math.isfinite(float(value)):
+            found.append((key, float(value)))
+
+    add("simulation.initial_temperature", case.simulation.initial_temperature)
+    for k, entry in enumerate(case.insertion):
+        add(f"insertion.{k}.temperature", getattr(entry, "temperature", None))
+        listed = getattr(entry, "temperatures", None)
+        if listed:
+            i = int(np.argmin(listed))
+            add(f"insertion.{k}.temperatures.{i}", listed[i])
+    times = np.linspace(0.0, case.simulation.end_time, 2001)
+    for k, wall in enumerate(case.walls):
+        value = wall.thermal.temperature if wall.thermal.kind == "fixed" else None
+        key = f"walls.{k}.thermal.temperature"
+        if isinstance(value, list):
+            i = int(np.argmin([row[1] for row in value]))
+            add(f"{key} (row {i})", value[i][1])
+        elif isinstance(value, str):
+            add(f"{key} (its smallest value)", _expression_minimum(value, ("t",), (times,)))
+        else:
+            add(key, value)
+    if th is not None:
+        rule = th.initial_temperature
+        key = "thermal.initial_temperature"
+        if rule is not None and rule.kind == "uniform":
+            add(f"{key}.value", rule.value)
+        elif rule is not None and rule.kind == "per_material":
+            for name, value in rule.values.items():
+                add(f"{key}.values.{name}", value)
+            add(f"{key}.default", rule.default)
+        elif rule is not None and rule.kind == "regions":
+            for i, (_, value) in enumerate(rule.regions):
+                add(f"{key}.regions.{i}", value)
+            add(f"{key}.default", rule.default)
+        elif rule is not None:
+            axes = [
+                np.linspace(lo, hi, 21)
+                for lo, hi in zip(case.domain.lower, case.domain.upper, strict=True)
+            ]
+            grid = tuple(np.meshgrid(*axes, indexing="ij"))
+            low = _expression_minimum(rule.expression, ("x", "y", "z"), grid)
+            add(f"{key}.expression (its smallest value in the domain)", low)
+        for k, entry in enumerate(th.fixed_temperature):
+            add(f"thermal.fixed_temperature.{k}.temperature", entry.temperature)
+        if "temperature" in th.gas.model_fields_set:
+            add("thermal.gas.temperature", th.gas.temperature)
+        fluid = th.fluid.temperature if th.fluid is not None else None
+        if fluid is not None and fluid.kind == "uniform":
+            add("thermal.fluid.temperature", fluid.value[0])
+        elif fluid is not None and fluid.kind == "table":
+            i = int(np.argmin([row[1] for row in fluid.table]))
+            add(f"thermal.fluid.temperature (row {i})", fluid.table[i][1])
+        for family in ("radiation",):
+            params = getattr(th, family).params
+            add(f"thermal.{family}.environment_temperature",
+                getattr(params, "environment_temperature", None))  # fmt: skip
+    bad = [(key, value) for key, value in found if value < CELSIUS_SUSPECT_BELOW]
+    p = sim.particles
+    n = sim.owned_count
+    if n and not any(k.startswith(("insertion", "thermal.initial", "simulation")) for k, _ in bad):
+        i = int(np.argmin(p.temperature[:n]))
+        if p.temperature[i] < CELSIUS_SUSPECT_BELOW:  # (a particle file's column)
+            bad.append((f"particle {int(p.global_id[i])} (its start temperature)",
+                        float(p.temperature[i])))  # fmt: skip
+    return [
+        f"{key}: {value:g} K is below {CELSIUS_SUSPECT_BELOW:g} K, colder than any natural "
+        "temperature on Earth (the record is 184 K): temperatures are in kelvin, is it a value "
+        f"in °C? ({value:g} °C = {value + 273.15:g} K); a cryogenic case can ignore this"
+        for key, value in bad
     ]
 
 
