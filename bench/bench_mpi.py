@@ -11,7 +11,13 @@ then, on the same state, the costs the weak-scaling model of docs/mpi.md is made
 - an ``Allreduce`` of a few numbers (median of 200);
 - gathering one frame and one checkpoint to rank 0 (the output cost) and writing them.
 
-    python bench/bench_mpi.py [--n 200000] [--steps 300] [--ranks 1 2] [--heat MODEL] [--json]
+    python bench/bench_mpi.py [--n 200000] [--steps 300] [--ranks 1 2] [--heat MODEL]
+        [--bed packed|shared] [--json]
+
+``--bed shared``: the bed settled by another code instead (``../shared/beds/bed50k.txt``,
+tiled k x k side by side for n = 50,000 k^2, in a box k times as wide) with that bed's
+standard comparison case (bench_shared_bed.py: contact radius from the overlap, the particles
+below z = 1.5 mm held at 400 K; ``--heat none``: mechanics only).
 
 The ranks are launched with the venv's own ``mpiexec`` (``pip install mpi4py mpich``).
 Timings depend on the load of the machine: the script prints ``uptime`` with them.
@@ -40,9 +46,12 @@ def child(args: argparse.Namespace) -> None:
     from thermodem.config.load import case_from_dict
     from thermodem.mpi import make_simulation, under_mpi
 
-    bed = bp.settle(args.n)
     heat = None if args.heat == "none" else args.heat
-    case = case_from_dict(bp.case_dict(args.n, str(bed), 5e-6, 0.5, 1.0, heat))
+    if args.bed == "shared":
+        case = case_from_dict(shared_case(args.n, heat))
+    else:
+        bed = bp.settle(args.n)
+        case = case_from_dict(bp.case_dict(args.n, str(bed), 5e-6, 0.5, 1.0, heat))
     t_build = time.perf_counter()
     sim = make_simulation(case, threads=1)
     t_build = time.perf_counter() - t_build
@@ -145,6 +154,34 @@ def child(args: argparse.Namespace) -> None:
     print(json.dumps(out), flush=True)
 
 
+def shared_case(n: int, heat: str | None) -> dict:
+    """The shared bed tiled k x k (n = 50,000 k^2) and its comparison case, the box k times
+    as wide; heat: that case's (BOB simple, bottom layer at 400 K) unless ``heat`` is None."""
+    import bench_shared_bed as sb
+
+    from thermodem.geometry.insertion import InsertedParticles, save_particle_file
+
+    base = np.loadtxt(sb.BED, comments="#")
+    tiles = int(round(np.sqrt(n / len(base))))
+    if tiles * tiles * len(base) != n:
+        raise SystemExit(f"--bed shared: --n must be {len(base)} k^2, got {n}")
+    path = sb.CACHE / f"shared_bed50k_tiled_{tiles}.txt"
+    if not path.exists():
+        sb.CACHE.mkdir(parents=True, exist_ok=True)
+        shifts = [(a * sb.SIDE, b * sb.SIDE, 0.0) for a in range(tiles) for b in range(tiles)]
+        pos = np.concatenate([base[:, :3] + shift for shift in shifts])
+        rad = np.tile(base[:, 3], tiles * tiles)
+        save_particle_file(path, InsertedParticles(pos, rad, np.zeros_like(pos), None, "glass"))
+    case = sb.case_dict("region" if heat else "mechanics", None, 1)
+    if heat:
+        case["thermal"]["direct_conduction"] = heat
+    side = tiles * sb.SIDE
+    case["domain"]["upper"][:2] = [side, side]
+    case["walls"][0]["upper"][:2] = [side, side]
+    case["insertion"] = [{"kind": "file", "material": "glass", "path": str(path)}]
+    return case
+
+
 # ------------------------------------------------------------------------ weak-scaling model
 def ghosts_per_rank(n: float, halo: float, radius: float, solid_fraction: float, k: int) -> float:
     """Ghosts of the fullest rank of a cube split into k^3 cubes of n particles: an interior
@@ -215,21 +252,30 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=300)
     ap.add_argument("--ranks", type=int, nargs="*", default=[1, 2])
     ap.add_argument("--heat", default="batchelor_obrien_simple", help="direct conduction or none")
+    ap.add_argument(
+        "--bed",
+        choices=("packed", "shared"),
+        default="packed",
+        help="bench_packed_bed's bed tiled, or the shared bed (another code's) tiled",
+    )
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         child(args)
         return
-    import bench_packed_bed as bp
+    if args.bed == "packed":
+        import bench_packed_bed as bp
 
-    bp.settle(args.n)  # (cached: the 50k bed, tiled)
+        bp.settle(args.n)  # (cached: the 50k bed, tiled)
+    else:
+        shared_case(args.n, None)  # (the tiled file, cached, before the ranks read it)
     env = dict(os.environ, NUMBA_NUM_THREADS="1")
     bin_dir = Path(sys.executable).parent
     results = []
     for ranks in args.ranks:
         cmd = [sys.executable, __file__, "--child", "--n", str(args.n), "--steps",
-               str(args.steps), "--heat", args.heat]  # fmt: skip
+               str(args.steps), "--heat", args.heat, "--bed", args.bed]  # fmt: skip
         if ranks > 1:
             cmd = [str(bin_dir / "mpiexec"), "-n", str(ranks), *cmd]
         load = os.getloadavg()[0]

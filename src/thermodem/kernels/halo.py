@@ -10,6 +10,7 @@ bound.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 
@@ -39,3 +40,36 @@ def unpack_moving(
             angular_velocity[i, a] = buffer[k, 6 + a]
         if with_temperature:
             temperature[i] = buffer[k, 9]
+
+
+@njit(cache=True, error_model="numpy")
+def key_positions(keys, wanted, table, out):
+    """``out[q]``: the index k with ``keys[k] == wanted[q]``, -1 when absent (keys unique and
+    non-negative). An open-addressing hash table (``table``: int64, a power of two >= 2 and
+    at least twice len(keys), scratch) with Fibonacci hashing and linear probing: O(n) against a
+    sort and binary searches (the MPI rebuild matches the history records of every listed
+    pair by the key of its two global ids; 10^5-10^6 keys)."""
+    size = table.shape[0]
+    bits = 0
+    while (1 << bits) < size:
+        bits += 1
+    shift = np.uint64(64 - bits)
+    mask = np.int64(size - 1)
+    golden = np.uint64(0x9E3779B97F4A7C15)
+    for s in range(size):
+        table[s] = -1
+    for k in range(keys.shape[0]):
+        s = np.int64((np.uint64(keys[k]) * golden) >> shift)
+        while table[s] >= 0:
+            s = (s + 1) & mask
+        table[s] = k
+    for q in range(wanted.shape[0]):
+        key = wanted[q]
+        s = np.int64((np.uint64(key) * golden) >> shift)
+        found = -1
+        while table[s] >= 0:
+            if keys[table[s]] == key:
+                found = table[s]
+                break
+            s = (s + 1) & mask
+        out[q] = found

@@ -29,6 +29,7 @@ from thermodem.geometry import wall_layout as WL
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
 from thermodem.kernels import slabs as SL
+from thermodem.kernels.halo import key_positions
 from thermodem.mpi import exchange as X
 from thermodem.mpi.decomposition import bisect
 from thermodem.state.pairs import PairBuffers
@@ -54,14 +55,17 @@ def pair_records(
     return rows, owner
 
 
-def _positions_of(global_id: np.ndarray, wanted: np.ndarray) -> np.ndarray:
-    """Index in ``global_id`` of each of ``wanted`` (-1 when absent)."""
-    if global_id.shape[0] == 0:
-        return np.full(wanted.shape[0], -1, np.int64)
-    sorter = np.argsort(global_id, kind="stable")
-    pos = np.searchsorted(global_id, wanted, sorter=sorter).clip(0, global_id.shape[0] - 1)
-    found = sorter[pos]
-    return np.where(global_id[found] == wanted, found, -1)
+def _positions_of(keys: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """Index in ``keys`` (unique, non-negative) of each of ``wanted`` (-1 when absent), by a
+    hash table (kernels/halo.py: key_positions; a sort and binary searches took about a
+    third of an MPI rebuild)."""
+    out = np.empty(wanted.shape[0], np.int64)
+    size = 1 << max(int(2 * keys.shape[0]).bit_length(), 1)
+    table = np.empty(size, np.int64)
+    key_positions(
+        np.ascontiguousarray(keys, np.int64), np.ascontiguousarray(wanted, np.int64), table, out
+    )
+    return out
 
 
 def _split(dest: np.ndarray, rows: np.ndarray, size: int) -> list[np.ndarray]:
@@ -81,10 +85,9 @@ def _take_history(
     buf.history[:count] = 0.0
     if count == 0 or record_keys.shape[0] == 0:
         return
-    sorter = np.argsort(record_keys, kind="stable")
-    pos = np.searchsorted(record_keys, keys, sorter=sorter).clip(0, record_keys.shape[0] - 1)
-    hit = record_keys[sorter[pos]] == keys
-    buf.history[np.nonzero(hit)[0]] = records[sorter[pos[hit]], 2:]
+    found = _positions_of(record_keys, keys)
+    hit = np.nonzero(found >= 0)[0]
+    buf.history[hit] = records[found[hit], 2:]
 
 
 # ------------------------------------------------------------------------------- rebuild
@@ -100,7 +103,7 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
         first, last = 0, sim._owned
     else:
         first, last = sim.rank * n_all // size, (sim.rank + 1) * n_all // size
-    share = np.arange(first, last)
+    share = slice(first, last)  # (a slice: the copies below are block copies)
     selected = np.zeros(n_all, np.bool_)
     selected[first:last] = True
     # 2. records, the per-particle thermal arrays
@@ -113,7 +116,7 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
         cs = th.conductance_sum if th.conductance_sum.shape[0] == n_all else np.zeros(n_all)
         extras = (cs,)
     owned = X.take_particles(p, share)
-    extra_own = tuple(e[share] for e in extras)
+    extra_own = tuple(e[share].copy() for e in extras)
     del p
     # 3. global numbers and the decomposition
     local_r = float(owned.radius.max()) if owned.count else 0.0
