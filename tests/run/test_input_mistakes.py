@@ -380,3 +380,122 @@ def test_temperatures_that_look_like_celsius_are_warned_about(tmp_path: Path) ->
     assert "simulation.initial_temperature: 25 K is below 200 K" in (out / "run.log").read_text()
     # kelvin: nothing said
     assert "is below 200 K" not in _cli("validate", _write(tmp_path, thermal={})).output
+
+
+#: (key, family) of every key that selects a model by name, one case each below.
+MODEL_KEYS = [
+    ("contact.normal", "normal"),  # a contact law without none
+    ("contact.tangential", "tangential"),
+    ("contact.rolling", "rolling"),
+    ("thermal.contact_radius", "contact_radius"),
+    ("thermal.direct_conduction", "direct_conduction"),  # thermal conduction
+    ("thermal.indirect_conduction", "indirect_conduction"),
+    ("thermal.convection", "convection"),
+    ("thermal.radiation", "radiation"),
+    ("thermal.heat_generation", "heat_generation"),
+]
+
+
+@pytest.mark.parametrize("key,family", MODEL_KEYS, ids=[k for k, _ in MODEL_KEYS])
+@pytest.mark.parametrize("form", ["key", "model"])
+def test_a_null_model_key_is_refused(tmp_path: Path, key: str, family: str, form: str) -> None:
+    """KEY: null (an empty key) and KEY: {model: null} ran the family's default model
+    silently (thermal.direct_conduction: null conducted by Batchelor & O'Brien); they are
+    refused, naming the key, the value and the model names."""
+    from thermodem.models import registry
+
+    section, name = key.split(".")
+    value = None if form == "key" else {"model": None}
+    result = _cli("validate", _write(tmp_path, **{section: {name: value}}))
+    assert result.exit_code == 2, result.output
+    where = key if form == "key" else f"{key}.model"
+    word = name if form == "key" else "model"
+    assert "error: " in result.output and "Traceback" not in result.output
+    assert f"{where}: null (an empty '{word}:' key) is not a model name; " in result.output
+    names = registry.names(family)
+    assert f"; allowed: {', '.join(names)}" in result.output
+    if "none" in names:
+        assert f"write none for no {family} model, a model name, or leave the key out" in (
+            result.output
+        )
+    else:
+        assert f"{family} has no model none: write a model name" in result.output
+
+
+def test_a_null_contact_law_names_the_2d_default_too(tmp_path: Path) -> None:
+    result = _cli("validate", _write(tmp_path, contact={"normal": None}))
+    assert result.exit_code == 2, result.output
+    assert "leave the key out for the default (hertz; hertz_2d for 2D discs)" in result.output
+
+
+def test_a_null_model_key_is_refused_by_the_cli_before_any_step(tmp_path: Path) -> None:
+    """The empty key as a user writes it (its model commented out), through the installed
+    command in a subprocess: validate and run refuse it (exit 2) before the simulation is
+    built; a mapping without model and an absent key still select the default."""
+    text = _write(tmp_path).read_text()
+    text += "thermal:\n  direct_conduction:   # batchelor_obrien_simple\n  convection: none\n"
+    case = tmp_path / "empty_key.yaml"
+    case.write_text(text)
+    assert yaml.safe_load(text)["thermal"]["direct_conduction"] is None
+    exe = str(Path(sys.executable).with_name("thermodem"))
+    res = subprocess.run([exe, "validate", str(case)], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "thermal.direct_conduction: null (an empty 'direct_conduction:' key) is not a model "
+        "name; write none for no direct_conduction model, a model name, or leave the key out "
+        "for the default (batchelor_obrien_simple); allowed: batchelor_obrien_complete, "
+    ) in res.stderr
+    assert "none, " in res.stderr.split("allowed: ")[1]
+    assert "Traceback" not in res.stdout + res.stderr
+    assert "compiling" not in res.stdout + res.stderr  # refused before the engine is built
+    out = tmp_path / "out"
+    result = _cli("run", case, "--output", out, "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "thermal.direct_conduction: null" in result.output
+    assert not (out / "timeseries.csv").exists()
+    # a mapping without model and an absent key: the default, as documented
+    from thermodem.config.load import case_from_dict
+
+    data = yaml.safe_load(_write(tmp_path, thermal={"convection": {}}).read_text())
+    thermal = case_from_dict(data).thermal
+    assert thermal.convection.model == "none"
+    assert thermal.direct_conduction.model == "batchelor_obrien_simple"
+
+
+def test_the_resolved_case_writes_no_null_model_key(tmp_path: Path) -> None:
+    """Every model key of case.resolved.yaml is {model: NAME, ...}, so the resolved case of a
+    run is read again (also in 2D, where the contact defaults of discs are filled in)."""
+    from thermodem.models import registry
+
+    for dim, data in (("3d", {"thermal": {}}), ("2d", None)):
+        if data is None:
+            case = Path(__file__).parents[2] / "examples" / "drum_2d.yaml"
+        else:
+            case = _write(tmp_path, **data)
+        out = tmp_path / f"out_{dim}"
+        result = _cli("run", case, "--output", out, "--steps", "2", "--no-progress")
+        assert result.exit_code == 0, result.output
+        resolved = yaml.safe_load((out / "case.resolved.yaml").read_text())
+        for key, family in MODEL_KEYS:
+            section, name = key.split(".")
+            value = resolved[section][name]
+            assert isinstance(value, dict) and value["model"] in registry.names(family), key
+        assert _cli("validate", out / "case.resolved.yaml").exit_code == 0
+
+
+def test_every_model_key_is_covered() -> None:
+    """The keys above are every model choice of the schema (a new family is tested too)."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.config.planar_case import selected_models
+    from thermodem.config.schema import MODEL_KEYS as SCHEMA_KEYS
+
+    case = case_from_dict({**json.loads(json.dumps(CASE)), "thermal": {}})
+    selected = {key: choice.family for key, choice in selected_models(case)}
+    assert selected == dict(MODEL_KEYS) == {v: k for k, v in SCHEMA_KEYS.items()}
+
+
+def test_the_registry_refuses_a_null_name() -> None:
+    from thermodem.models import registry
+
+    with pytest.raises(KeyError, match=r"convection model: null is not a model name; allowed: "):
+        registry.get("convection", None)  # type: ignore[arg-type]

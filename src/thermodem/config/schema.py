@@ -37,18 +37,58 @@ class ModelChoice(StrictModel):
         return registry.get(self.family, self.model)
 
 
+#: Registry family -> the case-file key that selects its model.
+MODEL_KEYS: dict[str, str] = {
+    "normal": "contact.normal",
+    "tangential": "contact.tangential",
+    "rolling": "contact.rolling",
+    "contact_radius": "thermal.contact_radius",
+    "direct_conduction": "thermal.direct_conduction",
+    "indirect_conduction": "thermal.indirect_conduction",
+    "convection": "thermal.convection",
+    "radiation": "thermal.radiation",
+    "heat_generation": "thermal.heat_generation",
+}
+
+
+def null_model_message(family: str, key: str, default: str) -> str:
+    """The refusal of ``KEY: null`` (an empty key), which used to select the default model
+    silently: the key, the value, how to say "off" where the family can, and the names."""
+    from thermodem.config.planar_case import DISC_CONTACT_DEFAULTS
+
+    choices = registry.names(family)
+    word = key.rsplit(".", 1)[-1]
+    disc = DISC_CONTACT_DEFAULTS.get(family)
+    shown = f"{default}; {disc} for 2D discs" if disc else default
+    if "none" in choices:
+        how = f"write none for no {family} model, a model name, or leave the key out"
+    else:
+        how = f"{family} has no model none: write a model name, or leave the key out"
+    return (
+        f"{key}: null (an empty '{word}:' key) is not a model name; {how} for the default "
+        f"({shown}); allowed: {', '.join(choices)}"
+    )
+
+
 def parse_model_choice(family: str, value: Any, default: str) -> ModelChoice:
-    """``"hertz"`` or ``{model: hertz, ...params}`` -> ModelChoice (raises ValueError)."""
+    """``"hertz"`` or ``{model: hertz, ...params}`` -> ModelChoice (raises ValueError).
+
+    ``null`` (an empty key), or ``model: null`` in the mapping, is refused: it selected the
+    default model silently, where the user more likely meant "off" or left a value out. A
+    mapping without ``model`` selects ``default``."""
     if isinstance(value, ModelChoice):
         return value
+    key = MODEL_KEYS.get(family, family)
     if value is None:
-        value = {"model": default}
+        raise ValueError(null_model_message(family, key, default))
     if isinstance(value, str):
         value = {"model": value}
     if not isinstance(value, dict):
         raise ValueError(f"expected a model name or a mapping with 'model', got {value!r}")
     data = dict(value)
     name = data.pop("model", default)
+    if name is None:
+        raise ValueError(null_model_message(family, f"{key}.model", default))
     try:
         spec = registry.get(family, str(name))
     except KeyError as exc:
@@ -59,12 +99,14 @@ def parse_model_choice(family: str, value: Any, default: str) -> ModelChoice:
 class ContactModels(StrictModel):
     """Mechanical contact laws: ``normal``, ``tangential``, ``rolling``."""
 
-    normal: ModelChoice = Field(default_factory=lambda: parse_model_choice("normal", None, "hertz"))
+    normal: ModelChoice = Field(
+        default_factory=lambda: parse_model_choice("normal", "hertz", "hertz")
+    )
     tangential: ModelChoice = Field(
-        default_factory=lambda: parse_model_choice("tangential", None, "mindlin")
+        default_factory=lambda: parse_model_choice("tangential", "mindlin", "mindlin")
     )
     rolling: ModelChoice = Field(
-        default_factory=lambda: parse_model_choice("rolling", None, "none")
+        default_factory=lambda: parse_model_choice("rolling", "none", "none")
     )
 
     @field_validator("normal", mode="before")

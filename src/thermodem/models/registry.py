@@ -235,6 +235,11 @@ def get(family: str, name: str) -> ModelSpec:
     if family not in _REGISTRY:
         raise KeyError(f"unknown model family {family!r}; families are {', '.join(FAMILIES)}")
     models = _REGISTRY[family]
+    if not isinstance(name, str):  # null (None) is no name: never the default model
+        raise KeyError(
+            f"{family} model: {'null' if name is None else repr(name)} is not a model name; "
+            f"allowed: {', '.join(sorted(models))}"
+        )
     if name not in models:
         raise KeyError(unknown_name_message(family, name))
     return models[name]
