@@ -187,9 +187,6 @@ class ThermalEngine:
         self.fuse_generation = (
             self.generation.active and self.implicit is None and not self.has_c_table
         )
-        self.gen_selected = np.array(
-            self.generation.mechanisms if self.fuse_generation else [], np.int64
-        )
         self._no_gen_energy = np.zeros((1, 1))
         #: some term adds conductances (the explicit limit; else conductance_sum stays zero)
         self.conducts = bool(self.contact.active or self.terms)
@@ -819,7 +816,7 @@ class ThermalEngine:
                 temperature, heat_rate, by_mech, self.euler_columns, source,
                 self.conditions.has_sources, mass, type_id, self.specific_heat_by_type,
                 conductance, self.conducts, fixed, dt, self.euler_partials, clear, gen_energy,
-                self.gen_selected, self.generation.conversion_fraction / dt,
+                self.fuse_generation, self.generation.conversion_fraction / dt,
             )  # fmt: skip
             # (with MPI ghosts after the owned particles the force reset zeroes them all)
             self.rates_cleared = clear and n == p.count

@@ -250,13 +250,13 @@ EULER_FIXED = 4
 @parallel_kernel(error_model="numpy")
 def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on, mass, type_id,
                c_by_type, conductance_sum, conductances, fixed, dt, part, clear, gen_energy,
-               gen_selected, gen_scale):  # fmt: skip
+               generation, gen_scale):  # fmt: skip
     """One fused per-particle thermal update with constant specific heats.
 
     Fills the source column (with ``source_on``; without sources it stays zero), forms the
-    total heat rate: the heat generation χ E_g / Δt of the mechanisms ``gen_selected``
-    (indices g into the accumulators ``gen_energy``, shape (n, 6); empty without generation,
-    and with generation all six accumulators are read: the unselected stay zero; ``gen_scale``
+    total heat rate: with ``generation``, the heat generation χ E_g / Δt of the six
+    accumulators ``gen_energy`` (n, 6) (the mechanisms not selected stay zero; without
+    ``generation`` they are not read, any array will do); ``gen_scale``
     = χ / Δt, the step's own length, so that the heat applied is χ E_g exactly), emptying
     the accumulators (kernels/generation.py's conversion, fused here: no conversion pass and
     no clearing pass; the generation columns are not written, ``columns`` must not hold them:
@@ -276,7 +276,6 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on,
     """
     n = temperature.shape[0]
     nmech = by_mechanism.shape[0]
-    generation = gen_selected.shape[0] > 0
     nchunks = (n + EULER_CHUNK - 1) // EULER_CHUNK
     for c in prange(nchunks):
         limit = math.inf

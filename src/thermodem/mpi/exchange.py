@@ -112,11 +112,16 @@ def unpack_particles(
     return Particles(**arrays), extras
 
 
+def _fortran(array: np.ndarray) -> bool:
+    """A Fortran-ordered (n, k) particle array (the heat rates by mechanism)."""
+    return array.ndim == 2 and array.flags.f_contiguous and not array.flags.c_contiguous
+
+
 def _take(array: np.ndarray, index: np.ndarray | slice) -> np.ndarray:
     """Rows ``index`` of a particle array, copied in the array's own order (the heat rates
     are Fortran-ordered: taken through the transpose, no C copy to convert)."""
-    if array.ndim == 2 and array.flags.f_contiguous and not array.flags.c_contiguous:
-        return np.ascontiguousarray(array.T[:, index]).T
+    if _fortran(array):
+        return np.array(array.T[:, index], order="C").T  # (a copy, also of a slice)
     if isinstance(index, slice):
         return array[index].copy()
     return np.ascontiguousarray(array[index])
@@ -129,7 +134,7 @@ def take_particles(p: Particles, index: np.ndarray | slice) -> Particles:
 
 
 def _joined(arrays: list[np.ndarray]) -> np.ndarray:
-    if arrays[0].ndim == 2 and arrays[0].flags.f_contiguous and not arrays[0].flags.c_contiguous:
+    if _fortran(arrays[0]):
         return np.ascontiguousarray(np.concatenate([a.T for a in arrays], axis=1)).T
     return np.ascontiguousarray(np.concatenate(arrays))
 
