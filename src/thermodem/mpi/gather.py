@@ -316,7 +316,7 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
 def _thermal_state(
     sim: DistributedSimulation, conductance_sum: np.ndarray, cumulative: dict
 ) -> dict:
-    from thermodem.engine.thermal import RANGE_PREFIX
+    from thermodem.engine.thermal_ledger import RANGE_PREFIX
 
     th = sim.thermal
     state = th.state_dict()
