@@ -1,0 +1,232 @@
+"""Geometry checks before a run: the particles placed at the start and the pour regions
+against the walls at their start positions (a particle overlapping a wall by more than
+``simulation.max_overlap_ratio``, a one-sided plane or a cylinder facing the wrong way, a pour
+region a wall passes through or that lies outside the walls). Called by
+:func:`thermodem.engine.validation.pre_run_checks`.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermodem.errors import ConfigError
+
+if TYPE_CHECKING:
+    from thermodem.config.schema import Case
+    from thermodem.engine.simulation import Simulation
+
+
+def wall_row_owners(case: Case) -> list[int]:
+    """The index in ``case.walls`` of every run-time wall row (a box gives several)."""
+    from thermodem.geometry.walls import row_count
+
+    planar = case.simulation.planar
+    return [k for k, w in enumerate(case.walls) for _ in range(row_count(w, planar))]
+
+
+def wall_distances(kind: int, row: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Distance of the centres ``x`` (n, 3) to one wall row, as the contact kernel measures
+    it (``kernels/neighbors.py: wall_distance``): signed along a plane's normal, unsigned to a
+    rectangle, signed towards the particles' side of a cylinder's mantle, inf beyond the ends
+    of a finite cylinder."""
+    from thermodem.geometry import wall_layout as WL
+
+    p = row[WL.COL_POINT : WL.COL_POINT + 3]
+    r = x - p
+    if kind == WL.PLANE:
+        return r @ row[WL.COL_NORMAL : WL.COL_NORMAL + 3]
+    if kind == WL.RECTANGLE:
+        n = row[WL.COL_NORMAL : WL.COL_NORMAL + 3]
+        u = row[WL.COL_U : WL.COL_U + 3]
+        v = np.cross(n, u)
+        a = np.clip(r @ u, -row[WL.COL_HALF_U], row[WL.COL_HALF_U])
+        b = np.clip(r @ v, -row[WL.COL_HALF_V], row[WL.COL_HALF_V])
+        q = p + a[:, None] * u + b[:, None] * v
+        return np.linalg.norm(x - q, axis=1)
+    if kind == WL.CYLINDER:
+        axis = row[WL.COL_AXIS : WL.COL_AXIS + 3]
+        h = r @ axis
+        rho = np.linalg.norm(r - h[:, None] * axis, axis=1)
+        d = row[WL.COL_RADIUS] - rho if row[WL.COL_SIDE] > 0.0 else rho - row[WL.COL_RADIUS]
+        return np.where(np.abs(h) > row[WL.COL_HALF_LENGTH], np.inf, d)
+    return np.full(x.shape[0], np.inf)
+
+
+def check_wall_overlaps(sim: Simulation) -> None:
+    """Refuse a start where a particle overlaps a wall by more than
+    ``simulation.max_overlap_ratio`` of its radius (the run would stop at its first step with
+    an overlap error blaming the stiffness): the insertion does not screen walls, so this is a
+    wall placed across the particles, or a one-sided plane or a cylinder facing away from
+    them. ConfigError naming the wall, the particle and the likely cause."""
+    from thermodem.geometry import wall_layout as WL
+
+    p = sim.particles
+    n = sim.owned_count  # (on several MPI ranks: this rank's particles, not its ghosts)
+    if n == 0 or sim.wall_rows.shape[0] == 0:
+        return
+    case = sim.case
+    limit = case.simulation.max_overlap_ratio
+    owners = wall_row_owners(case)
+    x, radius = p.position[:n], p.radius[:n]
+    for w in range(sim.wall_rows.shape[0]):
+        kind, row = int(sim.wall_kind[w]), sim.wall_rows[w]
+        d = wall_distances(kind, row, x)
+        ratio = (radius - d) / radius
+        bad = np.flatnonzero(ratio > limit)
+        if bad.size == 0:
+            continue
+        i = int(bad[np.argmax(ratio[bad])])
+        k = owners[w] if w < len(owners) else w
+        label = sim.wall_labels[w]
+        if kind == WL.PLANE and d[i] < 0.0:
+            normal = [float(c) for c in row[WL.COL_NORMAL : WL.COL_NORMAL + 3]]
+            why = (
+                f"its centre lies {-d[i]:.6g} m behind the plane, which is one-sided: its "
+                f"normal {normal} must point towards the particles (is it flipped?)"
+            )
+        elif kind == WL.CYLINDER and d[i] < 0.0:
+            inside = row[WL.COL_SIDE] > 0.0
+            why = (
+                f"its centre lies {'outside' if inside else 'inside'} the mantle of radius "
+                f"{row[WL.COL_RADIUS]:.6g} m (inside: {'true' if inside else 'false'} holds the "
+                f"particles {'inside' if inside else 'outside'} it)"
+            )
+        else:
+            why = "the wall passes through it"
+        more = f" ({bad.size - 1} more particle(s) too)" if bad.size > 1 else ""
+        position = [round(float(c), 9) for c in x[i]]
+        raise ConfigError(
+            f"walls.{k} ({label}): particle {int(p.global_id[i])} at {position} (radius "
+            f"{float(radius[i]):.6g} m) overlaps it by {float(ratio[i]):.3g} × its radius at "
+            f"the start{more}, more than simulation.max_overlap_ratio = {limit:g}, so the run "
+            f"would stop at its first step: {why}. The insertion does not keep particles clear "
+            "of walls: move the wall or the insertion region"
+        )
+
+
+def _radius_range(dist: Any) -> tuple[float, float]:
+    """(smallest, largest) radius a (bounded) distribution can draw [m]; 0 for a smallest
+    radius without a bound (a lognormal without min_radius)."""
+    if dist.kind == "mono":
+        return float(dist.radius), float(dist.radius)
+    if dist.kind == "discrete":
+        radii = [r for r, f in zip(dist.radii, dist.fractions, strict=True) if f > 0]
+        return float(min(radii)), float(max(radii))
+    return float(getattr(dist, "min_radius", None) or 0.0), float(dist.max_radius_bound)
+
+
+def _pour_centres(region: Any, r: float, planar: bool) -> np.ndarray:
+    """Where the centre of a poured particle of radius ``r`` may be: points spanning the
+    region shrunk by ``r`` (its corners and a grid of 9 per axis; a cylinder: rings of 36
+    angles at 5 radii and 9 heights), as the pour samples them (geometry/random_fill.py)."""
+    from thermodem.geometry.random_fill import _Box, _Circle, _region_of
+
+    shape = _region_of(region, planar)
+    if isinstance(shape, _Box):  # (and the 2D rectangle)
+        axes = [
+            np.linspace(lo + r, hi - r, 9) for lo, hi in zip(shape.lower, shape.upper, strict=True)
+        ]
+        if planar:
+            axes[2] = np.zeros(1)
+        grid = np.meshgrid(*axes, indexing="ij")
+        return np.column_stack([g.ravel() for g in grid])
+    theta = np.linspace(0.0, 2.0 * np.pi, 36, endpoint=False)
+    rho = np.linspace(0.0, max(shape.radius - r, 0.0), 5)
+    ring = (rho[:, None] * np.cos(theta)).ravel(), (rho[:, None] * np.sin(theta)).ravel()
+    if isinstance(shape, _Circle):
+        out = np.zeros((ring[0].size, 3))
+        out[:, 0] = shape.centre[0] + ring[0]
+        out[:, 1] = shape.centre[1] + ring[1]
+        return out
+    h = np.linspace(r, max(shape.length - r, r), 9)
+    pts = (
+        shape.base
+        + h[:, None, None] * shape.axis
+        + ring[0][None, :, None] * shape.e1
+        + ring[1][None, :, None] * shape.e2
+    )
+    return pts.reshape(-1, 3)
+
+
+def check_pour_walls(sim: Simulation) -> None:
+    """Refuse a pour whose region reaches through a wall or lies behind it: a poured particle
+    would start overlapping the wall (the run would stop blaming the stiffness, or throw it
+    out at speed), or on the far side of it. Checked against the walls at their start
+    positions, for the smallest and the largest radius of the distribution (the points of
+    :func:`_pour_centres`; exact for planes, whose distance is linear). ConfigError naming
+    the entry, the wall, a point and the cause."""
+    from thermodem.geometry import wall_layout as WL
+
+    rows = sim.wall_rows.shape[0]
+    if rows == 0:
+        return
+    case = sim.case
+    owners = wall_row_owners(case)
+    span = float(np.max(np.subtract(case.domain.upper, case.domain.lower)))
+    for k, entry in enumerate(case.insertion):
+        if entry.kind != "pour":
+            continue
+        for r in sorted(set(_radius_range(entry.distribution))):
+            x = _pour_centres(entry.region, r, sim.planar)
+            for w in range(rows):
+                kind, row = int(sim.wall_kind[w]), sim.wall_rows[w]
+                d = wall_distances(kind, row, x)
+                depth = r - d
+                i = int(np.argmax(depth))
+                if not depth[i] > 1e-9 * span:
+                    continue
+                wall = owners[w] if w < len(owners) else w
+                where = [round(float(c), 9) for c in x[i]]
+                if kind == WL.PLANE and d[i] < 0.0:
+                    normal = [float(c) for c in row[WL.COL_NORMAL : WL.COL_NORMAL + 3]]
+                    why = (
+                        f"that point lies {-d[i]:.6g} m behind the plane, which is one-sided "
+                        f"(its normal {normal} points to the particles' side)"
+                    )
+                elif kind == WL.CYLINDER and d[i] < 0.0:
+                    inside = row[WL.COL_SIDE] > 0.0
+                    why = (
+                        f"that point lies {'outside' if inside else 'inside'} the mantle of "
+                        f"radius {row[WL.COL_RADIUS]:.6g} m, on the side without particles"
+                    )
+                else:
+                    why = f"the wall passes {max(float(d[i]), 0.0):.6g} m from that centre"
+                raise ConfigError(
+                    f"insertion.{k}.region: a particle of radius {r:.6g} m poured with its "
+                    f"centre at {where} would overlap walls.{wall} ({sim.wall_labels[w]}) at "
+                    f"the start: {why}. Poured particles must start clear of every wall (the "
+                    "region is checked against the walls at their start positions): move the "
+                    "region inside the walls, or move the wall"
+                )
+            _check_pour_in_boxes(case, k, x, r, span)
+
+
+def _check_pour_in_boxes(case: Case, k: int, x: np.ndarray, r: float, span: float) -> None:
+    """A box wall holds particles inside: its faces are two-sided rectangles, so a particle
+    poured outside the box (on its lid, beside it) stays outside. Refuse centres ``x`` of
+    pour entry ``k`` outside a box (above an ``open_top`` box is inside: they fall in)."""
+    axes = "xy" if case.simulation.planar else "xyz"
+    top = len(axes) - 1
+    for b, wall in enumerate(case.walls):
+        if wall.kind != "box":
+            continue
+        for a, axis in enumerate(axes):
+            below = wall.lower[a] - x[:, a]
+            above = x[:, a] - wall.upper[a]
+            if wall.open_top and a == top:
+                above = np.zeros_like(above)
+            out = np.maximum(below, above)
+            i = int(np.argmax(out))
+            if out[i] > 1e-9 * span:
+                where = [round(float(c), 9) for c in x[i]]
+                side = "below" if below[i] > 0 else "above"
+                raise ConfigError(
+                    f"insertion.{k}.region: a particle of radius {r:.6g} m poured with its "
+                    f"centre at {where} would start outside the box walls.{b} "
+                    f"({wall.name or f'box{b}'}), {side} its {axis} range {wall.lower[a]:g} .. "
+                    f"{wall.upper[a]:g} m: a box holds the particles inside it (its faces are "
+                    "two-sided), so move the region into the box (above an open_top box is "
+                    "fine: the particles fall in)"
+                )
