@@ -116,6 +116,7 @@ DERIVED: tuple[str, ...] = (
     "requested_threads",
     "threads",
     "threads_reason",
+    "governor",  # (engine/threads.py: ThreadGovernor, made by set_threads)
 )
 #: Attributes of the thermal engine that are never saved (objects, back references).
 THERMAL_SKIP: tuple[str, ...] = ("sim", "settings", "wall_functions")

@@ -299,6 +299,13 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     elapsed = wallclock.perf_counter() - started
     steps = sim.step_count - start_step
     log.info(progress.line(sim))
+    governor = sim.governor
+    if governor.single_steps:
+        log.info(
+            f"threads: {governor.single_steps} of the run's steps ran on 1 thread, which was "
+            f"faster than {governor.chosen} when timed (another process on the cores, or too "
+            "little work per step for the threads)"
+        )
     run.status.update(
         status="finished",
         message=f"finished in {format_duration(elapsed)}",

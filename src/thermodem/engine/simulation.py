@@ -31,6 +31,7 @@ Order inside one step (``Simulation.step``):
 from __future__ import annotations
 
 from collections.abc import Callable
+from time import perf_counter
 
 import numpy as np
 
@@ -39,7 +40,7 @@ from thermodem.engine import diagnostics as D
 from thermodem.engine import external_loads as EL
 from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
-from thermodem.engine.threads import apply_threads
+from thermodem.engine.threads import ThreadGovernor, apply_threads
 from thermodem.engine.validation import check_completeness, check_insertion_memory
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
@@ -113,6 +114,7 @@ class Simulation:
         self.requested_threads = None if threads is None else int(threads)
         self.threads = self.requested_threads or 1
         self.threads_reason = ""
+        self.governor = ThreadGovernor(self.threads, automatic=False)
         apply_threads(self.threads)
         check_completeness(case)  # validation layer 2 (engine/validation.py)
         self.case = case
@@ -254,8 +256,15 @@ class Simulation:
         self.threads, self.threads_reason = choose_threads(
             mean, self.pairs.count, self.requested_threads
         )
+        self.governor = ThreadGovernor(self.threads, automatic=self.requested_threads is None)
         apply_threads(self.threads)
         return self.threads
+
+    @property
+    def running_threads(self) -> int:
+        """The thread count the steps run on now: :attr:`threads`, or 1 while the
+        :class:`~thermodem.engine.threads.ThreadGovernor` of a chosen count finds 1 faster."""
+        return self.governor.current
 
     # ---------------------------------------------- ranks (thermodem.mpi overrides these)
     @property
@@ -450,13 +459,25 @@ class Simulation:
             self.thermal.complete_rates()
 
     def step(self, complete: bool = True) -> None:
-        """Advance one time step (see the module docstring for the order).
+        """Advance one time step (see the module docstring for the order); with a chosen
+        thread count, timed for the :class:`~thermodem.engine.threads.ThreadGovernor`.
 
         ``complete=False``: the source column and the total heat rates of the new state are
         left to the next step's thermal update, which forms them anyway (one pass over the
         particles less per step), unless :meth:`complete_rates` is called first; the
         mechanism columns are complete either way. :meth:`run` and the run loop step so and
         complete the rates wherever they are read."""
+        if not self.governor.active:
+            self._advance(complete)
+            return
+        start = perf_counter()
+        self._advance(complete)
+        threads = self.governor.tick(perf_counter() - start)
+        if threads is not None:
+            apply_threads(threads)
+
+    def _advance(self, complete: bool) -> None:
+        """The step itself (:meth:`step`)."""
         self._complete = complete
         th = self.thermal
         if th is not None and th.settings.frozen_mechanics:
@@ -517,7 +538,7 @@ class Simulation:
         """Advance ``steps`` steps, or until simulated time ``until`` [s]."""
         if (steps is None) == (until is None):
             raise ValueError("give exactly one of steps= or until=")
-        apply_threads(self.threads)  # another simulation may have changed it
+        apply_threads(self.running_threads)  # another simulation may have changed it
         if until is not None:
             dt = self.dt
             if self.thermal is not None and self.thermal.settings.frozen_mechanics:

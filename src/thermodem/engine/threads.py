@@ -11,10 +11,14 @@ parallel kernel runs (:func:`configure_threading_layer`, called from ``thermodem
 - ``workqueue`` (Numba's own) when OpenMP cannot be loaded; the run log then says why;
 - whatever ``NUMBA_THREADING_LAYER`` names, when the user set it.
 
-With any layer, ``OMP_WAIT_POLICY=passive`` is set unless the environment sets a wait policy
-(``OMP_WAIT_POLICY`` or ``GOMP_SPINCOUNT``): a waiting OpenMP thread sleeps instead of
-spinning, which costs little on an idle machine and keeps 2 threads from becoming many times
-slower than 1 when another process shares the cores (docs/architecture.md, "Threads").
+With any layer, ``OMP_WAIT_POLICY=passive`` and ``GOMP_SPINCOUNT`` = :data:`SPIN_COUNT` are
+set unless the environment sets either: a waiting OpenMP thread spins for about 0.1 ms, then
+sleeps. The spin covers the gaps between the parallel regions of a step (waking a sleeping
+thread cost 80-140 µs per region on the 2-core VM: the idle virtual core halts), and the
+bound keeps 2 threads from becoming many times slower than 1 when another process shares the
+cores, which unbounded spinning did; what bounded spinning still loses then, the
+:class:`ThreadGovernor` of an automatically chosen count takes back by running on 1 thread
+(docs/architecture.md, "Threads").
 
 GNU OpenMP is not fork-safe: a process that forks after a parallel kernel ran must not run
 parallel kernels in the child (thermodem itself never forks; ``subprocess`` is fine).
@@ -40,6 +44,12 @@ import os
 PARALLEL_MIN_PARTICLES = 2000
 PARALLEL_MIN_PAIRS = 5500
 
+#: GNU OpenMP's spin count of a waiting thread (``GOMP_SPINCOUNT``): about 0.1-0.15 ms on the
+#: 2-core VM. Measured there (docs/architecture.md, "Threads"; 50k shared bed, mechanics,
+#: 2 threads, M particle-steps/s): sleeping at once 9.5, 3000 9.75, 10000 10.5, 30000 10.9
+#: idle; with one busy process beside it 5.8, -, 4.8, 3.7.
+SPIN_COUNT = 10000
+
 _layer_note = ""
 
 
@@ -57,7 +67,9 @@ def configure_threading_layer() -> None:
         _layer_note = "launched before thermodem was imported"
         return
     if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
-        os.environ["OMP_WAIT_POLICY"] = "passive"  # read by libgomp when it loads
+        # read by libgomp when it loads: a bounded spin, then sleep
+        os.environ["OMP_WAIT_POLICY"] = "passive"
+        os.environ["GOMP_SPINCOUNT"] = str(SPIN_COUNT)
     chosen = os.environ.get("NUMBA_THREADING_LAYER", "").strip()
     if chosen and chosen.lower() != "default":
         _layer_note = f"set by NUMBA_THREADING_LAYER={chosen}"
@@ -127,3 +139,67 @@ def choose_threads(particles: float, pairs: int, requested: int | None = None) -
         f"chosen for {n} particles and {pairs} pairs (2 threads pay from about "
         f"{PARALLEL_MIN_PARTICLES} particles); --threads N to change"
     )
+
+
+class ThreadGovernor:
+    """Keeps an automatically chosen thread count (more than one) only while it pays.
+
+    Several threads lose to one when another process holds one of the cores (the threads of a
+    parallel region wait for each other) or when the system is too small for them. The
+    governor adds up the seconds of the steps (not of outputs between them) in windows of
+    about :attr:`WINDOW_SECONDS`; after the first window and then every
+    :attr:`PERIOD_WINDOWS` windows it runs one window on the other count (1 thread, or back
+    to the chosen count) and keeps that count only if it was faster per step by more than
+    :attr:`MARGIN`. Results do not depend on the thread count (the kernels' sums run in a
+    fixed chunk order, tests/unit/test_threads.py), so switching changes the speed only. A
+    count the user asked for is kept (:attr:`active` False), as is one thread.
+
+    :meth:`tick` is called after every step with its duration and returns the count to apply
+    when it changes.
+    """
+
+    WINDOW_SECONDS = 0.25
+    PERIOD_WINDOWS = 40
+    MARGIN = 0.05
+
+    def __init__(self, chosen: int, automatic: bool) -> None:
+        self.chosen = int(chosen)
+        self.active = automatic and self.chosen > 1
+        self.current = self.chosen
+        self.switches = 0  # probes and switches back
+        self.single_steps = 0  # steps that ran on 1 thread (for the run log)
+        self._seconds = 0.0  # the window's step seconds and steps so far
+        self._steps = 0
+        self._reference = 0.0  # seconds per step of the window before a probe
+        self._probing = False
+        self._windows = self.PERIOD_WINDOWS - 1  # the first probe after one window
+
+    def tick(self, seconds: float) -> int | None:
+        """A step took ``seconds``: the thread count to switch to, or None."""
+        if not self.active:
+            return None
+        self._seconds += seconds
+        self._steps += 1
+        if self.current == 1:
+            self.single_steps += 1
+        if self._seconds < self.WINDOW_SECONDS:
+            return None
+        per_step = self._seconds / self._steps
+        self._seconds, self._steps = 0.0, 0
+        other = 1 if self.current == self.chosen else self.chosen
+        if self._probing:  # the window just timed ran on the probed count
+            self._probing = False
+            self._windows = 0
+            if per_step < (1.0 - self.MARGIN) * self._reference:
+                return None  # the probed count was faster: it stays
+            self.current = other
+            self.switches += 1
+            return self.current
+        self._windows += 1
+        if self._windows < self.PERIOD_WINDOWS:
+            return None
+        self._reference = per_step
+        self._probing = True
+        self.current = other
+        self.switches += 1
+        return self.current
