@@ -720,3 +720,35 @@ def test_rates_left_to_the_next_update_give_the_same_run(tmp_path: Path) -> None
         assert np.array_equal(arr, getattr(lazy.particles, name)), name
     assert every.report() == lazy.report()
     assert every.thermal.balance_error() == lazy.thermal.balance_error()
+
+
+def test_held_particles_stay_at_their_bath_and_only_candidates_are_visited(
+    tmp_path: Path,
+) -> None:
+    # a touching line of limp spheres (frozen in place by the mechanics), the first two held
+    # at 500 K by a region far from their centres: they are held, not candidates, so after
+    # the classification's first evaluation the per-step pass visits no particle; they stay
+    # at exactly 500 K while conducting into the rest, and the ledger closes
+    rows = [(0.0011 + 1.95e-3 * k, 0.0013, 0.0017, R, 300.0) for k in range(5)]
+    path = _write(tmp_path / "line.txt", rows, temperature=True)
+    region = {"lower": [-0.01, -0.01, -0.01], "upper": [0.0011 + 1.95e-3 * 1.5, 0.01, 0.01]}
+    thermal = {
+        "direct_conduction": "batchelor_obrien_simple",
+        "contact_radius": "geometric",
+        "fixed_temperature": [{"select": {"region": region}, "temperature": 500.0}],
+    }
+    sim = _sim([_file(path, "limp")], thermal)
+    conditions = sim.thermal.conditions
+    assert conditions.listed.shape[0] == 2 and conditions.candidates.shape[0] == 0
+    assert not conditions.hold_pending  # the start's evaluation set them
+    sim.run(steps=400)
+    t = _temps(sim)
+    assert t[:2].tolist() == [500.0, 500.0]
+    assert 300.0 < t[2] < 500.0  # the heat reached the first free particle
+    assert abs(sim.thermal.balance_error()) < 1e-9
+    # a temperature written from outside, then invalidate(): the next evaluation holds it again
+    sim.particles.temperature[_order(sim)[0]] = 321.0
+    conditions.invalidate()
+    sim.run(steps=1)
+    assert _temps(sim)[0] == 500.0
+    assert sim.thermal.cumulative["fixed_reset"] > 0.0  # m c (500 - 321) went in

@@ -9,9 +9,11 @@ insertion or a restart) one compiled parallel pass classifies every particle
 particle only, and until the next build no particle moves farther than half the Verlet skin
 from its position at the build (``Simulation.reference``; the build comes first otherwise),
 so a region holds a particle surely, or surely not, unless the particle is within half a skin
-of the region's faces. Fixed particles and sources are set there; per thermal step only the
-fixed particles (held at their bath temperature) and the few candidates near a region face
-(evaluated at their current position) are visited (``apply_listed``). A material or id
+of the region's faces. Fixed particles and sources are set there; the held (surely fixed)
+particles take their bath temperature at the first evaluation after it, and then per thermal
+step only the few candidates near a region face (evaluated at their current position) are
+visited (``apply_listed``): no thermal update changes a fixed particle's temperature, and code
+that writes temperatures directly calls :meth:`ThermalConditions.invalidate`. A material or id
 selection has no candidates. External sources (a power shared by the particles in a box,
 uniform or Gaussian) take a compiled parallel pass over the particles at every thermal step.
 Nothing here loops over particles in Python.
@@ -28,6 +30,7 @@ from thermodem.engine.expressions import compile_expression
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.geometry.walls import row_count
 from thermodem.kernels.conditions import (
+    CANDIDATE,
     CHUNK,
     FIXED,
     FLUX,
@@ -102,6 +105,10 @@ class ThermalConditions:
         self.code = np.zeros(0, np.int8)
         #: indices of the held and candidate particles (kernels/conditions.py)
         self.listed = np.zeros(0, np.int64)
+        #: indices of the candidate particles only
+        self.candidates = np.zeros(0, np.int64)
+        #: the held particles have not taken their bath temperature since the classification
+        self.hold_pending = True
         #: the displacement from Simulation.reference up to which the classification holds
         self.margin = -1.0
         self._moved = 0.0  # Simulation.moved when the particles were classified
@@ -114,7 +121,8 @@ class ThermalConditions:
 
     def invalidate(self) -> None:
         """The particles were reordered or inserted (a neighbour-list build, a pour, a
-        restart): classify them again at the next evaluation."""
+        restart), or temperatures were written from outside the thermal update: classify
+        them again at the next evaluation (which sets every held particle to its bath)."""
         self.static_valid = False
 
     def _static_masks(self) -> None:
@@ -162,6 +170,8 @@ class ThermalConditions:
             2 if getattr(sim, "planar", False) else 3,
         )  # fmt: skip
         self.listed = np.flatnonzero(self.code).astype(np.int64)
+        self.candidates = self.listed[self.code[self.listed] == CANDIDATE]
+        self.hold_pending = True
         self.static_valid = True
         self.classifications += 1
 
@@ -191,18 +201,25 @@ class ThermalConditions:
             or not (moved <= self.margin or moved == self._moved)
         ):
             self._classify()
-        rows = self.listed.shape[0] // CHUNK + 1
+        # a held particle takes its bath temperature once after the classification: no
+        # thermal update changes a fixed particle's temperature (they skip the fixed ones),
+        # so after that only the candidates are evaluated per step (scattered through the
+        # arrays, the held particles of a bed's bottom layer cost more than the update of
+        # all particles when the caches hold other data)
+        listed = self.listed if self.hold_pending else self.candidates
+        self.hold_pending = False
+        rows = listed.shape[0] // CHUNK + 1
         if self._part.shape[0] < rows:
             self._part = np.zeros(rows)
         own = self.sim.owned_count
         if own == n:
-            parts = (self.listed,)
+            parts = (listed,)
         else:
             # on several MPI ranks the ghosts (after the owned particles) get the same
             # conditions as on their owners, but only the owned particles' reset energy enters
             # this rank's ledger (thermodem.mpi); `listed` is sorted
-            split = int(np.searchsorted(self.listed, own))
-            parts = (self.listed[:split], self.listed[split:])
+            split = int(np.searchsorted(listed, own))
+            parts = (listed[:split], listed[split:])
         reset = 0.0
         thickness = float(getattr(self.sim, "disc_thickness", 0.0))  # 2D discs
         for k, listed in enumerate(parts):
