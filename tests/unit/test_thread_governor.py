@@ -59,6 +59,18 @@ def test_chosen_count_faster_comes_back_after_the_probe():
     assert set(ran) == {2}
 
 
+def test_a_slow_first_step_does_not_decide():
+    # the first step loads or compiles kernels: 2 s on the chosen count, which is faster
+    g = ThreadGovernor(2, automatic=True)
+    speed = {1: 2e-3, 2: 1e-3}
+    g.tick(2.0)
+    assert g.current == 2  # one step is no window (MIN_WINDOW_STEPS)
+    drive(g, speed, ThreadGovernor.MIN_WINDOW_STEPS)
+    assert g.current == 1  # the probe of 1 thread starts ...
+    drive(g, speed, window_steps(speed[1]))
+    assert g.current == 2  # ... and loses: the 2 s step was left out of the reference
+
+
 def test_within_the_margin_the_count_before_the_probe_stays():
     g = ThreadGovernor(2, automatic=True)
     speed = {1: 0.98e-3, 2: 1e-3}  # 1 thread 2 % faster: not worth a switch
@@ -133,6 +145,7 @@ def test_switching_counts_mid_run_changes_no_result(tmp_path, monkeypatch):
     monkeypatch.setattr(T, "PARALLEL_MIN_PARTICLES", 1)
     monkeypatch.setattr(T, "available_threads", lambda: 2)
     monkeypatch.setattr(ThreadGovernor, "WINDOW_SECONDS", 0.0)
+    monkeypatch.setattr(ThreadGovernor, "MIN_WINDOW_STEPS", 1)
     monkeypatch.setattr(ThreadGovernor, "PERIOD_WINDOWS", 2)
     governed = Simulation(case)
     assert governed.threads == 2 and governed.governor.active

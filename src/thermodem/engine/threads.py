@@ -146,8 +146,10 @@ class ThreadGovernor:
 
     Several threads lose to one when another process holds one of the cores (the threads of a
     parallel region wait for each other) or when the system is too small for them. The
-    governor adds up the seconds of the steps (not of outputs between them) in windows of
-    about :attr:`WINDOW_SECONDS`; after the first window and then every
+    governor adds up the seconds of the steps (not of outputs between them) in windows of at
+    least :attr:`WINDOW_SECONDS` and :attr:`MIN_WINDOW_STEPS` steps, without the window's
+    slowest step (a kernel compiled or loaded on its first call, a neighbour-list build); after
+    the first window and then every
     :attr:`PERIOD_WINDOWS` windows it runs one window on the other count (1 thread, or back
     to the chosen count) and keeps that count only if it was faster per step by more than
     :attr:`MARGIN`. Results do not depend on the thread count (the kernels' sums run in a
@@ -159,6 +161,7 @@ class ThreadGovernor:
     """
 
     WINDOW_SECONDS = 0.25
+    MIN_WINDOW_STEPS = 10
     PERIOD_WINDOWS = 40
     MARGIN = 0.05
 
@@ -168,7 +171,8 @@ class ThreadGovernor:
         self.current = self.chosen
         self.switches = 0  # probes and switches back
         self.single_steps = 0  # steps that ran on 1 thread (for the run log)
-        self._seconds = 0.0  # the window's step seconds and steps so far
+        self._seconds = 0.0  # the window's step seconds, slowest step and steps so far
+        self._slowest = 0.0
         self._steps = 0
         self._reference = 0.0  # seconds per step of the window before a probe
         self._probing = False
@@ -179,13 +183,17 @@ class ThreadGovernor:
         if not self.active:
             return None
         self._seconds += seconds
+        self._slowest = max(self._slowest, seconds)
         self._steps += 1
         if self.current == 1:
             self.single_steps += 1
-        if self._seconds < self.WINDOW_SECONDS:
+        if self._seconds < self.WINDOW_SECONDS or self._steps < self.MIN_WINDOW_STEPS:
             return None
-        per_step = self._seconds / self._steps
-        self._seconds, self._steps = 0.0, 0
+        if self._steps > 1:
+            per_step = (self._seconds - self._slowest) / (self._steps - 1)
+        else:
+            per_step = self._seconds
+        self._seconds, self._slowest, self._steps = 0.0, 0.0, 0
         other = 1 if self.current == self.chosen else self.chosen
         if self._probing:  # the window just timed ran on the probed count
             self._probing = False
