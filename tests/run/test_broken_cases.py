@@ -84,6 +84,26 @@ def test_aliases_within_the_limit_still_work(tmp_path: Path) -> None:
     assert case.materials["steel"] == case.materials["glass"]
 
 
+def test_merge_keys_are_read_and_only_true_duplicates_refused(tmp_path: Path) -> None:
+    """``<<: *name`` (YAML's merge key) was refused as 'could not determine a constructor for
+    the tag ...merge' by the duplicate-key loader; a merged key given again beside ``<<`` is
+    an override, a key written twice in one mapping is still a duplicate."""
+    from thermodem.config.load import load_case
+
+    head = (
+        b"simulation: {time_step: 1.0e-5, end_time: 0.001}\n"
+        b"domain: {lower: [0, 0, 0], upper: [0.01, 0.01, 0.01]}\n"
+        b"materials:\n  glass: &g {density: 2500, youngs_modulus: 1.0e7, poisson_ratio: 0.3}\n"
+    )
+    case = load_case(_file(tmp_path, "merge.yaml", head + b"  steel: {<<: *g, density: 7800}\n"))
+    assert case.materials["steel"].density == 7800.0
+    assert case.materials["steel"].youngs_modulus == 1.0e7
+    twice = _file(tmp_path, "twice.yaml", head + b"  steel: {<<: *g, density: 1, density: 2}\n")
+    result = CliRunner().invoke(app, ["validate", str(twice)])
+    assert result.exit_code == 2
+    assert "line 5, column 31: duplicate key 'density' (first at line 5)" in result.output
+
+
 @pytest.mark.parametrize(
     ("make", "expected"),
     [

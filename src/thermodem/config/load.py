@@ -20,12 +20,19 @@ def _format_validation_error(exc: ValidationError, data: Any = None) -> str:
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """A safe loader that refuses duplicate keys (PyYAML would keep the last one silently)."""
+    """A safe loader that refuses duplicate keys (PyYAML would keep the last one silently).
+    Merge keys (``<<: *name``) are YAML's own: the merged keys may be given again (the value
+    written beside ``<<`` wins), only a key written twice in the same mapping is refused."""
+
+
+MERGE_TAG = "tag:yaml.org,2002:merge"
 
 
 def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False):  # noqa: ANN202
     seen: dict[Any, Any] = {}
     for key_node, _ in node.value:
+        if key_node.tag == MERGE_TAG:  # '<<' (no constructor of its own: merged below)
+            continue
         key = loader.construct_object(key_node, deep=deep)
         if key in seen:
             mark = key_node.start_mark
