@@ -97,6 +97,30 @@ def test_output_path_under_a_file_is_refused(tmp_path: Path) -> None:
     assert blocker.read_text() == "not a directory"
 
 
+def test_output_path_the_system_refuses_is_an_error_not_a_traceback(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A name too long (OSError from the path check) and a directory the file system will not
+    create (read-only, /proc: mkdir fails although the parent looks writable) ended in a
+    traceback."""
+    import errno
+
+    case = _case_file(tmp_path)
+    result = _invoke("run", str(case), "--output", str(tmp_path / ("a" * 300)), "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "cannot be used: File name too long; choose another --output" in result.output
+    assert "Traceback" not in result.output
+
+    def refuse(self: Path, *args: object, **kwargs: object) -> None:
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    monkeypatch.setattr(Path, "mkdir", refuse)
+    result = _invoke("run", str(case), "--output", str(tmp_path / "out"), "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert "the directory cannot be created: Read-only file system" in result.output
+    assert "Traceback" not in result.output
+
+
 def test_threads_above_the_core_count_are_clamped_with_a_message(tmp_path: Path) -> None:
     case = _case_file(tmp_path)
     cores = len(os.sched_getaffinity(0))

@@ -25,7 +25,18 @@ LOCK_FILE = "run.lock"
 
 def check_output_path(output: Path) -> None:
     """The output directory can be created: no file on its path, and the first existing
-    directory on it is writable."""
+    directory on it is writable (an OSError of the path itself, a name too long, is told as
+    such)."""
+    try:
+        _check_output_path(output)
+    except OSError as exc:
+        raise ConfigError(
+            f"--output {str(output)!r} cannot be used: {exc.strerror or exc}; choose another "
+            "--output"
+        ) from None
+
+
+def _check_output_path(output: Path) -> None:
     for parent in (output, *output.parents):
         if not parent.exists():
             continue

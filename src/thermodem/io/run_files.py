@@ -51,7 +51,13 @@ def prepare_output_dir(path: Path, overwrite: bool) -> None:
             f"--output {str(path)!r} exists and is not empty; choose another "
             "directory or pass --overwrite"
         )
-    path.mkdir(parents=True, exist_ok=True)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # (a file system that refuses it: read-only, /proc, full)
+        raise ConfigError(
+            f"--output {str(path)!r}: the directory cannot be created: {exc.strerror or exc}; "
+            "choose another --output"
+        ) from None
 
 
 def _atomic_write_text(path: Path, text: str) -> None:
