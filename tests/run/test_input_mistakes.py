@@ -99,6 +99,25 @@ def test_an_output_interval_in_steps_is_told(tmp_path: Path) -> None:
     assert "warning: output.timeseries_interval" not in result.output
 
 
+def test_an_output_interval_shorter_than_the_time_step_is_told(tmp_path: Path) -> None:
+    """An interval below the time step (meant in ms, or in steps of a smaller unit) wrote a
+    frame at every step silently: 100 frames here, 50 000 for the default example."""
+    case = _write(tmp_path, output={"interval": 1.0e-6, "timeseries_interval": 1.0e-5})
+    result = _cli("validate", case)
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: output.interval = 1e-06 s is shorter than simulation.time_step = 1e-05 s: a "
+        "frame is written at every step (100 steps to simulation.end_time); intervals are "
+        "simulated seconds: give at least 1e-05 s"
+    ) in result.output
+    assert "output.timeseries_interval" not in result.output  # (= the time step: fine)
+    result = _cli("run", case, "--output", tmp_path / "out", "--steps", "2", "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert "warning: output.interval = 1e-06 s is shorter than simulation.time_step" in (
+        result.output
+    )
+
+
 def test_a_region_selection_empty_at_the_start_is_a_warning(tmp_path: Path) -> None:
     region = {"lower": [0.008, 0.008, 0.008], "upper": [0.01, 0.01, 0.01]}
     thermal = {"heat_flux": [{"select": {"region": region}, "flux": 100.0}]}

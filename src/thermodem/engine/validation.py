@@ -506,7 +506,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
     notes = section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
-    notes += temperature_warnings(sim)
+    notes += temperature_warnings(sim) + step_interval_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
 
 
@@ -638,6 +638,30 @@ def output_interval_warnings(case: Case) -> list[str]:
                 "written at the start and the end only (intervals are simulated seconds, not "
                 "steps)"
             )
+    return out
+
+
+def step_interval_warnings(sim: Simulation) -> list[str]:
+    """Output intervals shorter than the time step: written at every step (a frame per step
+    is 50 000 VTU files for 50 000 steps), said before the run; an interval meant in steps or
+    in another unit (ms) is the usual cause."""
+    case = sim.case
+    th = sim.thermal
+    frozen = th is not None and th.settings.frozen_mechanics
+    key = "thermal.time_step" if frozen else "simulation.time_step"
+    dt = th.settings.time_step if frozen else sim.dt
+    steps = total_steps(sim)
+    out = []
+    for name in ("interval", "timeseries_interval", "checkpoint_interval"):
+        value = getattr(case.output, name)
+        if value is None or value >= dt * (1.0 - 1e-9):
+            continue
+        what = "a frame" if name == "interval" else "a row" if name[0] == "t" else "a checkpoint"
+        out.append(
+            f"output.{name} = {value:g} s is shorter than {key} = {dt:g} s: {what} is written at "
+            f"every step ({steps} steps to simulation.end_time); intervals are simulated "
+            f"seconds: give at least {dt:g} s"
+        )
     return out
 
 
