@@ -318,7 +318,14 @@ def insert(
             if planar:
                 _check_planar(given, entry)
             _check_given(
-                entry, given, key, domain, max_overlap_ratio, existing_positions, existing_radii
+                entry,
+                given,
+                key,
+                domain,
+                max_overlap_ratio,
+                existing_positions,
+                existing_radii,
+                planar,
             )
             return given.particles
     except ConfigError:
@@ -551,8 +558,10 @@ def _check_given(
     limit: float,
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
+    planar: bool = False,
 ) -> None:
-    """Refuse given particles outside the domain, coincident or overlapping too deeply."""
+    """Refuse given particles outside the domain, wider than it (a radius in mm read as
+    metres), coincident or overlapping too deeply."""
     p = given.particles
     sep = "." if isinstance(entry, ListInsertion) else ".path: "
 
@@ -571,6 +580,19 @@ def _check_given(
                 f"[{_vec(lower)}, {_vec(upper)}] ({bad.size} of {len(p)} particles are); move "
                 "the particles or enlarge domain"
             )
+        extent = upper - lower
+        for a, axis in enumerate("xy" if planar else "xyz"):
+            wide = np.flatnonzero(2.0 * p.radius > extent[a])
+            if wide.size:
+                i = int(wide[np.argmax(p.radius[wide])])
+                r = float(p.radius[i])
+                raise ConfigError(
+                    f"{at(i)}: radius {r:g} m: the particle ({2.0 * r:g} m across) is wider "
+                    f"than the domain along {axis} ({lower[a]:g} .. {upper[a]:g} m, "
+                    f"{extent[a]:g} m; {wide.size} of {len(p)} particles are); lengths are in "
+                    "metres (is the radius in mm?); give radii smaller than half the domain or "
+                    "enlarge domain"
+                )
     found = _deepest_overlap(
         p.position,
         p.radius,
