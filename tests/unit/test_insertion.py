@@ -634,6 +634,19 @@ def test_file_csv_any_column_order_comments_and_defaults(tmp_path):
     np.testing.assert_array_equal(q.temperature, [500.0])
 
 
+def test_file_with_a_byte_order_mark_is_read(tmp_path):
+    """Excel's "CSV UTF-8" starts with a byte order mark: the header was refused as the
+    unknown column '\\ufeffx'. Read by the fast parser and by the checked one (which names
+    the line of a duplicate row)."""
+    path = tmp_path / "excel.csv"
+    path.write_bytes(b"\xef\xbb\xbfx,y,z,radius\r\n0,0,0,1e-3\r\n0.01,0,0,1e-3\r\n")
+    p = load_particle_file(path)
+    np.testing.assert_array_equal(p.position, [[0, 0, 0], [0.01, 0, 0]])
+    path.write_bytes(b"\xef\xbb\xbfx y z radius\n0 0 0 abc\n")
+    with pytest.raises(ValueError, match=r"line 2, column 'radius': 'abc' is not a number"):
+        load_particle_file(path)
+
+
 @pytest.mark.parametrize(
     ("content", "pattern"),
     [

@@ -120,7 +120,7 @@ def _content_lines(lines: Iterable[str]) -> Iterator[tuple[int, str, bool]]:
 
 def _data_line_numbers(path: Path) -> np.ndarray:
     """Line numbers of the data lines."""
-    with path.open(encoding="utf-8") as f:
+    with path.open(encoding="utf-8-sig") as f:
         numbers = [n for n, _, is_header in _content_lines(f) if not is_header]
     return np.asarray(numbers, dtype=np.int64)
 
@@ -158,7 +158,7 @@ def _parse_fast(path: Path, material: str, planar: bool = False) -> _ParsedFile 
         header: list[str] | None = None
         header_line = 0
         comma = False
-        with path.open(encoding="utf-8") as f:
+        with path.open(encoding="utf-8-sig") as f:
             for lineno, line, is_header in _content_lines(f):
                 if is_header:
                     header = _header_names(line)
@@ -178,7 +178,7 @@ def _parse_fast(path: Path, material: str, planar: bool = False) -> _ParsedFile 
                 delimiter="," if comma else None,
                 skiprows=header_line,
                 ndmin=2,
-                encoding="utf-8",
+                encoding="utf-8-sig",  # (a BOM, as Excel writes it, is not a column name)
             )
     except (ValueError, OSError, UnicodeDecodeError):
         return None
@@ -237,7 +237,7 @@ def _read_text(path: Path) -> str:
     except OSError as exc:
         raise ValueError(f"cannot read {where}: {exc.strerror}") from None
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise ValueError(
