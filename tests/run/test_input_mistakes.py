@@ -303,6 +303,62 @@ def test_a_pour_region_through_a_wall_is_refused_before_the_run(tmp_path: Path) 
     assert _cli("validate", _write(tmp_path, walls=CASE["walls"], insertion=[POUR])).exit_code == 0
 
 
+def test_a_wall_wholly_outside_the_domain_is_refused_or_told(tmp_path: Path) -> None:
+    """A wall that no particle of the domain can touch (a side plane at x = -5 m for a 1 cm
+    domain, a box or a drum far away) was accepted silently; a moving one may come in: a
+    warning. Walls on the domain's boundary, or enclosing it, are fine."""
+    floor = CASE["walls"][0]
+    side = {"kind": "plane", "point": [-5.0, 0, 0], "normal": [1, 0, 0], "material": "glass"}
+    result = _cli("validate", _write(tmp_path, walls=[floor, side]))
+    assert result.exit_code == 2, result.output
+    assert (
+        "error: walls.1.point: [-5.0, 0.0, 0.0] (a plane with normal [1.0, 0.0, 0.0]) lies 5 m "
+        "outside the domain [[0.0, 0.0, 0.0], [0.01, 0.01, 0.01]], facing it: no particle "
+        "inside the domain reaches it (they reach at most 0.002 m beyond it), and it does not "
+        "move, so it would never act"
+    ) in result.output
+    # the same plane moving: it may come in
+    moving = {**side, "velocity": [1.0, 0, 0]}
+    result = _cli("validate", _write(tmp_path, walls=[floor, moving]))
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: walls.1.point: [-5.0, 0.0, 0.0] (a plane with normal [1.0, 0.0, 0.0]) lies 5 m "
+        "outside the domain"
+    ) in result.output
+    assert "it moves (velocity [1.0, 0.0, 0.0] m/s), so it may come in later" in result.output
+    # a flipped plane with the whole domain behind it (no particle yet to overlap it)
+    lid = {"kind": "plane", "point": [0, 0, 0.01], "normal": [0, 0, 1], "material": "glass"}
+    result = _cli("validate", _write(tmp_path, walls=[lid], insertion=[]))
+    assert result.exit_code == 2, result.output
+    assert "walls.0.point: [0.0, 0.0, 0.01] (a plane with normal [0.0, 0.0, 1.0]) has the " in (
+        result.output
+    )
+    # a box away from the domain
+    box = {"kind": "box", "lower": [1, 1, 1], "upper": [2, 2, 2], "material": "glass"}
+    result = _cli("validate", _write(tmp_path, walls=[floor, box]))
+    assert result.exit_code == 2, result.output
+    assert (
+        "error: walls.1: [[1.0, 1.0, 1.0], [2.0, 2.0, 2.0]] (a box) lies 0.99 m outside the "
+        "domain [[0.0, 0.0, 0.0], [0.01, 0.01, 0.01]] on the x axis (the wall spans 1 .. 2 m, "
+        "the domain 0 .. 0.01 m)"
+    ) in result.output
+    # legitimate: planes on every face of the domain, a box enclosing it, a rectangle and a
+    # cylinder touching it from outside
+    faces = [
+        {"kind": "plane", "point": p, "normal": n, "material": "glass"}
+        for p, n in (([0.01, 0, 0], [-1, 0, 0]), ([0, 0, 0], [1, 0, 0]), ([0, 0, 0.01], [0, 0, -1]))
+    ]
+    around = {"kind": "box", "lower": [-1, -1, -1], "upper": [1, 1, 1], "material": "glass"}
+    plate = {"kind": "rectangle", "center": [0.005, 0.005, 0.0105], "normal": [0, 0, 1],
+             "u_axis": [1, 0, 0], "half_extents": [0.005, 0.005], "material": "glass"}  # fmt: skip
+    drum = {"kind": "cylinder", "center": [0.005, 0.005, 0.021], "axis": [1, 0, 0],
+            "radius": 0.01, "length": 0.01, "inside": False, "material": "glass"}  # fmt: skip
+    walls = [floor, *faces, around, plate, drum]
+    result = _cli("validate", _write(tmp_path, walls=walls))
+    assert result.exit_code == 0, result.output
+    assert "outside the domain" not in result.output
+
+
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 
 

@@ -230,3 +230,125 @@ def _check_pour_in_boxes(case: Case, k: int, x: np.ndarray, r: float, span: floa
                     "two-sided), so move the region into the box (above an open_top box is "
                     "fine: the particles fall in)"
                 )
+
+
+def _reach(sim: Simulation) -> float:
+    """How far beyond the domain a particle can touch a wall [m]: the largest diameter of the
+    particles present and of the pour distributions (every rank's), plus
+    ``neighbors.extra_distance``; generous on purpose, so that only a wall far from the
+    domain is refused."""
+    case = sim.case
+    n = sim.owned_count
+    largest = float(np.max(sim.particles.radius[:n])) if n else 0.0
+    for entry in case.insertion:
+        if entry.kind == "pour":
+            largest = max(largest, float(entry.distribution.max_radius_bound or 0.0))
+    comm = getattr(sim, "comm", None)
+    if comm is not None:
+        largest = max(comm.allgather(largest))
+    return 2.0 * largest + float(case.neighbors.extra_distance)
+
+
+def _wall_extent(wall: Any, planar: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) of the axis-aligned box around a rectangle, box or cylinder wall
+    (unbounded: +-inf; 2D: walls are lines and circles in the x-y plane)."""
+    if wall.kind == "box":
+        return np.asarray(wall.lower, float), np.asarray(wall.upper, float)
+    c = np.asarray(wall.center, float)
+    if wall.kind == "rectangle":
+        n = np.asarray(wall.normal, float)
+        u = np.asarray(wall.u_axis, float)
+        n, u = n / np.linalg.norm(n), u / np.linalg.norm(u)
+        v = np.cross(n, u)
+        half = np.abs(u) * wall.half_extents[0] + np.abs(v) * wall.half_extents[1]
+        return c - half, c + half
+    a = np.asarray(wall.axis, float)
+    a = a / np.linalg.norm(a)
+    across = wall.radius * np.sqrt(np.clip(1.0 - a * a, 0.0, 1.0))
+    if wall.length is None or planar:
+        along = np.where(np.abs(a) > 1e-12, np.inf, 0.0)
+    else:
+        along = np.abs(a) * 0.5 * wall.length
+    return c - across - along, c + across + along
+
+
+def check_walls_in_domain(sim: Simulation) -> list[str]:
+    """A wall that cannot touch any particle of the domain (particles stay inside it: leaving
+    a closed side stops the run, periodic ones are wrapped) is a mistake: a plane lying
+    outside the domain (a coordinate in mm, or a sign error), or one with the whole domain
+    behind it; a rectangle, box or cylinder whose extent misses the domain, farther than a
+    particle reaches (:func:`_reach`). Refused naming the key, the value and the domain;
+    a wall with a ``velocity`` may move in: a warning. Touching the boundary is fine (the
+    usual floor at z = lower). A cylinder's ``angular_velocity`` turns it about its own axis,
+    which moves no part of it into the domain. Returns the warnings."""
+    case = sim.case
+    if not case.walls:
+        return []
+    planar = case.simulation.planar
+    axes = "xy" if planar else "xyz"
+    lo = np.asarray(case.domain.lower, float)
+    hi = np.asarray(case.domain.upper, float)
+    if planar:
+        lo[2] = hi[2] = 0.0
+    span = float(np.max((hi - lo)[: len(axes)]))
+    reach = _reach(sim)
+    domain = f"[{list(case.domain.lower)}, {list(case.domain.upper)}]"
+    warnings: list[str] = []
+    for k, wall in enumerate(case.walls):
+        why = None
+        if wall.kind == "plane":
+            key, value = f"walls.{k}.point", list(wall.point)
+            n = np.asarray(wall.normal, float)
+            n = n / np.linalg.norm(n)
+            corners = np.array(
+                [[(lo, hi)[(c >> a) & 1][a] for a in range(3)] for c in range(8)], dtype=float
+            )
+            d = (corners - np.asarray(wall.point, float)) @ n
+            normal = [float(c) for c in wall.normal]
+            if d.min() > reach:
+                why = (
+                    f"(a plane with normal {normal}) lies {d.min():.6g} m outside the domain "
+                    f"{domain}, facing it: no particle inside the domain reaches it (they reach at "
+                    f"most {reach:.6g} m beyond it)"
+                )
+            elif d.max() <= 1e-9 * span:
+                why = (
+                    f"(a plane with normal {normal}) has the whole domain {domain} behind it: "
+                    "the plane is one-sided, its normal must point towards the particles (is it "
+                    "flipped?)"
+                )
+        else:
+            key = f"walls.{k}.lower" if wall.kind == "box" else f"walls.{k}.center"
+            value = list(wall.lower if wall.kind == "box" else wall.center)
+            low, up = _wall_extent(wall, planar)
+            for a, axis in enumerate(axes):
+                gap = max(low[a] - hi[a], lo[a] - up[a])
+                if gap > reach:
+                    extent = f"{low[a]:g} .. {up[a]:g}"
+                    if wall.kind == "box":
+                        key, value = f"walls.{k}", f"[{list(wall.lower)}, {list(wall.upper)}]"
+                    why = (
+                        f"(a {wall.kind}) lies {gap:.6g} m outside the domain {domain} on the "
+                        f"{axis} axis (the wall spans {extent} m, the domain "
+                        f"{lo[a]:g} .. {hi[a]:g} m): no particle inside the domain reaches it "
+                        f"(they reach at most {reach:.6g} m beyond it)"
+                    )
+                    break
+        if why is None:
+            continue
+        if any(float(c) != 0.0 for c in wall.velocity):
+            warnings.append(
+                f"{key}: {value} {why}; it moves (velocity {list(wall.velocity)} m/s), so it "
+                "may come in later, but it touches nothing until then"
+            )
+            continue
+        still = "it does not move"
+        if getattr(wall, "angular_velocity", 0.0):
+            still += " (angular_velocity turns it about its own axis only)"
+        raise ConfigError(
+            f"{key}: {value} {why}, and {still}, so it would never act: particles "
+            "stay inside the domain. Move the wall onto the domain's boundary or into the "
+            "domain (a coordinate in mm instead of m, or a sign?), enlarge domain, or remove "
+            "the wall"
+        )
+    return warnings

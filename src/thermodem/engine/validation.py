@@ -24,7 +24,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from pydantic import BaseModel
 
-from thermodem.engine.start_checks import check_pour_walls, check_wall_overlaps
+from thermodem.engine.start_checks import (
+    check_pour_walls,
+    check_wall_overlaps,
+    check_walls_in_domain,
+)
 from thermodem.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -505,7 +509,8 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_step_count(sim)
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
-    notes = section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
+    notes = check_walls_in_domain(sim)
+    notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
     notes += temperature_warnings(sim) + step_interval_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
 
