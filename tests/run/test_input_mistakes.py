@@ -359,6 +359,33 @@ def test_a_wall_wholly_outside_the_domain_is_refused_or_told(tmp_path: Path) -> 
     assert "outside the domain" not in result.output
 
 
+def test_a_wall_closing_a_periodic_axis_is_told(tmp_path: Path) -> None:
+    """Planes on both x faces of a domain periodic along x gave no word: the particles by the
+    two walls interact across the periodic boundary, through the walls."""
+    x_walls = [
+        {"kind": "plane", "point": [0, 0, 0], "normal": [1, 0, 0], "material": "glass"},
+        {"kind": "plane", "point": [0.01, 0, 0], "normal": [-1, 0, 0], "material": "glass"},
+    ]
+    domain = {**CASE["domain"], "periodic": [True, False, False]}
+    result = _cli("validate", _write(tmp_path, domain=domain, walls=CASE["walls"] + x_walls))
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: domain.periodic: [true, false, false] makes x periodic, but walls.1 (plane1) "
+        "is a plane with normal [1.0, 0.0, 0.0] that closes x: particles are wrapped across the "
+        "periodic boundary"
+    ) in result.output
+    assert "but walls.2 (plane2) is a plane with normal [-1.0, 0.0, 0.0]" in result.output
+    assert "walls.0" not in result.output  # the floor: z is not periodic
+    box = [{"kind": "box", "lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01], "material": "glass",
+            "name": "bin"}]  # fmt: skip
+    result = _cli("validate", _write(tmp_path, domain=domain, walls=box))
+    assert "but walls.0 (bin) is a box (its faces close every axis) that closes x" in (
+        result.output
+    )
+    result = _cli("validate", _write(tmp_path, domain=domain))  # the floor only: fine
+    assert result.exit_code == 0 and "domain.periodic" not in result.output, result.output
+
+
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 
 

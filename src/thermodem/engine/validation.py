@@ -509,10 +509,44 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_step_count(sim)
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
-    notes = check_walls_in_domain(sim)
+    notes = check_walls_in_domain(sim) + periodic_wall_warnings(case)
     notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
     notes += temperature_warnings(sim) + step_interval_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
+
+
+def periodic_wall_warnings(case: Case) -> list[str]:
+    """A periodic axis that a wall closes: a plane whose normal has a component along it, a box
+    (its faces close every axis). Particles are wrapped across the periodic boundary, so the
+    particles on either side of such a wall interact through the domain's faces: the wall does
+    not separate them. A warning each, naming ``domain.periodic`` and the wall."""
+    periodic = case.domain.periodic
+    axes = "xy" if case.simulation.planar else "xyz"
+    shown = "[" + ", ".join("true" if p else "false" for p in periodic[: len(axes)]) + "]"
+    out = []
+    for k, wall in enumerate(case.walls):
+        label = wall.name or f"{wall.kind}{k}"
+        if wall.kind == "plane":
+            n = np.asarray(wall.normal, float)
+            n = n / np.linalg.norm(n)
+            closed = [a for a in range(len(axes)) if periodic[a] and abs(n[a]) > 1e-9]
+            what = f"a plane with normal {[float(c) for c in wall.normal]}"
+        elif wall.kind == "box":
+            closed = [a for a in range(len(axes)) if periodic[a]]
+            what = "a box (its faces close every axis)"
+        else:
+            continue
+        if not closed:
+            continue
+        names = " and ".join(axes[a] for a in closed)
+        out.append(
+            f"domain.periodic: {shown} makes {names} periodic, but walls.{k} ({label}) is {what} "
+            f"that closes {names}: particles are wrapped across the periodic boundary, so those "
+            "on either side of the wall interact through the domain's faces, past the wall; a "
+            f"wall bounds an axis that is not periodic: set {names} false in domain.periodic, "
+            "or remove the wall"
+        )
+    return out
 
 
 def section_warnings(case: Case) -> list[str]:
