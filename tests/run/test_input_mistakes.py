@@ -484,6 +484,29 @@ def test_temperatures_that_look_like_celsius_are_warned_about(tmp_path: Path) ->
     assert "is below 200 K" not in _cli("validate", _write(tmp_path, thermal={})).output
 
 
+def test_a_fluid_temperature_grid_in_celsius_is_warned_about(tmp_path: Path) -> None:
+    """A fluid grid file of temperatures in °C (26.85) was read silently, while the single
+    temperature keys below 200 K are told: its smallest value is told once."""
+    import numpy as np
+
+    axis = np.linspace(0.0, 0.01, 3)
+    temperature = np.full((3, 3, 3), 26.85)
+    temperature[1, 2, 0] = 20.0
+    np.savez(tmp_path / "flow.npz", x=axis, y=axis, z=axis, T=temperature)
+    fluid = {"temperature": {"file": "flow.npz", "field": "T"}}
+    case = _write(tmp_path, thermal={"convection": "stagnant", "fluid": fluid})
+    result = _cli("validate", case)
+    assert result.exit_code == 0, result.output
+    assert result.output.count("thermal.fluid.temperature") == 1, result.output
+    assert (
+        f"warning: thermal.fluid.temperature (grid file {tmp_path / 'flow.npz'}, field 'T': its "
+        "smallest value, at grid index (1, 2, 0)): 20 K is below 200 K, colder than any natural "
+        "temperature on Earth"
+    ) in result.output
+    np.savez(tmp_path / "flow.npz", x=axis, y=axis, z=axis, T=temperature + 273.15)
+    assert "is below 200 K" not in _cli("validate", case).output
+
+
 #: (key, family) of every key that selects a model by name, one case each below.
 MODEL_KEYS = [
     ("contact.normal", "normal"),  # a contact law without none

@@ -580,6 +580,23 @@ def _expression_minimum(expression: str, names: tuple[str, ...], grid: tuple) ->
         return math.nan
 
 
+def _grid_minimum(sim: Simulation, source: Any) -> tuple[str, float | None]:
+    """(key, smallest value) of the fluid temperature grid file as the run reads it (None when
+    no selected model reads the fluid temperature: the file is not read)."""
+    provider = getattr(sim.thermal, "field_provider", None)
+    read = getattr(provider, "_sources", {}).get("temperature")
+    if read is None or read[0] != "grid":
+        return "thermal.fluid.temperature", None
+    values = read[2]
+    k = np.unravel_index(int(np.argmin(values)), values.shape)
+    where = tuple(int(v) for v in k[:3])
+    return (
+        f"thermal.fluid.temperature (grid file {source.file}, field {source.field!r}: its "
+        f"smallest value, at grid index {where})",
+        float(values[k]),
+    )
+
+
 def temperature_warnings(sim: Simulation) -> list[str]:
     """Every temperature key of the case (and the particles' start temperatures, which files
     give) below :data:`CELSIUS_SUSPECT_BELOW`: a warning each naming the key and the value
@@ -643,6 +660,8 @@ def temperature_warnings(sim: Simulation) -> list[str]:
         elif fluid is not None and fluid.kind == "table":
             i = int(np.argmin([row[1] for row in fluid.table]))
             add(f"thermal.fluid.temperature (row {i})", fluid.table[i][1])
+        elif fluid is not None and fluid.kind == "grid":
+            add(*_grid_minimum(sim, fluid))
         for family in ("radiation",):
             params = getattr(th, family).params
             add(f"thermal.{family}.environment_temperature",
