@@ -122,3 +122,43 @@ def test_bad_files_give_one_line(tmp_path: Path, make, expected: str) -> None:  
     assert result.exit_code == 2
     assert expected in result.output
     assert len(result.output.strip().splitlines()) == 1, result.output
+
+
+UNION_HEAD = (
+    "simulation: {time_step: 1.0e-5, end_time: 0.001}\n"
+    "domain: {lower: [0, 0, 0], upper: [0.01, 0.01, 0.01]}\n"
+    "materials:\n  glass: {density: 2500, youngs_modulus: 1.0e7, poisson_ratio: 0.3}\n"
+)
+LATTICE = (
+    "insertion:\n  - {kind: lattice, material: glass, distribution: {kind: mono, radius: 0.001},"
+    " lower: [0, 0, 0], upper: [0.006, 0.006, 0.006], spacing: %s}\n"
+)
+
+
+@pytest.mark.parametrize(
+    ("body", "expected"),
+    [
+        (LATTICE % "-1", "insertion.0.spacing: must be greater than 0 (got -1), or a list of "
+         "three such values"),
+        (LATTICE % "abc", "insertion.0.spacing: should be a number or a list of three numbers "
+         "(got 'abc')"),
+        (LATTICE % "[0.002, 0, 0.002]", "insertion.0.spacing.1: Input should be greater than 0 "
+         "(got 0)"),
+        ("walls:\n  - {kind: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass, "
+         "thermal: {kind: fixed, temperature: {a: 1}}}\n",
+         "walls.0.thermal.temperature: should be a number, a list of rows of two numbers or a "
+         "string (got {'a': 1})"),
+    ],
+    ids=["spacing-negative", "spacing-string", "spacing-list-item", "temperature-mapping"],
+)  # fmt: skip
+def test_a_value_for_a_union_gets_one_line_without_type_names(
+    tmp_path: Path, body: str, expected: str
+) -> None:
+    """A number-or-list key given a bad value printed one line per member of the union,
+    named by pydantic's types (insertion.0.spacing.constrained-float: ... and
+    insertion.0.spacing.tuple[constrained-float, ...]: should be a list of values)."""
+    path = _file(tmp_path, "union.yaml", (UNION_HEAD + body).encode())
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2, result.output
+    lines = result.output.splitlines()
+    assert lines[1:] == [expected], result.output

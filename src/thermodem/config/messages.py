@@ -292,6 +292,11 @@ def format_error(err: dict[str, Any], data: Any) -> str:
         if not keys and kinds:
             allowed = f" with a kind: {', '.join(kinds)}"
         return f"{dotted}: should be a mapping of keys (key: value){allowed} (got {_shown(value)})"
+    if kind == "union_type":  # (from _collapse_unions: the value fits no member)
+        return f"{dotted}: {msg} (got {_shown(value)})"
+    if err.get("or_list"):  # a number out of bounds where a list of such numbers also fits
+        msg = re.sub(r"^Input should be ", "must be ", msg)
+        return f"{dotted}: {msg} (got {_shown(value)}), or {err['or_list']}"
     if kind == "tuple_type":
         # 'Input should be a valid tuple': a case file has lists
         tp = _unwrap(where.tp) if where is not None else None
@@ -324,8 +329,64 @@ def format_error(err: dict[str, Any], data: Any) -> str:
     return f"{dotted}: {msg}{shown}" if dotted else f"{msg}{shown}"
 
 
-_MEMBER_TAG = re.compile(r"^(float|int|str|bool|none|[\w.]+\[.*\])$")
+_MEMBER_TAG = re.compile(r"^(float|int|str|bool|none|constrained-\w+|[\w.]+\[.*\])$")
 _TYPE_ERRORS = re.compile(r"_(type|parsing)$")
+_SCALAR_TAGS = {"float": "a number", "int": "an integer", "str": "a string",
+                "bool": "true or false", "none": "null"}  # fmt: skip
+_COUNTS = {2: "two", 3: "three", 4: "four", 6: "six"}
+
+
+def _tag_base(tag: str) -> str:
+    """'float' of 'constrained-float'; 'tuple' of 'tuple[float, float]'."""
+    return tag.removeprefix("constrained-").split("[", 1)[0]
+
+
+def _tag_items(tag: str) -> list[str]:
+    """The top-level member types of 'tuple[a, b, c]' or 'list[a]'."""
+    inner = tag[tag.index("[") + 1 : -1] if "[" in tag else ""
+    items, depth, start = [], 0, 0
+    for i, ch in enumerate(inner):
+        depth += ch == "["
+        depth -= ch == "]"
+        if ch == "," and depth == 0:
+            items.append(inner[start:i].strip())
+            start = i + 1
+    if inner:
+        items.append(inner[start:].strip())
+    return items
+
+
+def _describe_tag(tag: str) -> str:
+    """What a member of a union of plain types takes, in case-file words: 'a number', 'a
+    list of three numbers', 'a list of rows of two numbers'."""
+    base = _tag_base(tag)
+    if base in _SCALAR_TAGS:
+        return _SCALAR_TAGS[base]
+    items = _tag_items(tag)
+    numbers = bool(items) and all(_tag_base(i) in ("float", "int") for i in items)
+    if base == "tuple" and items and "..." not in items:
+        count = _COUNTS.get(len(items), str(len(items)))
+        return f"a list of {count} {'numbers' if numbers else 'values'}"
+    if base in ("list", "tuple") and len(items) == 1 and _tag_base(items[0]) == "tuple":
+        row = _tag_items(items[0])
+        if row and all(_tag_base(i) in ("float", "int") for i in row):
+            return f"a list of rows of {_COUNTS.get(len(row), str(len(row)))} numbers"
+    if base in ("list", "tuple"):
+        return "a list of numbers" if numbers else "a list"
+    return "a mapping" if base == "dict" else base
+
+
+def _or_list(tag: str, others: list[str]) -> str | None:
+    """', or a list of three such values' for a number refused by its bounds when the union
+    also takes a list of such numbers (spacing: 0.001 or [0.001, 0.001, 0.002])."""
+    if _tag_base(tag) not in ("float", "int"):
+        return None
+    for other in others:
+        items = _tag_items(other)
+        if _tag_base(other) in ("tuple", "list") and items and items[0] == tag:
+            count = len(items) if "..." not in items and _tag_base(other) == "tuple" else 0
+            return f"a list of {_COUNTS.get(count, str(count)) + ' ' if count else ''}such values"
+    return None
 
 
 def _member_tag_at(loc: tuple[Any, ...], data: Any) -> int:
@@ -362,9 +423,19 @@ def _collapse_unions(errors: list[dict[str, Any]], data: Any) -> list[dict[str, 
         groups.setdefault(loc[:k], []).append((k, err))
     for members in groups.values():
         content = [(k, e) for k, e in members if not _TYPE_ERRORS.search(e["type"])]
-        for k, err in content or members:
+        tags = list(dict.fromkeys(str(e["loc"][k]) for k, e in members))
+        if not content:  # the value fits no member: one line saying what each takes
+            k, err = members[0]
+            taken = list(dict.fromkeys(_describe_tag(t) for t in tags))
+            alternatives = ", ".join(taken[:-1]) + f" or {taken[-1]}" if len(taken) > 1 else ""
+            msg = f"should be {alternatives or taken[0]}"
+            out.append({**err, "loc": tuple(err["loc"])[:k], "type": "union_type", "msg": msg})
+            continue
+        for k, err in content:
             loc = tuple(err["loc"])
-            out.append({**err, "loc": loc[:k] + loc[k + 1 :]} if content else err)
+            tag = str(loc[k])
+            extra = _or_list(tag, [t for t in tags if t != tag])
+            out.append({**err, "loc": loc[:k] + loc[k + 1 :], "or_list": extra})
     return out
 
 
