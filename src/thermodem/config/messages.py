@@ -20,7 +20,17 @@ from thermodem.models import registry
 
 
 def suggest(name: str, choices: list[str]) -> str | None:
-    """The closest choice to ``name`` (spelling, or a choice starting with it), if any."""
+    """The closest choice to ``name`` (the same but for capitals, spelling, or a choice
+    starting with it), if any. Names stay case-sensitive: only the suggestion ignores case
+    ('EPSD': did you mean 'epsd'?)."""
+    name = str(name)
+    same = [c for c in choices if c.casefold() == name.casefold()]
+    if same:
+        return same[0]
+    folded = {c.casefold(): c for c in choices}
+    close = difflib.get_close_matches(name.casefold(), list(folded), n=1, cutoff=0.6)
+    if close:
+        return folded[close[0]]
     close = difflib.get_close_matches(str(name), choices, n=1, cutoff=0.6)
     if close:
         return close[0]

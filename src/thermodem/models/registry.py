@@ -22,7 +22,6 @@ family's dispatcher and each model's own kernel give the same answer.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -260,9 +259,11 @@ def all_models() -> list[ModelSpec]:
 def unknown_name_message(family: str, name: str) -> str:
     """'unknown ... model 'x'; did you mean 'y'? allowed: ...' for error messages."""
     _ensure_loaded()
+    from thermodem.config.messages import suggest  # (capitals first: 'EPSD' -> 'epsd')
+
     choices = sorted(_REGISTRY[family])
-    close = difflib.get_close_matches(name, choices, n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
+    close = suggest(name, choices)
+    hint = f"; did you mean {close!r}?" if close else ""
     return f"unknown {family} model {name!r}{hint} allowed: {', '.join(choices)}"
 
 
