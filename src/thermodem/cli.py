@@ -209,6 +209,8 @@ def _shorten(case, end_time: float | None, steps: int | None, restart: Path | No
         from thermodem.io.checkpoint import read_checkpoint
 
         start = read_checkpoint(restart).time
+    option = f"--end-time {end_time:g}" if end_time is not None else f"--steps {steps}"
+    case._shortened = (option, float(case.simulation.end_time))
     if end_time is not None:
         if not math.isfinite(end_time) or end_time <= start:
             where = f"the checkpoint's time {start:g} s" if restart is not None else "0"

@@ -76,6 +76,23 @@ def test_a_pour_that_pours_nothing_before_the_end_is_told(tmp_path: Path) -> Non
     assert result.exit_code == 0, result.output
     assert "warning: insertion.1: its first batch is due at t = 1 s" in result.output
     assert "insertion.1: its first batch" in (tmp_path / "out" / "run.log").read_text()
+    # --steps / --end-time shorten the run: the end is theirs, not simulation.end_time's
+    # (it said 'after simulation.end_time = 2e-05 s' of a case whose end_time is 0.001 s)
+    assert (
+        "after the end of this run, t = 2e-05 s (--steps 2; simulation.end_time = 0.001 s): "
+        "nothing is poured in this run"
+    ) in result.output
+    result = _cli("run", case, "--output", tmp_path / "o2", "--end-time", "3e-5", "--no-progress")
+    assert result.exit_code == 0, result.output
+    assert "after the end of this run, t = 3e-05 s (--end-time 3e-05; simulation.end_time = " in (
+        result.output
+    )
+    result = _cli("run", case, "--output", tmp_path / "o3", "--end-time", "1e-9", "--no-progress")
+    assert result.exit_code == 2, result.output
+    assert (
+        "error: --end-time 1e-09: the end of this run, t = 1e-09 s, gives no step of "
+        "simulation.time_step = 1e-05 s after t = 0 s"
+    ) in result.output
 
 
 def test_a_pour_rate_below_one_particle_is_told(tmp_path: Path) -> None:
@@ -116,6 +133,7 @@ def test_an_output_interval_shorter_than_the_time_step_is_told(tmp_path: Path) -
     assert "warning: output.interval = 1e-06 s is shorter than simulation.time_step" in (
         result.output
     )
+    assert "(2 steps to the end of this run (--steps 2))" in result.output
 
 
 def test_a_region_selection_empty_at_the_start_is_a_warning(tmp_path: Path) -> None:

@@ -10,7 +10,14 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, ValidationInfo, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    Field,
+    PrivateAttr,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from thermodem.config.base import StrictModel
 from thermodem.config.insertion import InsertionEntry
@@ -338,6 +345,10 @@ class Case(StrictModel):
     external_force: list[ExternalForce] = Field(
         default_factory=list, description="constant force/torque on selected particles"
     )
+    #: set by ``thermodem run --steps N`` / ``--end-time T``: (the option as given, the case
+    #: file's own ``simulation.end_time``), so that messages about the end of the run name
+    #: the option, not the case's key (:func:`thermodem.engine.validation.end_time_text`)
+    _shortened: tuple[str, float] | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _names(self) -> Case:

@@ -436,6 +436,18 @@ def check_thermal_selections(sim: Simulation) -> list[str]:
     return warnings
 
 
+def end_time_text(case: Case) -> str:
+    """The end of the run for a message: 'simulation.end_time = 0.25 s', or after ``thermodem
+    run --steps 20`` 'the end of this run, t = 0.0001 s (--steps 20; simulation.end_time =
+    0.25 s)': the shortened end is the option's, not the case's key."""
+    end = case.simulation.end_time
+    shortened = getattr(case, "_shortened", None)
+    if shortened is None:
+        return f"simulation.end_time = {end:g} s"
+    option, own = shortened
+    return f"the end of this run, t = {end:g} s ({option}; simulation.end_time = {own:g} s)"
+
+
 def check_step_count(sim: Simulation) -> None:
     """``thermodem run`` makes ``round(end_time / time_step)`` steps (thermal steps with frozen
     mechanics): refuse an end time that gives none (the run said 'done: 0 steps')."""
@@ -446,6 +458,13 @@ def check_step_count(sim: Simulation) -> None:
     key = "thermal.time_step" if frozen else "simulation.time_step"
     dt = th.settings.time_step if frozen else sim.dt
     end = sim.case.simulation.end_time
+    shortened = getattr(sim.case, "_shortened", None)
+    if shortened is not None:  # (--end-time: the case's own end time is not at fault)
+        raise ConfigError(
+            f"{shortened[0]}: the end of this run, t = {end:g} s, gives no step of {key} = "
+            f"{dt:g} s after t = {sim.time:g} s (the run makes round((end - t) / time_step) "
+            f"steps; simulation.end_time = {shortened[1]:g} s); give at least {sim.time + dt:g}"
+        )
     raise ConfigError(
         f"simulation.end_time: {end:g} s gives no step of {key} = {dt:g} s after t = "
         f"{sim.time:g} s (the run makes round((end_time - t) / time_step) steps); the end time "
@@ -468,8 +487,8 @@ def insertion_warnings(case: Case) -> list[str]:
         if first - 0.5 * dt > end:
             out.append(
                 f"insertion.{k}: its first batch is due at t = {first:g} s (start_time "
-                f"{e.start_time:g} s + interval {e.interval:g} s), after simulation.end_time = "
-                f"{end:g} s: nothing is poured in this run"
+                f"{e.start_time:g} s + interval {e.interval:g} s), after "
+                f"{end_time_text(case)}: nothing is poured in this run"
             )
         elif e.rate * max(0.0, stop - e.start_time) < 1.0:
             out.append(
@@ -709,6 +728,8 @@ def step_interval_warnings(sim: Simulation) -> list[str]:
     key = "thermal.time_step" if frozen else "simulation.time_step"
     dt = th.settings.time_step if frozen else sim.dt
     steps = total_steps(sim)
+    shortened = getattr(case, "_shortened", None)
+    target = "simulation.end_time" if shortened is None else f"the end of this run ({shortened[0]})"
     out = []
     for name in ("interval", "timeseries_interval", "checkpoint_interval"):
         value = getattr(case.output, name)
@@ -717,7 +738,7 @@ def step_interval_warnings(sim: Simulation) -> list[str]:
         what = "a frame" if name == "interval" else "a row" if name[0] == "t" else "a checkpoint"
         out.append(
             f"output.{name} = {value:g} s is shorter than {key} = {dt:g} s: {what} is written at "
-            f"every step ({steps} steps to simulation.end_time); intervals are simulated "
+            f"every step ({steps} steps to {target}); intervals are simulated "
             f"seconds: give at least {dt:g} s"
         )
     return out
