@@ -121,6 +121,43 @@ def test_output_path_the_system_refuses_is_an_error_not_a_traceback(
     assert "Traceback" not in result.output
 
 
+def test_export_and_plot_paths_the_system_refuses_are_errors_not_tracebacks(
+    tmp_path: Path, finished: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """export --out /proc/x.csv (a file the file system will not create), a name too long, and
+    plot --out into such a directory ended in a FileNotFoundError / OSError traceback."""
+    import errno
+
+    long = str(tmp_path / ("a" * 300))
+    for args, expected in (
+        (("export", str(finished), "--out", "/proc/x.csv"),
+         "error: --out '/proc/x.csv': the file cannot be written: No such file or directory; "
+         "choose another --out"),
+        (("export", str(finished), "--frame", "0", "--out", long + ".csv"),
+         "the file cannot be written: File name too long; choose another --out"),
+        (("plot", str(finished), "--out", long),
+         "cannot be used: File name too long; choose another --out"),
+        (("plot", str(finished), "--out", "/proc/self"),
+         "error: --out '/proc/self': energies.png cannot be written: No such file or directory; "
+         "choose another --out"),
+    ):  # fmt: skip
+        result = _invoke(*args)
+        assert result.exit_code == 2, result.output
+        assert expected in result.output, result.output
+        assert "Traceback" not in result.output
+
+    def refuse(self: Path, *args: object, **kwargs: object) -> None:
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    monkeypatch.setattr(Path, "write_text", refuse)
+    result = _invoke("export", str(finished), "--out", str(tmp_path / "p.csv"))
+    assert result.exit_code == 2, result.output
+    assert "the file cannot be written: Read-only file system; choose another --out" in (
+        result.output
+    )
+    assert not list(tmp_path.glob(".p.csv.*"))
+
+
 def test_threads_above_the_core_count_are_clamped_with_a_message(tmp_path: Path) -> None:
     case = _case_file(tmp_path)
     cores = len(os.sched_getaffinity(0))

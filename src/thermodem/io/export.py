@@ -144,9 +144,12 @@ def _rows(table: ParticleTable) -> list[list[str]]:
     return rows
 
 
-def write_csv(table: ParticleTable, out: Path | None, overwrite: bool = True) -> str:
+def write_csv(
+    table: ParticleTable, out: Path | None, overwrite: bool = True, given: bool = True
+) -> str:
     """Write the table to ``out`` (None: standard output); returns where it went. An existing
-    ``out`` is replaced only with ``overwrite``."""
+    ``out`` is replaced only with ``overwrite``; ``given``: ``out`` is the user's ``--out``
+    (else the default file in the run's directory)."""
     buffer = io.StringIO()
     buffer.write(f"# thermodem export: {table.source}; {UNITS}\n")
     writer = csv.writer(buffer, lineterminator="\n")
@@ -155,6 +158,20 @@ def write_csv(table: ParticleTable, out: Path | None, overwrite: bool = True) ->
     if out is None:
         sys.stdout.write(buffer.getvalue())
         return "standard output"
+    try:
+        _write_file(out, buffer.getvalue(), overwrite)
+    except OSError as exc:  # (a file system that refuses it: read-only, /proc, full; a name
+        raise ConfigError(  # too long; no permission)
+            f"{'--out ' if given else ''}{str(out)!r}{'' if given else ' (no --out)'}: the file "
+            f"cannot be written: {exc.strerror or exc}; choose another --out"
+        ) from None
+    return str(out)
+
+
+def _write_file(out: Path, text: str, overwrite: bool) -> None:
+    """``text`` to the file ``out`` (through a temporary file beside it, replaced atomically);
+    ConfigError for a directory, an existing file without ``overwrite``, a path under a file;
+    OSError where the system refuses."""
     if out.is_dir():
         raise ConfigError(f"--out {out}: is a directory; give a file name")
     if out.exists() and not overwrite:
@@ -171,9 +188,12 @@ def write_csv(table: ParticleTable, out: Path | None, overwrite: bool = True) ->
     except OSError as exc:
         raise ConfigError(f"--out {out}: its directory cannot be made: {exc.strerror}") from None
     tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
-    tmp.write_text(buffer.getvalue())
-    os.replace(tmp, out)
-    return str(out)
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, out)
+    except OSError:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def export_particles(
@@ -214,7 +234,7 @@ def export_particles(
         stem = Path(checkpoint).stem.replace("checkpoint", "step")
         default = directory / f"particles_{stem}.csv"
     if out is None:
-        return write_csv(table, default)
+        return write_csv(table, default, given=False)
     if str(out) == "-":
         return write_csv(table, None)
     return write_csv(table, Path(out), overwrite)

@@ -98,14 +98,25 @@ def plot_directory(
     data = read_timeseries(path)
     if "time" not in data or data["time"].size == 0:
         raise ConfigError(f"{path} has no rows yet")
-    target = _plot_target(directory, out, overwrite)
+    given = f"--out {str(out)!r}" if out is not None else f"{str(directory / 'plots')!r} (no --out)"
+    try:
+        target = _plot_target(directory, out, overwrite)
+    except OSError as exc:  # (a name too long, no permission)
+        raise ConfigError(
+            f"{given} cannot be used: {exc.strerror or exc}; choose another --out"
+        ) from None
     t = data["time"]
     written: list[Path] = []
 
     def save(fig, name: str) -> None:  # noqa: ANN001
         fig.axes[-1].set_xlabel("time [s]")
         file = target / name
-        fig.savefig(file, dpi=110)
+        try:
+            fig.savefig(file, dpi=110)
+        except OSError as exc:  # (a file system that refuses it: read-only, /proc, full)
+            raise ConfigError(
+                f"{given}: {name} cannot be written: {exc.strerror or exc}; choose another --out"
+            ) from None
         written.append(file)
 
     # energies
