@@ -136,6 +136,24 @@ def test_an_output_interval_shorter_than_the_time_step_is_told(tmp_path: Path) -
     assert "(2 steps to the end of this run (--steps 2))" in result.output
 
 
+def test_a_skin_of_many_diameters_is_told(tmp_path: Path) -> None:
+    """A skin typed as a domain size (or in mm) listed every pair of the domain: the packed-bed
+    example ran 40 times slower without a word. The usual skins are not warned about."""
+    result = _cli("validate", _write(tmp_path, neighbors={"skin": 1.0}))
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: neighbors.skin = 1 m is 500 times the largest particle diameter (0.002 m): "
+        "every particle lists all the others within 1 m"
+    ) in result.output
+    thermal = {"range_skin": 0.05, "indirect_conduction": "rong_horio1999",
+               "gas": {"thermal_conductivity": 0.026}}  # fmt: skip
+    result = _cli("validate", _write(tmp_path, neighbors={"skin": 0.004}, thermal=thermal))
+    assert "thermal.range_skin = 0.05 m is 25 times" in result.output, result.output
+    assert "neighbors.skin" not in result.output  # 2 diameters: the limit, not above it
+    result = _cli("validate", _write(tmp_path, neighbors={"skin": 0.0005}))
+    assert "skin" not in result.output.split("# ")[0], result.output
+
+
 def test_a_region_selection_empty_at_the_start_is_a_warning(tmp_path: Path) -> None:
     region = {"lower": [0.008, 0.008, 0.008], "upper": [0.01, 0.01, 0.01]}
     thermal = {"heat_flux": [{"select": {"region": region}, "flux": 100.0}]}

@@ -232,21 +232,25 @@ def _check_pour_in_boxes(case: Case, k: int, x: np.ndarray, r: float, span: floa
                 )
 
 
-def _reach(sim: Simulation) -> float:
-    """How far beyond the domain a particle can touch a wall [m]: the largest diameter of the
-    particles present and of the pour distributions (every rank's), plus
-    ``neighbors.extra_distance``; generous on purpose, so that only a wall far from the
-    domain is refused."""
-    case = sim.case
+def largest_radius(sim: Simulation) -> float:
+    """The largest radius of the particles present and of the pour distributions (every
+    rank's) [m]; 0 when there is none."""
     n = sim.owned_count
     largest = float(np.max(sim.particles.radius[:n])) if n else 0.0
-    for entry in case.insertion:
+    for entry in sim.case.insertion:
         if entry.kind == "pour":
             largest = max(largest, float(entry.distribution.max_radius_bound or 0.0))
     comm = getattr(sim, "comm", None)
     if comm is not None:
         largest = max(comm.allgather(largest))
-    return 2.0 * largest + float(case.neighbors.extra_distance)
+    return largest
+
+
+def _reach(sim: Simulation) -> float:
+    """How far beyond the domain a particle can touch a wall [m]: the largest diameter
+    (:func:`largest_radius`), plus ``neighbors.extra_distance``; generous on purpose, so that
+    only a wall far from the domain is refused."""
+    return 2.0 * largest_radius(sim) + float(sim.case.neighbors.extra_distance)
 
 
 def _wall_extent(wall: Any, planar: bool) -> tuple[np.ndarray, np.ndarray]:

@@ -28,6 +28,7 @@ from thermodem.engine.start_checks import (
     check_pour_walls,
     check_wall_overlaps,
     check_walls_in_domain,
+    largest_radius,
 )
 from thermodem.errors import ConfigError
 
@@ -528,10 +529,40 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_step_count(sim)
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
-    notes = check_walls_in_domain(sim) + periodic_wall_warnings(case)
+    notes = check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
     notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
     notes += temperature_warnings(sim) + step_interval_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
+
+
+#: A Verlet skin above this many largest particle diameters is warned about.
+SKIN_WARN_DIAMETERS = 2.0
+
+
+def skin_warnings(sim: Simulation) -> list[str]:
+    """A neighbour skin (``neighbors.skin``, ``thermal.range_skin``) of more than
+    :data:`SKIN_WARN_DIAMETERS` largest particle diameters: every particle then lists every
+    other within that distance (the number of listed pairs grows as the cube of the skin),
+    which costs time and memory at every step and buys nothing (a skin only saves list
+    rebuilds). Typically a length typed in mm or a domain size given as the skin."""
+    diameter = 2.0 * largest_radius(sim)
+    if diameter <= 0.0:
+        return []
+    case = sim.case
+    skins = [("neighbors.skin", case.neighbors.skin)]
+    if case.thermal is not None:
+        skins.append(("thermal.range_skin", case.thermal.range_skin))
+    out = []
+    for key, skin in skins:
+        if skin is not None and skin > SKIN_WARN_DIAMETERS * diameter:
+            out.append(
+                f"{key} = {skin:g} m is {skin / diameter:.3g} times the largest particle "
+                f"diameter ({diameter:g} m): every particle lists all the others within "
+                f"{skin:g} m (the listed pairs grow as the cube of the skin), which slows every "
+                "step and takes memory for nothing; a skin of 0.1-0.5 diameters is usual (the "
+                "default, left out, is 0.2 times the largest radius). A length in mm?"
+            )
+    return out
 
 
 def periodic_wall_warnings(case: Case) -> list[str]:
