@@ -198,3 +198,44 @@ def test_sigint_writes_a_checkpoint_and_restart_finishes(tmp_path: Path) -> None
     )
     assert result.exit_code == 0, result.output
     assert json.loads((out / "status.json").read_text())["status"] == "finished"
+
+
+def test_thermal_blow_up_names_the_step_after_the_last_good_state(tmp_path: Path) -> None:
+    """An explicit heat update that fails ran in step k + 1 from the state of step k; the
+    message said 'at step k', the step of the checkpoint it offered as the last good state."""
+    case = _case(
+        tmp_path,
+        simulation__end_time=0.0005,
+        simulation__initial_temperature=300.0,
+        materials={
+            "glass": {
+                "density": 2500,
+                "youngs_modulus": 1.0e7,
+                "poisson_ratio": 0.3,
+                "thermal_conductivity": 100.0,
+                "specific_heat": 0.001,
+            }
+        },
+        walls__0__thermal={"kind": "fixed", "temperature": 600.0},
+        insertion=[
+            {
+                "kind": "list",
+                "material": "glass",
+                "radius": 0.0008,
+                "positions": [[0.005, 0.005, 0.00079], [0.005, 0.005, 0.00237]],
+            }
+        ],
+        thermal={"stability": {"allow_unstable": True}},
+        output={"checkpoint_interval": 1.0e-5},  # every step: the last good one is k
+    )
+    out = tmp_path / "out"
+    result = _run(case, out)
+    assert result.exit_code == 1, result.output
+    text = result.output
+    m = re.search(r"temperature of particle \d+ became \S+ K at step (\d+) \(t = (\S+) s\)", text)
+    assert m, text
+    good = re.search(r"last good state: \S+ \(step (\d+), t = (\S+) s\)", text)
+    assert int(m.group(1)) == int(good.group(1)) + 1, text
+    assert float(m.group(2)) > float(good.group(2))
+    assert "likely cause: thermal time step 1e-05 s against the limit" in text
+    _assert_failure_leaves_state(out, text)

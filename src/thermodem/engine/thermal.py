@@ -474,6 +474,23 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
             return self._interp(self.c_t, self.c_v, self.c_n, p.type_id, p.temperature)
         return self.specific_heat_by_type[p.type_id]
 
+    def _failing_step(self, dt: float, time: float) -> tuple[str, int, float]:
+        """Where an explicit heat update over ``dt`` from the state at ``time`` fails: in the
+        step being computed (step_count + 1, as the mechanical failures say), not the step of
+        the state it starts from, which the last good checkpoint may hold. Over several
+        mechanical steps (thermal.substeps = n) the message names the interval too."""
+        sim = self.sim
+        mechanical = dt if self.settings.frozen_mechanics else sim.dt
+        step, at = sim.step_count + 1, time + mechanical
+        text = f"at step {step} (t = {at:.6g} s)"
+        n = int(round(dt / mechanical)) if mechanical > 0 else 1
+        if n > 1:
+            text += (
+                f", in the heat update over thermal.substeps = {n} steps from t = {time:.6g} s "
+                f"to t = {time + dt:.6g} s"
+            )
+        return text, step, at
+
     def step(self, dt: float, time: float, clear: bool = False) -> None:
         """Advance temperatures by dt using the state at ``time`` (explicit Euler, or the
         implicit scheme of ``thermal.scheme``: engine/implicit.py).
@@ -538,14 +555,14 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
             int(gid[bad]) if bad >= 0 else -1,
             float(temperature[bad]) if bad >= 0 else math.nan,
         )
+        where_text, failed_step, failed_time = self._failing_step(dt, time)
         if dt > self.limit and not self.settings.stability.allow_unstable:
             raise SimulationError(
                 f"thermal time step {dt:.4g} s exceeds the explicit Euler limit m c / ΣH = "
-                f"{self.limit:.4g} s of particle {self.limit_particle} at step "
-                f"{sim.step_count} (t = {time:.6g} s); use a smaller thermal.substeps / "
-                "thermal.time_step or 'auto'",
-                sim.step_count,
-                time,
+                f"{self.limit:.4g} s of particle {self.limit_particle} {where_text}; use a "
+                "smaller thermal.substeps / thermal.time_step or 'auto'",
+                failed_step,
+                failed_time,
                 self.limit_particle,
             )
         cumulative = self.cumulative
@@ -566,10 +583,10 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
                     f"limit {self.limit:.4g} s)"
                 )
             raise SimulationError(
-                f"temperature of particle {bad_gid} became {bad_temperature:.6g} K at step "
-                f"{sim.step_count} (t = {time:.6g} s); likely cause: {cause}",
-                sim.step_count,
-                time,
+                f"temperature of particle {bad_gid} became {bad_temperature:.6g} K "
+                f"{where_text}; likely cause: {cause}",
+                failed_step,
+                failed_time,
                 bad_gid,
             )
         if self.settings.substeps == "auto" and math.isfinite(self.limit):
