@@ -239,3 +239,36 @@ def test_thermal_blow_up_names_the_step_after_the_last_good_state(tmp_path: Path
     assert float(m.group(2)) > float(good.group(2))
     assert "likely cause: thermal time step 1e-05 s against the limit" in text
     _assert_failure_leaves_state(out, text)
+
+
+def test_a_signal_while_the_run_is_set_up_is_reported_and_the_directory_reused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C while the simulation was built (a large bed, the first compile) exited 130
+    without a word, SIGTERM killed the process; both left run.log and case.resolved.yaml, and
+    the same command then refused the directory as 'exists and is not empty'."""
+    import thermodem.engine.runner as runner
+
+    original = runner.pre_run_checks
+
+    def checks(sim: Simulation) -> list[str]:
+        os.kill(os.getpid(), signal.SIGTERM)
+        return original(sim)
+
+    monkeypatch.setattr(runner, "pre_run_checks", checks)
+    case = _case(tmp_path)
+    out = tmp_path / "out"
+    result = _run(case, out)
+    assert result.exit_code == 143, result.output
+    assert "interrupted (SIGTERM) while the run was being set up, before its first step" in (
+        result.output
+    )
+    assert "to start it: the same command" in result.output
+    assert "Traceback" not in result.output
+    status = json.loads((out / "status.json").read_text())
+    assert status["status"] == "interrupted" and status["not_started"] is True
+    assert not (out / "run.lock").exists()
+    monkeypatch.setattr(runner, "pre_run_checks", original)
+    again = _run(case, out)  # no --overwrite needed: nothing was computed
+    assert again.exit_code == 0, again.output
+    assert json.loads((out / "status.json").read_text())["status"] == "finished"

@@ -98,6 +98,7 @@ from thermodem.io.run_files import (  # noqa: F401 (re-exported)
     TimeseriesWriter,
     _atomic_write_text,
     _cell,
+    only_run_record,
     prepare_output_dir,
     read_timeseries,
 )
@@ -142,6 +143,47 @@ class _StopRequest:
     def __exit__(self, *exc: object) -> None:
         for sig, old in self._old.items():
             signal.signal(sig, old)
+
+
+class _Starting:
+    """SIGINT/SIGTERM while a run is being set up (the simulation built, the checks, the
+    step-0 outputs): there is no state worth a checkpoint yet, so either signal stops at once
+    (KeyboardInterrupt, ``signum`` kept) and :func:`_not_started` records it. Without it
+    Ctrl-C here exited 130 without a word and SIGTERM killed the process, leaving a
+    ``run.log`` and ``case.resolved.yaml`` that made the same command refuse the directory."""
+
+    def __init__(self) -> None:
+        self.signum = 0
+        self._old: dict[int, Any] = {}
+
+    def _handler(self, signum: int, frame: object) -> None:
+        self.signum = signum
+        raise KeyboardInterrupt
+
+    def __enter__(self) -> _Starting:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handler)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+
+def _not_started(output: Path, log: RunLog, status: Status, signum: int) -> RunInterrupted:
+    """The record of a run stopped by a signal before its first step (:class:`_Starting`)."""
+    signum = signum or signal.SIGINT
+    name = signal.Signals(signum).name
+    record_only = only_run_record(output, ignore=LOCK_FILE)
+    again = "the same command" if record_only else "the same command with --overwrite"
+    message = (
+        f"interrupted ({name}) while the run was being set up, before its first step: nothing "
+        f"was computed and no checkpoint written; to start it: {again}"
+    )
+    log.info(message)
+    status.update(status="interrupted", message=message, not_started=True)
+    return RunInterrupted(message, checkpoint=None, exit_code=128 + signum)
 
 
 # ---------------------------------------------------------------------------------- driver
@@ -248,14 +290,19 @@ def _status_numbers(sim: Simulation, run: _Run) -> dict[str, Any]:
     }
 
 
+def _first_outputs(sim: Simulation, run: _Run) -> None:
+    """The outputs of the starting state: a row, a frame and the first checkpoint."""
+    run.timeseries.write(sim)
+    if run.frames:
+        run.frames.write(sim)
+    _checkpoint(sim, run, "checkpoint")
+
+
 def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     """The time loop with outputs on their triggers; failures and interrupts handled here."""
     log = run.log
     if fresh:
-        run.timeseries.write(sim)
-        if run.frames:
-            run.frames.write(sim)
-        _checkpoint(sim, run, "checkpoint")
+        _first_outputs(sim, run)
     run.status.update(status="running", pid=os.getpid(), message="", **_status_numbers(sim, run))
     in_step = False
     stop = None
@@ -464,16 +511,23 @@ def run_case(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         _compile_note(runlog, case)
         run_id = status.data["run_id"]
+        starting = _Starting()
         try:
-            sim = Simulation(case, threads=threads)
-            for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
-                runlog.warn(warning)
-            _header(runlog, sim, threads, output)
-            run = _make_run(
-                sim, output, runlog, status, False, progress, log_interval, callback, every
-            )
-            run.run_id = run_id
-            return _drive(sim, run, fresh=True)
+            with starting:
+                sim = Simulation(case, threads=threads)
+                for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
+                    runlog.warn(warning)
+                _header(runlog, sim, threads, output)
+                run = _make_run(
+                    sim, output, runlog, status, False, progress, log_interval, callback, every
+                )
+                run.run_id = run_id
+                _first_outputs(sim, run)
+            return _drive(sim, run, fresh=False)
+        except RunInterrupted:
+            raise
+        except KeyboardInterrupt:
+            raise _not_started(output, runlog, status, starting.signum) from None
         except ConfigError as exc:
             runlog.file_only(f"error: {exc}")
             status.update(status="failed", message=str(exc), refused_input=True)
@@ -607,14 +661,22 @@ def run_from_checkpoint(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         try:
             runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
-            for warning in check_simulation_time_step(sim):
-                runlog.warn(warning)
-            _header(runlog, sim, threads, output)
-            run = _make_run(
-                sim, output, runlog, status, False, progress, log_interval, callback, every
-            )
-            run.run_id = status.data["run_id"]
-            return _drive(sim, run, fresh=True)
+            starting = _Starting()
+            try:
+                with starting:
+                    for warning in check_simulation_time_step(sim):
+                        runlog.warn(warning)
+                    _header(runlog, sim, threads, output)
+                    run = _make_run(
+                        sim, output, runlog, status, False, progress, log_interval, callback, every
+                    )
+                    run.run_id = status.data["run_id"]
+                    _first_outputs(sim, run)
+            except RunInterrupted:
+                raise
+            except KeyboardInterrupt:
+                raise _not_started(output, runlog, status, starting.signum) from None
+            return _drive(sim, run, fresh=False)
         finally:
             runlog.close()
     finally:

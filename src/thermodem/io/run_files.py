@@ -30,15 +30,23 @@ FAILED_FILE = "failed.h5"
 REFUSED_RUN_FILES = frozenset({"case.resolved.yaml", LOG_FILE, STATUS_FILE})
 
 
+def only_run_record(path: Path, ignore: str = "") -> bool:
+    """``path`` holds nothing but the record files a run writes before its first step (and
+    ``ignore``: the lock of the run that asks)."""
+    return {child.name for child in path.iterdir()} - {ignore} <= REFUSED_RUN_FILES
+
+
 def refused_run_record(path: Path) -> bool:
-    """``path`` holds only the record of a run whose input was refused before its first step
-    (nothing a user made or a run computed): the next run may reuse it without --overwrite,
-    so that after fixing the case the same command works (and an unfixed case is told its
-    error again, not that the directory is not empty)."""
+    """``path`` holds only the record of a run whose input was refused before its first step,
+    or that a signal stopped while it was being set up (nothing a user made or a run
+    computed): the next run may reuse it without --overwrite, so that after fixing the case
+    the same command works (and an unfixed case is told its error again, not that the
+    directory is not empty)."""
     names = {child.name for child in path.iterdir()}
     if not names or not names <= REFUSED_RUN_FILES or STATUS_FILE not in names:
         return False
-    return Status.read(path).get("refused_input") is True
+    status = Status.read(path)
+    return status.get("refused_input") is True or status.get("not_started") is True
 
 
 def prepare_output_dir(path: Path, overwrite: bool) -> None:
