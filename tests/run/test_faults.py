@@ -526,3 +526,62 @@ def test_read_vtu_keeps_the_field_data_of_an_empty_frame(tmp_path: Path) -> None
             np.array_equal(empty.field_data[key], value)
             and empty.field_data[key].dtype == value.dtype
         )
+
+
+# ------------------------------------------------------------- outputs refused during the run
+def test_an_output_refused_mid_run_stops_with_a_message_and_restart_continues(
+    tmp_path: Path, finished: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A disk filling up (or a read-only remount) in the middle of a run ended in an OSError
+    traceback and left status.json saying 'running'; the run directory removed, the same."""
+    import errno
+    import shutil
+
+    from thermodem.engine.runner import TimeseriesWriter
+
+    original = TimeseriesWriter.write
+
+    def full(self: TimeseriesWriter, sim: Simulation) -> None:
+        if sim.step_count == 15:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        original(self, sim)
+
+    monkeypatch.setattr(TimeseriesWriter, "write", full)
+    case = _case_file(tmp_path)
+    out = tmp_path / "out"
+    result = _invoke("run", str(case), "--output", str(out), "--no-progress")
+    assert result.exit_code == 1, result.output
+    assert (
+        f"error: the run directory {out} cannot be written at step 15 (t = 0.00015 s): No "
+        "space left on device; the run stopped" in result.output
+    )
+    ckpt = out / "checkpoints" / "checkpoint_000000010.h5"
+    assert f"last checkpoint on disk: {ckpt}; once the directory can be written again, " in (
+        result.output
+    )
+    assert "Traceback" not in result.output
+    assert json.loads((out / "status.json").read_text())["status"] == "failed"
+    assert not (out / LOCK_FILE).exists()
+    # space again: the restart the message names finishes as an uninterrupted run
+    monkeypatch.setattr(TimeseriesWriter, "write", original)
+    again = _invoke("restart", str(out), "--no-progress")
+    assert again.exit_code == 0, again.output
+    final = "checkpoints/checkpoint_000000020.h5"
+    with h5py.File(out / final) as a, h5py.File(finished / final) as b:
+        for name in ("position", "velocity", "angular_velocity"):
+            assert np.array_equal(a["particles"][name][()], b["particles"][name][()])
+    assert (out / "timeseries.csv").read_bytes() == (finished / "timeseries.csv").read_bytes()
+
+    def removed(self: TimeseriesWriter, sim: Simulation) -> None:
+        if sim.step_count == 15:
+            shutil.rmtree(self.path.parent)
+        original(self, sim)
+
+    monkeypatch.setattr(TimeseriesWriter, "write", removed)
+    gone = tmp_path / "gone"
+    result = _invoke("run", str(case), "--output", str(gone), "--no-progress")
+    assert result.exit_code == 1, result.output
+    assert f"the run directory {gone} cannot be written at step 15" in result.output
+    assert "No such file or directory" in result.output
+    assert f"no checkpoint of this run is left in {gone}: start it again" in result.output
+    assert "Traceback" not in result.output

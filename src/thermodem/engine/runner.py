@@ -292,14 +292,54 @@ def _status_numbers(sim: Simulation, run: _Run) -> dict[str, Any]:
 
 def _first_outputs(sim: Simulation, run: _Run) -> None:
     """The outputs of the starting state: a row, a frame and the first checkpoint."""
-    run.timeseries.write(sim)
-    if run.frames:
-        run.frames.write(sim)
-    _checkpoint(sim, run, "checkpoint")
+    try:
+        run.timeseries.write(sim)
+        if run.frames:
+            run.frames.write(sim)
+        _checkpoint(sim, run, "checkpoint")
+    except OSError as exc:
+        raise _unwritable(sim, run, exc) from None
 
 
 def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     """The time loop with outputs on their triggers; failures and interrupts handled here."""
+    try:
+        return _loop(sim, run, fresh)
+    except OSError as exc:
+        raise _unwritable(sim, run, exc) from None
+
+
+def _unwritable(sim: Simulation, run: _Run, exc: OSError) -> SimulationError:
+    """An output the system refused in the middle of the run (the directory removed, the disk
+    full, a read-only file system): the run stops with the file, the cause, the step and what
+    is left on disk (before, an OSError traceback and status.json saying 'running')."""
+    cause = exc.strerror or str(exc)
+    name = f" ({exc.filename})" if exc.filename else ""
+    where = f"at step {sim.step_count} (t = {sim.time:.6g} s)"
+    last = run.last_checkpoint if run.last_checkpoint and run.last_checkpoint.is_file() else None
+    if last is not None:
+        left = (
+            f"last checkpoint on disk: {last}; once the directory can be written again, "
+            f"continue with: thermodem restart {run.output} (or thermodem run CASE --restart "
+            f"{last} --output NEWDIR)"
+        )
+    else:
+        left = f"no checkpoint of this run is left in {run.output}: start it again"
+    message = (
+        f"the run directory {run.output} cannot be written {where}: {cause}{name}; the run "
+        f"stopped\n{left}"
+    )
+    try:
+        run.log.file_only(f"error: {message}")
+        run.status.update(status="failed", message=message, **_status_numbers(sim, run))
+    except OSError:
+        pass  # (the directory that refused the output may refuse these too)
+    return SimulationError(
+        message, sim.step_count, sim.time, -1, checkpoint=str(last) if last else None
+    )
+
+
+def _loop(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     log = run.log
     if fresh:
         _first_outputs(sim, run)
@@ -394,8 +434,11 @@ def _failed(sim: Simulation, run: _Run, exc: SimulationError) -> SimulationError
     else:
         last_text = "no checkpoint of a good state was written"
     message = f"{exc}\n{last_text}\n{failed_text}"
-    run.log.file_only(f"error: {message}")
-    run.status.update(status="failed", message=str(exc), **_status_numbers(sim, run))
+    try:
+        run.log.file_only(f"error: {message}")
+        run.status.update(status="failed", message=str(exc), **_status_numbers(sim, run))
+    except OSError:
+        pass  # (a directory that refuses them: the message on the console says it all)
     return SimulationError(
         message, exc.step, exc.time, exc.particle, checkpoint=str(last) if last else None
     )
