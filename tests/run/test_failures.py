@@ -272,3 +272,29 @@ def test_a_signal_while_the_run_is_set_up_is_reported_and_the_directory_reused(
     again = _run(case, out)  # no --overwrite needed: nothing was computed
     assert again.exit_code == 0, again.output
     assert json.loads((out / "status.json").read_text())["status"] == "finished"
+
+
+def test_an_overlap_present_at_the_start_is_named_as_the_cause(tmp_path: Path) -> None:
+    """Two particles given overlapping (overlap_check: false) stopped the run at step 1 with
+    'likely cause: contact stiffness (youngs_modulus) too low for the loads'."""
+    case = _case(
+        tmp_path,
+        insertion=[
+            {
+                "kind": "list",
+                "material": "glass",
+                "radius": 0.001,
+                "positions": [[0.005, 0.005, 0.005], [0.005, 0.005, 0.0066]],
+                "overlap_check": False,
+            }
+        ],
+    )
+    out = tmp_path / "out"
+    result = _run(case, out)
+    assert result.exit_code == 1, result.output
+    text = result.output
+    assert "(particle 0 and particle 1) at step 1 (t = 1e-05 s)" in text
+    assert "likely cause: particles inserted overlapping: at the first step" in text
+    assert "raise simulation.max_overlap_ratio (at most 1) above 0.3" in text
+    assert "youngs_modulus" not in text
+    _assert_failure_leaves_state(out, text)

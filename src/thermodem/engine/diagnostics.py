@@ -57,6 +57,19 @@ def overlap_cause(sim: Simulation) -> str:
     too_large, numbers = _time_step_numbers(sim)
     if too_large:
         return f"time step {sim.dt:.4g} s too large for the contact stiffness: it is {numbers}"
+    if sim.step_count == 1:  # the first step from t = 0: the overlap was (nearly) there
+        ratio = sim.max_overlap_ratio
+        remedy = (
+            f"move them apart, or raise simulation.max_overlap_ratio (at most 1) above "
+            f"{ratio:.3g} to let the run push them apart"
+            if ratio < 1.0
+            else "move them apart (simulation.max_overlap_ratio allows at most 1)"
+        )
+        return (
+            "particles inserted overlapping: at the first step the overlap is the one they "
+            "started with (a particle file or list entry with overlap_check: false accepts "
+            f"it); {remedy}; the time step {sim.dt:.4g} s is within the limits ({numbers})"
+        )
     return (
         "contact stiffness (youngs_modulus) too low for the loads or impact speeds; the time "
         f"step {sim.dt:.4g} s is within the limits ({numbers})"
