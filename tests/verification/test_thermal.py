@@ -221,6 +221,36 @@ def test_unstable_thermal_step_is_refused(tmp_path: Path) -> None:
         sim.step()
 
 
+@pytest.mark.parametrize(
+    ("thermal", "remedy"),
+    [
+        ({"frozen_mechanics": True, "time_step": 50.0}, "reduce thermal.time_step, choose an "
+         "implicit thermal.scheme"),
+        ({"substeps": 100}, "reduce thermal.substeps, use substeps: auto"),
+        # ρ c R²/k below the mechanical step itself: substeps cannot help (it told
+        # "use substeps: auto" to a case with substeps: auto)
+        ({"substeps": "auto"}, "the thermal step is already one mechanical step "
+         "(thermal.substeps: auto): reduce simulation.time_step"),
+    ],
+)  # fmt: skip
+def test_a_refused_thermal_step_names_what_can_change(
+    tmp_path: Path, thermal: dict, remedy: str
+) -> None:
+    from thermodem.engine.checks import check_thermal_time_step
+    from thermodem.errors import ConfigError
+
+    path = _write(tmp_path / "two.txt", [(0.0, 0.0, 0.0, R, 300.0), (1.95e-3, 0, 0, R, 400.0)])
+    case = _case(path, thermal)
+    if not thermal.get("frozen_mechanics"):
+        # ρ c R²/k = 2.5e-5 s: above Δt = 1e-5 s, below 100 Δt; 2.5e-6 s: below Δt itself
+        case["materials"]["glass"]["specific_heat"] = 0.01 if thermal["substeps"] == 100 else 0.001
+    sim = Simulation(case_from_dict(case))
+    with pytest.raises(ConfigError, match="thermal time step refused") as refused:
+        check_thermal_time_step(sim)
+    assert remedy in str(refused.value)
+    assert str(refused.value).endswith("or set thermal.stability.allow_unstable: true)")
+
+
 def test_auto_substeps_follow_the_limit(tmp_path: Path) -> None:
     case = _case(_bed(tmp_path), {"substeps": "auto"})
     sim = Simulation(case_from_dict(case))

@@ -228,9 +228,23 @@ def check_thermal_time_step(sim) -> list[str]:  # noqa: ANN001 (avoids an import
             warnings.append(msg + f": above {s.stability.warn_fraction} × the limit")
     if refusals and not s.stability.allow_unstable:
         raise ConfigError(
-            "thermal time step refused:\n"
-            + "\n".join(refusals)
-            + "\n(reduce thermal.substeps or thermal.time_step, use substeps: auto, or set "
-            "thermal.stability.allow_unstable: true)"
+            "thermal time step refused:\n" + "\n".join(refusals) + f"\n({_thermal_remedy(sim)})"
         )
     return refusals + warnings
+
+
+def _thermal_remedy(sim) -> str:  # noqa: ANN001
+    """What a refused explicit thermal step can change: the frozen run's thermal.time_step,
+    thermal.substeps when there are several, else (one mechanical step per thermal step,
+    ``substeps`` 1 or auto) the mechanical time step or the properties themselves."""
+    s = sim.thermal.settings
+    last = "or set thermal.stability.allow_unstable: true"
+    if s.frozen_mechanics:
+        return f"reduce thermal.time_step, choose an implicit thermal.scheme, {last}"
+    if s.substeps != "auto" and s.substeps > 1:
+        return f"reduce thermal.substeps, use substeps: auto, {last}"
+    return (
+        f"the thermal step is already one mechanical step (thermal.substeps: {s.substeps}): "
+        "reduce simulation.time_step, or check density, specific_heat [J/(kg K)] and "
+        f"thermal_conductivity [W/(m K)] for a unit mistake, {last}"
+    )
