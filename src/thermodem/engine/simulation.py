@@ -585,8 +585,11 @@ class Simulation:
             where = self._where()
             _, gid, other, kind = D.worst_overlap(self)
             who = f"particle {gid} and {kind}" + (f" {other}" if other >= 0 else "")
+            ratio = f"{self.max_overlap_ratio:.3g}"
+            if float(ratio) <= limit:  # (three digits would show the limit itself)
+                ratio = f"{self.max_overlap_ratio:.6g}"
             raise SimulationError(
-                f"overlap of {self.max_overlap_ratio:.3g} × the smaller radius ({who}) {where} "
+                f"overlap of {ratio} × the smaller radius ({who}) {where} "
                 f"exceeds simulation.max_overlap_ratio = {limit}; likely cause: "
                 f"{D.overlap_cause(self)}",
                 self.step_count,
