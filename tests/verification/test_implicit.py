@@ -256,3 +256,20 @@ def test_rannacher_start_keeps_second_order_and_damps_the_stiff_start(tmp_path: 
     assert np.diff(_by_gid(plain))[0] == pytest.approx(100.0 * (9.0 / 11.0) ** 2, rel=1e-9)
     # four backward-Euler half steps of 1/(1 + x): monotone decay
     assert np.diff(_by_gid(started))[0] == pytest.approx(100.0 / 11.0**4, rel=1e-9)
+
+
+def test_a_failed_solve_names_the_step_being_computed(tmp_path: Path) -> None:
+    """Conjugate gradients stopped after one iteration fail in the first heat step, from the
+    state at t = 0 to t = 0.3 s: the message names step 1 and its end (as the explicit update
+    and the mechanics do), not step 0, the state it starts from, which the last checkpoint
+    holds."""
+    from thermodem.errors import SimulationError
+
+    thermal = {"time_step": 0.3, "scheme": "backward_euler",
+               "implicit": {"preconditioner": "jacobi", "max_iterations": 1}}  # fmt: skip
+    sim = _sim(_column(tmp_path, 10), thermal, walls=HOT_FLOOR)
+    sim.thermal.implicit.direct_below = 0
+    with pytest.raises(SimulationError, match="conjugate gradients did not reach") as failed:
+        sim.run(steps=5)
+    assert "at step 1 (t = 0.3 s)" in str(failed.value), str(failed.value)
+    assert failed.value.step == 1

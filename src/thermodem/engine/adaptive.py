@@ -104,7 +104,7 @@ class AdaptiveTRBDF2:
                         f"tr_bdf2: the step size fell below {h:.3g} s without meeting "
                         f"thermal.implicit.error_tolerance = {self.tolerance:g} K "
                         f"(t = {now:.6g} s)",
-                        eng.sim.step_count,
+                        eng.sim.step_count + 1,
                         now,
                         -1,
                     )

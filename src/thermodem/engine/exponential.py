@@ -326,7 +326,7 @@ class KrylovExponential:
                             f"thermal.implicit.krylov_tolerance = {self.tolerance:g} K with "
                             f"thermal.implicit.krylov_dimension = {self.dimension} vectors "
                             f"(t = {now:.6g} s)",
-                            eng.sim.step_count,
+                            eng.sim.step_count + 1,
                             now,
                             -1,
                         )
@@ -374,8 +374,8 @@ class KrylovExponential:
             raise SimulationError(
                 f"exponential step: temperature of particle {gid} became "
                 f"{p.temperature[bad[0]]:.6g} K at t = {time + dt:.6g} s",
-                eng.sim.step_count,
-                time,
+                eng.sim.step_count + 1,
+                time + dt,
                 gid,
             )
         for m, q in zip(eng.boundary_columns, boundary, strict=True):

@@ -148,6 +148,7 @@ class ImplicitSolver:
         self._network_cache: tuple | None = None
         self._system: tuple | None = None  # (matrix, fixed, free block)
         self._capacity_matrix: tuple | None = None  # (K, C/Δt, θ K + diag(C/Δt))
+        self.interval: tuple[float, float] | None = None  # (Δt, t) of the step being computed
         self.direct_below = 200
         self.linear = engine.override == 0 and not any(
             t.target == "particles" for t in engine.terms
@@ -296,14 +297,14 @@ class ImplicitSolver:
         self.timings.cg_iterations += count[0]
         if info != 0:
             achieved = float(np.linalg.norm(r - a @ x)) / norm
-            sim = self.engine.sim
+            where, step, at = self.failing_step()
             raise SimulationError(
                 f"implicit heat solve: conjugate gradients did not reach the relative residual "
                 f"thermal.implicit.tolerance = {self.options.tolerance:g} in "
                 f"thermal.implicit.max_iterations = {self.options.max_iterations} iterations "
-                f"(reached {achieved:.3g}) at step {sim.step_count} (t = {sim.time:.6g} s)",
-                sim.step_count,
-                sim.time,
+                f"(reached {achieved:.3g}) {where}",
+                step,
+                at,
                 -1,
             )
         delta[free] = x
@@ -379,6 +380,7 @@ class ImplicitSolver:
         non-smooth start (a wall or a layer switched to a new temperature) excites and that
         Crank–Nicolson alone damps only by (1 - x)/(1 + x) per step.
         """
+        self.interval = (dt, time)
         if self.exponential is not None:
             self.exponential.step(dt, time)
             return
@@ -394,6 +396,16 @@ class ImplicitSolver:
                 self.theta = 0.5
             return
         self._step(dt, time)
+
+    def failing_step(self) -> tuple[str, int, float]:
+        """(text, step, time) of a failure in the heat step being computed (the step after the
+        state it starts from, as the explicit update and the mechanics say); outside a time
+        step (a steady-state solve) the current state's."""
+        interval = self.interval
+        if interval is None:
+            sim = self.engine.sim
+            return f"at step {sim.step_count} (t = {sim.time:.6g} s)", sim.step_count, sim.time
+        return self.engine._failing_step(*interval)
 
     def start_rates(self, time: float) -> Rates:
         """The rates of the current state at ``time`` (those the last step left, if they are
@@ -489,8 +501,8 @@ class ImplicitSolver:
             raise SimulationError(
                 f"implicit heat step: temperature of particle {gid} became "
                 f"{p.temperature[bad[0]]:.6g} K at t = {time:.6g} s",
-                eng.sim.step_count,
-                time - dt,
+                eng.sim.step_count + 1,
+                time,
                 gid,
             )
         return limit, where
@@ -523,7 +535,7 @@ class ImplicitSolver:
             f"not converge to thermal.implicit.picard_tolerance = "
             f"{self.options.picard_tolerance:g} K in thermal.implicit.picard_iterations = "
             f"{self.options.picard_iterations} (last change {change:.3g} K) at t = {time:.6g} s",
-            sim.step_count,
+            sim.step_count + 1,
             time,
             -1,
         )
@@ -540,6 +552,7 @@ class ImplicitSolver:
         eng = self.engine
         p = eng.sim.particles
         time = eng.sim.time if time is None else time
+        self.interval = None  # (not a time step)
         change = math.inf
         for _ in range(self.options.picard_iterations):
             net = self.network(time, extra_fixed)
