@@ -298,3 +298,28 @@ def test_an_overlap_present_at_the_start_is_named_as_the_cause(tmp_path: Path) -
     assert "raise simulation.max_overlap_ratio (at most 1) above 0.3" in text
     assert "youngs_modulus" not in text
     _assert_failure_leaves_state(out, text)
+
+
+def test_a_failure_is_reported_when_the_last_checkpoint_cannot_be_read(tmp_path: Path) -> None:
+    """The last checkpoint damaged or removed by the time the run fails: the report said only
+    that the checkpoint could not be read (an input error, exit 2), hiding the failure."""
+    from thermodem.config.load import load_case
+    from thermodem.engine.runner import run_case
+    from thermodem.errors import SimulationError
+
+    out = tmp_path / "out"
+
+    def damage_then_throw(sim: Simulation) -> None:
+        if sim.step_count == 5:
+            (checkpoint,) = list_checkpoints(out / "checkpoints")
+            Path(checkpoint).write_bytes(b"not a checkpoint")
+            sim.particles.velocity[0] = [1.0e4, 0.0, 0.0]  # leaves the domain in the next step
+
+    with pytest.raises(SimulationError) as failed:
+        run_case(load_case(_case(tmp_path)), out, log=None, progress=False,
+                 callback=damage_then_throw)  # fmt: skip
+    text = str(failed.value)
+    assert re.search(r"particle \d+ left the domain at step 6", text), text
+    assert "the last checkpoint" in text and "cannot be read" in text, text
+    assert (out / "failed.h5").is_file()
+    assert json.loads((out / "status.json").read_text())["status"] == "failed"

@@ -425,14 +425,19 @@ def _failed(sim: Simulation, run: _Run, exc: SimulationError) -> SimulationError
     if last is None:
         existing = list_checkpoints(run.output / CHECKPOINT_DIR)
         last = existing[-1] if existing else None
+    last_text = "no checkpoint of a good state was written"
     if last is not None:
-        good = read_checkpoint(last)
-        last_text = (
-            f"last good state: {last} (step {good.step}, t = {good.time:.6g} s); to continue "
-            f"from it with a changed case: thermodem run CASE --restart {last} --output NEWDIR"
-        )
-    else:
-        last_text = "no checkpoint of a good state was written"
+        try:
+            good = read_checkpoint(last)
+        except Exception as read_error:  # noqa: BLE001 (the run's failure comes first)
+            last_text = f"the last checkpoint {last} cannot be read: {read_error}"
+            last = None
+        else:
+            last_text = (
+                f"last good state: {last} (step {good.step}, t = {good.time:.6g} s); to "
+                f"continue from it with a changed case: thermodem run CASE --restart {last} "
+                "--output NEWDIR"
+            )
     message = f"{exc}\n{last_text}\n{failed_text}"
     try:
         run.log.file_only(f"error: {message}")
