@@ -410,3 +410,49 @@ def test_unsupported_key_refused_by_mpiexec(tmp_path: Path) -> None:
     assert res.returncode == 2
     assert res.stderr.count("MPI does not support it yet") == 1, res.stderr
     assert "output.contacts" in res.stderr
+
+
+DISK_FULL_SCRIPT = """
+import errno
+import sys
+
+from thermodem.cli import app
+from thermodem.io.run_files import TimeseriesWriter
+
+original = TimeseriesWriter.write
+
+
+def full(self, sim):
+    if sim.step_count >= 10:
+        sim.report()  # (the collective part comes first, as in the real writer)
+        raise OSError(errno.ENOSPC, "No space left on device")
+    original(self, sim)
+
+
+TimeseriesWriter.write = full
+app(["run", sys.argv[1], "-o", sys.argv[2], "--no-progress"])
+"""
+
+
+@needs_mpi
+def test_an_output_refused_stops_every_rank_with_one_message(tmp_path: Path) -> None:
+    """A full disk on rank 0 in the middle of a run: every rank stops with rank 0's message
+    (before, rank 0 printed an OSError traceback and aborted the job), status.json says
+    'failed' and the message names the last checkpoint and the mpiexec restart."""
+    import json
+
+    case = bed_case(DATA / "mpi_bed_box.txt", heat=None, end_time=40 * DT)
+    case["output"] = {"timeseries_interval": 5 * DT, "checkpoint_interval": 5 * DT}
+    path = _write_case(tmp_path / "full.yaml", case)
+    script = tmp_path / "full.py"
+    script.write_text(DISK_FULL_SCRIPT)
+    out = tmp_path / "full"
+    cmd = [str(MPIEXEC), "-n", "2", str(BIN / "python"), str(script), str(path), str(out)]
+    res = subprocess.run(cmd, capture_output=True, text=True, env=_env(2), timeout=300)
+    assert res.returncode == 1, res.stderr
+    assert res.stderr.count("error:") == 1, res.stderr
+    assert "Traceback" not in res.stderr, res.stderr
+    assert f"the run directory {out} cannot be written at step 10" in res.stderr, res.stderr
+    assert "No space left on device" in res.stderr
+    assert f"continue with: mpiexec -n 2 thermodem restart {out}" in res.stderr, res.stderr
+    assert json.loads((out / "status.json").read_text())["status"] == "failed"

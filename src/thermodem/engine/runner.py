@@ -309,18 +309,20 @@ def _drive(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
         raise _unwritable(sim, run, exc) from None
 
 
-def _unwritable(sim: Simulation, run: _Run, exc: OSError) -> SimulationError:
+def _unwritable(sim: Simulation, run: _Run, exc: OSError, ranks: int = 1) -> SimulationError:
     """An output the system refused in the middle of the run (the directory removed, the disk
     full, a read-only file system): the run stops with the file, the cause, the step and what
-    is left on disk (before, an OSError traceback and status.json saying 'running')."""
+    is left on disk (before, an OSError traceback and status.json saying 'running'). ``ranks``:
+    the MPI ranks of the run (the commands it suggests start with ``mpiexec -n``)."""
     cause = exc.strerror or str(exc)
     name = f" ({exc.filename})" if exc.filename else ""
     where = f"at step {sim.step_count} (t = {sim.time:.6g} s)"
     last = run.last_checkpoint if run.last_checkpoint and run.last_checkpoint.is_file() else None
+    launch = f"mpiexec -n {ranks} thermodem" if ranks > 1 else "thermodem"
     if last is not None:
         left = (
             f"last checkpoint on disk: {last}; once the directory can be written again, "
-            f"continue with: thermodem restart {run.output} (or thermodem run CASE --restart "
+            f"continue with: {launch} restart {run.output} (or {launch} run CASE --restart "
             f"{last} --output NEWDIR)"
         )
     else:

@@ -12,7 +12,9 @@ Failures: a :class:`SimulationError` is agreed inside the step (every rank raise
 message, :meth:`DistributedSimulation.agree`), the state at the failure is gathered to
 ``failed.h5`` and the message names the last good checkpoint, on every rank. A signal
 (SIGINT, SIGTERM) on any rank stops every rank after the same step with a checkpoint (the
-stop request travels with the step's reduction). Any other exception on one rank cannot be
+stop request travels with the step's reduction). An output the system refuses on rank 0 (a
+full disk, the run directory removed) is agreed after each write: every rank stops with rank
+0's message (engine/runner.py's ``_unwritable``). Any other exception on one rank cannot be
 agreed (the others wait in a collective): the rank prints it and aborts the MPI job
 (``MPI_Abort``), so no rank hangs (``thermodem.cli``).
 """
@@ -64,6 +66,10 @@ def _agreed(comm: Any, error: Exception | None) -> None:
         raise ConfigError(message)
 
 
+class _OutputRefused(Exception):
+    """Rank 0 could not write an output (agreed: every rank raises it with rank 0's text)."""
+
+
 @dataclass
 class _Outputs:
     """What the loop writes besides the simulation; ``run`` is None on the other ranks."""
@@ -83,20 +89,41 @@ class _Outputs:
 
     # every rank calls these at the same steps (they are collective)
     def series(self, sim: DistributedSimulation) -> None:
+        refused = None
         if self.run is not None:
-            self.run.timeseries.write(sim)  # (calls sim.report(), the collective part)
+            try:
+                self.run.timeseries.write(sim)  # (sim.report(), the collective part, first)
+            except OSError as exc:
+                refused = exc
         else:
             sim.report()
+        self._agree_written(sim, refused)
 
     def frame(self, sim: DistributedSimulation) -> None:
         t0 = wallclock.perf_counter()
         view = gathered_view(sim)
         t1 = wallclock.perf_counter()
         self.gather_seconds += t1 - t0
+        refused = None
         if self.run is not None and self.run.frames is not None:
-            self.run.frames.write(view)
+            try:
+                self.run.frames.write(view)
+            except OSError as exc:
+                refused = exc
             self.write_seconds += wallclock.perf_counter() - t1
+        self._agree_written(sim, refused)
         self.frames_written += 1
+
+    def _agree_written(self, sim: DistributedSimulation, refused: OSError | None) -> None:
+        """After rank 0's write: every rank stops with rank 0's message if the system refused
+        it (a full disk, the run directory removed), instead of rank 0 dying alone while the
+        others wait in the next collective."""
+        text = None
+        if refused is not None and self.run is not None:
+            text = R._unwritable(sim, self.run, refused, ranks=sim.size).args[0]
+        text = sim.comm.bcast(text, root=0)
+        if text is not None:
+            raise _OutputRefused(text)
 
     def checkpoint(self, sim: DistributedSimulation, kind: str) -> Path:
         t0 = wallclock.perf_counter()
@@ -104,21 +131,33 @@ class _Outputs:
         t1 = wallclock.perf_counter()
         self.gather_seconds += t1 - t0
         path = Path(".")
+        refused = None
         if self.run is not None:
-            directory = self.run.output / CHECKPOINT_DIR
-            path = write_checkpoint(sim, directory / checkpoint_name(sim.step_count), kind=kind,
-                                    case_yaml=self.run.case_yaml, run_id=self.run.run_id,
-                                    state=state)  # fmt: skip
-            self.run.last_checkpoint = path
-            if self.run.checkpoint_keep is not None:
-                existing = list_checkpoints(directory)
-                for old in existing[: max(0, len(existing) - self.run.checkpoint_keep)]:
-                    if old != path:
-                        old.unlink(missing_ok=True)
+            try:
+                path = self._write_checkpoint(sim, kind, state)
+            except OSError as exc:
+                refused = exc
             self.write_seconds += wallclock.perf_counter() - t1
+        self._agree_written(sim, refused)
         self.checkpoints_written += 1
         path = Path(sim.comm.bcast(str(path) if self.run is not None else None, root=0))
         self.last_checkpoint = path
+        return path
+
+    def _write_checkpoint(self, sim: DistributedSimulation, kind: str, state: dict) -> Path:
+        """Rank 0: the gathered state to the next checkpoint, the oldest beyond
+        ``output.checkpoint_keep`` removed."""
+        run = self.run
+        directory = run.output / CHECKPOINT_DIR
+        path = write_checkpoint(sim, directory / checkpoint_name(sim.step_count), kind=kind,
+                                case_yaml=run.case_yaml, run_id=run.run_id,
+                                state=state)  # fmt: skip
+        run.last_checkpoint = path
+        if run.checkpoint_keep is not None:
+            existing = list_checkpoints(directory)
+            for old in existing[: max(0, len(existing) - run.checkpoint_keep)]:
+                if old != path:
+                    old.unlink(missing_ok=True)
         return path
 
 
@@ -189,6 +228,8 @@ def _drive(sim: DistributedSimulation, out: _Outputs, fresh: bool) -> Distribute
                     raise KeyboardInterrupt
                 if out.callback is not None and k % out.every == 0:
                     out.callback(sim)
+    except _OutputRefused as exc:
+        raise SimulationError(str(exc), sim.step_count, sim.time, -1) from None
     except SimulationError as exc:
         raise _failed(sim, out, exc) from None
     except KeyboardInterrupt:
