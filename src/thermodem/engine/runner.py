@@ -116,14 +116,34 @@ __all__ = [
 ]
 
 
-class _StopRequest:
+class _SignalHandlers:
+    """SIGINT and SIGTERM handled by ``_handler`` inside the ``with`` block (main thread)."""
+
+    def __init__(self) -> None:
+        self.signum = 0
+        self._old: dict[int, Any] = {}
+
+    def _handler(self, signum: int, frame: object) -> None:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def __enter__(self) -> _SignalHandlers:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handler)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+
+class _StopRequest(_SignalHandlers):
     """SIGINT/SIGTERM handler: the first signal asks the loop to stop after the current step,
     a second one aborts at once (KeyboardInterrupt)."""
 
     def __init__(self, log: RunLog) -> None:
+        super().__init__()
         self.log = log
-        self.signum = 0
-        self._old: dict[int, Any] = {}
 
     def _handler(self, signum: int, frame: object) -> None:
         if self.signum:
@@ -134,41 +154,17 @@ class _StopRequest:
             "checkpoint (send it again to abort without one)"
         )
 
-    def __enter__(self) -> _StopRequest:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._old[sig] = signal.signal(sig, self._handler)
-        return self
 
-    def __exit__(self, *exc: object) -> None:
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
-
-
-class _Starting:
+class _Starting(_SignalHandlers):
     """SIGINT/SIGTERM while a run is being set up (the simulation built, the checks, the
     step-0 outputs): there is no state worth a checkpoint yet, so either signal stops at once
     (KeyboardInterrupt, ``signum`` kept) and :func:`_not_started` records it. Without it
     Ctrl-C here exited 130 without a word and SIGTERM killed the process, leaving a
     ``run.log`` and ``case.resolved.yaml`` that made the same command refuse the directory."""
 
-    def __init__(self) -> None:
-        self.signum = 0
-        self._old: dict[int, Any] = {}
-
     def _handler(self, signum: int, frame: object) -> None:
         self.signum = signum
         raise KeyboardInterrupt
-
-    def __enter__(self) -> _Starting:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._old[sig] = signal.signal(sig, self._handler)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
 
 
 def _not_started(output: Path, log: RunLog, status: Status, signum: int) -> RunInterrupted:
@@ -259,7 +255,9 @@ def _make_run(
     )
 
 
-def _checkpoint(sim: Simulation, run: _Run, kind: str) -> Path:
+def _checkpoint(sim: Simulation, run: _Run, kind: str, state: dict | None = None) -> Path:
+    """The next checkpoint of the run, the oldest beyond ``output.checkpoint_keep`` removed
+    (``state``: the state to write, e.g. the MPI ranks' gathered one; default ``sim``'s)."""
     directory = run.output / CHECKPOINT_DIR
     path = write_checkpoint(
         sim,
@@ -267,6 +265,7 @@ def _checkpoint(sim: Simulation, run: _Run, kind: str) -> Path:
         kind=kind,
         case_yaml=run.case_yaml,
         run_id=run.run_id,
+        state=state,
     )
     run.last_checkpoint = path
     if run.checkpoint_keep is not None:

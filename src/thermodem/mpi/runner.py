@@ -43,7 +43,6 @@ from thermodem.engine.validation import (
 from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
 from thermodem.io.checkpoint import (
     Checkpoint,
-    checkpoint_name,
     list_checkpoints,
     read_checkpoint,
     write_checkpoint,
@@ -134,7 +133,7 @@ class _Outputs:
         refused = None
         if self.run is not None:
             try:
-                path = self._write_checkpoint(sim, kind, state)
+                path = R._checkpoint(sim, self.run, kind, state)
             except OSError as exc:
                 refused = exc
             self.write_seconds += wallclock.perf_counter() - t1
@@ -142,22 +141,6 @@ class _Outputs:
         self.checkpoints_written += 1
         path = Path(sim.comm.bcast(str(path) if self.run is not None else None, root=0))
         self.last_checkpoint = path
-        return path
-
-    def _write_checkpoint(self, sim: DistributedSimulation, kind: str, state: dict) -> Path:
-        """Rank 0: the gathered state to the next checkpoint, the oldest beyond
-        ``output.checkpoint_keep`` removed."""
-        run = self.run
-        directory = run.output / CHECKPOINT_DIR
-        path = write_checkpoint(sim, directory / checkpoint_name(sim.step_count), kind=kind,
-                                case_yaml=run.case_yaml, run_id=run.run_id,
-                                state=state)  # fmt: skip
-        run.last_checkpoint = path
-        if run.checkpoint_keep is not None:
-            existing = list_checkpoints(directory)
-            for old in existing[: max(0, len(existing) - run.checkpoint_keep)]:
-                if old != path:
-                    old.unlink(missing_ok=True)
         return path
 
 
