@@ -31,10 +31,7 @@ def suggest(name: str, choices: list[str]) -> str | None:
     close = difflib.get_close_matches(name.casefold(), list(folded), n=1, cutoff=0.6)
     if close:
         return folded[close[0]]
-    close = difflib.get_close_matches(str(name), choices, n=1, cutoff=0.6)
-    if close:
-        return close[0]
-    starts = [c for c in choices if c.startswith(str(name)) or str(name).startswith(c)]
+    starts = [c for c in choices if c.startswith(name) or name.startswith(c)]
     return starts[0] if len(starts) == 1 else None
 
 

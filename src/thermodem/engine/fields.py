@@ -306,6 +306,12 @@ class FieldProvider:
             c[fk.F_PRANDTL] = pr
             c[fk.F_PRANDTL_CBRT] = pr ** (1.0 / 3.0)
 
+    def grid_values(self, name: str) -> np.ndarray | None:
+        """The values of the fluid field ``name`` ('temperature', 'velocity') as read from its
+        grid file, or None when it is not a grid (or no selected model reads it)."""
+        source = self._sources.get(name)
+        return source[2] if source is not None and source[0] == "grid" else None
+
     def _constant_columns(self) -> dict[int, float]:
         """Columns that are the same for every particle at every step."""
         out = dict(self._constant_properties)

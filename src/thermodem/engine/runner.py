@@ -117,14 +117,14 @@ __all__ = [
 
 
 class _SignalHandlers:
-    """SIGINT and SIGTERM handled by ``_handler`` inside the ``with`` block (main thread)."""
+    """SIGINT and SIGTERM handled inside the ``with`` block (main thread) by the subclass's
+    ``_handler(signum, frame)``."""
+
+    _handler: Callable[[int, object], None]
 
     def __init__(self) -> None:
         self.signum = 0
         self._old: dict[int, Any] = {}
-
-    def _handler(self, signum: int, frame: object) -> None:  # pragma: no cover - overridden
-        raise NotImplementedError
 
     def __enter__(self) -> _SignalHandlers:
         if threading.current_thread() is threading.main_thread():

@@ -442,7 +442,7 @@ def end_time_text(case: Case) -> str:
     run --steps 20`` 'the end of this run, t = 0.0001 s (--steps 20; simulation.end_time =
     0.25 s)': the shortened end is the option's, not the case's key."""
     end = case.simulation.end_time
-    shortened = getattr(case, "_shortened", None)
+    shortened = case._shortened
     if shortened is None:
         return f"simulation.end_time = {end:g} s"
     option, own = shortened
@@ -459,7 +459,7 @@ def check_step_count(sim: Simulation) -> None:
     key = "thermal.time_step" if frozen else "simulation.time_step"
     dt = th.settings.time_step if frozen else sim.dt
     end = sim.case.simulation.end_time
-    shortened = getattr(sim.case, "_shortened", None)
+    shortened = sim.case._shortened
     if shortened is not None:  # (--end-time: the case's own end time is not at fault)
         raise ConfigError(
             f"{shortened[0]}: the end of this run, t = {end:g} s, gives no step of {key} = "
@@ -634,10 +634,9 @@ def _grid_minimum(sim: Simulation, source: Any) -> tuple[str, float | None]:
     """(key, smallest value) of the fluid temperature grid file as the run reads it (None when
     no selected model reads the fluid temperature: the file is not read)."""
     provider = getattr(sim.thermal, "field_provider", None)
-    read = getattr(provider, "_sources", {}).get("temperature")
-    if read is None or read[0] != "grid":
+    values = provider.grid_values("temperature") if provider is not None else None
+    if values is None:
         return "thermal.fluid.temperature", None
-    values = read[2]
     k = np.unravel_index(int(np.argmin(values)), values.shape)
     where = tuple(int(v) for v in k[:3])
     return (
@@ -759,7 +758,7 @@ def step_interval_warnings(sim: Simulation) -> list[str]:
     key = "thermal.time_step" if frozen else "simulation.time_step"
     dt = th.settings.time_step if frozen else sim.dt
     steps = total_steps(sim)
-    shortened = getattr(case, "_shortened", None)
+    shortened = case._shortened
     target = "simulation.end_time" if shortened is None else f"the end of this run ({shortened[0]})"
     out = []
     for name in ("interval", "timeseries_interval", "checkpoint_interval"):

@@ -42,8 +42,7 @@ def refused_run_record(path: Path) -> bool:
     computed): the next run may reuse it without --overwrite, so that after fixing the case
     the same command works (and an unfixed case is told its error again, not that the
     directory is not empty)."""
-    names = {child.name for child in path.iterdir()}
-    if not names or not names <= REFUSED_RUN_FILES or STATUS_FILE not in names:
+    if not (path / STATUS_FILE).is_file() or not only_run_record(path):
         return False
     status = Status.read(path)
     return status.get("refused_input") is True or status.get("not_started") is True
