@@ -347,7 +347,7 @@ class Case(StrictModel):
     )
     #: set by ``thermodem run --steps N`` / ``--end-time T``: (the option as given, the case
     #: file's own ``simulation.end_time``), so that messages about the end of the run name
-    #: the option, not the case's key (:func:`thermodem.engine.validation.end_time_text`)
+    #: the option, not the case's key (:func:`thermodem.engine.case_warnings.end_time_text`)
     _shortened: tuple[str, float] | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")

@@ -1,0 +1,297 @@
+"""Warnings of a case that runs but may not do what it says, told before its first step by
+``thermodem validate`` and ``thermodem run`` (:func:`thermodem.engine.validation.pre_run_checks`):
+temperatures that look like °C, output intervals in steps or below the time step, pours that
+pour nothing, a skin of many diameters, a wall closing a periodic axis, ``thermal: null``.
+Each names the key, the value and what was probably meant; none refuses the case."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermodem.engine.start_checks import largest_radius
+
+if TYPE_CHECKING:
+    from thermodem.config.schema import Case
+    from thermodem.engine.simulation import Simulation
+
+
+def end_time_text(case: Case) -> str:
+    """The end of the run for a message: 'simulation.end_time = 0.25 s', or after ``thermodem
+    run --steps 20`` 'the end of this run, t = 0.0001 s (--steps 20; simulation.end_time =
+    0.25 s)': the shortened end is the option's, not the case's key."""
+    end = case.simulation.end_time
+    shortened = case._shortened
+    if shortened is None:
+        return f"simulation.end_time = {end:g} s"
+    option, own = shortened
+    return f"the end of this run, t = {end:g} s ({option}; simulation.end_time = {own:g} s)"
+
+
+def insertion_warnings(case: Case) -> list[str]:
+    """Pour entries that pour nothing before ``simulation.end_time``."""
+    end = case.simulation.end_time
+    dt = case.simulation.time_step
+    out = []
+    for k, e in enumerate(case.insertion):
+        if e.kind != "pour":
+            continue
+        first = e.start_time + e.interval
+        if e.end_time is not None:
+            first = min(first, e.end_time)
+        stop = end if e.end_time is None else min(e.end_time, end)
+        if first - 0.5 * dt > end:
+            out.append(
+                f"insertion.{k}: its first batch is due at t = {first:g} s (start_time "
+                f"{e.start_time:g} s + interval {e.interval:g} s), after "
+                f"{end_time_text(case)}: nothing is poured in this run"
+            )
+        elif e.rate * max(0.0, stop - e.start_time) < 1.0:
+            out.append(
+                f"insertion.{k}: rate {e.rate:g}/s from t = {e.start_time:g} s to {stop:g} s "
+                "asks for less than one particle: nothing is poured in this run"
+            )
+    return out
+
+
+#: A Verlet skin above this many largest particle diameters is warned about.
+SKIN_WARN_DIAMETERS = 2.0
+
+
+def skin_warnings(sim: Simulation) -> list[str]:
+    """A neighbour skin (``neighbors.skin``, ``thermal.range_skin``) of more than
+    :data:`SKIN_WARN_DIAMETERS` largest particle diameters: every particle then lists every
+    other within that distance (the number of listed pairs grows as the cube of the skin),
+    which costs time and memory at every step and buys nothing (a skin only saves list
+    rebuilds). Typically a length typed in mm or a domain size given as the skin."""
+    diameter = 2.0 * largest_radius(sim)
+    if diameter <= 0.0:
+        return []
+    case = sim.case
+    skins = [("neighbors.skin", case.neighbors.skin)]
+    if case.thermal is not None:
+        skins.append(("thermal.range_skin", case.thermal.range_skin))
+    out = []
+    for key, skin in skins:
+        if skin is not None and skin > SKIN_WARN_DIAMETERS * diameter:
+            out.append(
+                f"{key} = {skin:g} m is {skin / diameter:.3g} times the largest particle "
+                f"diameter ({diameter:g} m): every particle lists all the others within "
+                f"{skin:g} m (the listed pairs grow as the cube of the skin), which slows every "
+                "step and takes memory for nothing; a skin of 0.1-0.5 diameters is usual (the "
+                "default, left out, is 0.2 times the largest radius). A length in mm?"
+            )
+    return out
+
+
+def periodic_wall_warnings(case: Case) -> list[str]:
+    """A periodic axis that a wall closes: a plane whose normal has a component along it, a box
+    (its faces close every axis). Particles are wrapped across the periodic boundary, so the
+    particles on either side of such a wall interact through the domain's faces: the wall does
+    not separate them. A warning each, naming ``domain.periodic`` and the wall."""
+    periodic = case.domain.periodic
+    axes = "xy" if case.simulation.planar else "xyz"
+    shown = "[" + ", ".join("true" if p else "false" for p in periodic[: len(axes)]) + "]"
+    out = []
+    for k, wall in enumerate(case.walls):
+        label = wall.name or f"{wall.kind}{k}"
+        if wall.kind == "plane":
+            n = np.asarray(wall.normal, float)
+            n = n / np.linalg.norm(n)
+            closed = [a for a in range(len(axes)) if periodic[a] and abs(n[a]) > 1e-9]
+            what = f"a plane with normal {[float(c) for c in wall.normal]}"
+        elif wall.kind == "box":
+            closed = [a for a in range(len(axes)) if periodic[a]]
+            what = "a box (its faces close every axis)"
+        else:
+            continue
+        if not closed:
+            continue
+        names = " and ".join(axes[a] for a in closed)
+        out.append(
+            f"domain.periodic: {shown} makes {names} periodic, but walls.{k} ({label}) is {what} "
+            f"that closes {names}: particles are wrapped across the periodic boundary, so those "
+            "on either side of the wall interact through the domain's faces, past the wall; a "
+            f"wall bounds an axis that is not periodic: set {names} false in domain.periodic, "
+            "or remove the wall"
+        )
+    return out
+
+
+def section_warnings(case: Case) -> list[str]:
+    """``thermal: null`` (an empty ``thermal:`` key, its settings commented out or indented
+    wrongly) is the absent section, so the case runs mechanics only: said, since it reads
+    like the heat with every default (``thermal: {}``)."""
+    if case.thermal is not None or "thermal" not in case.model_fields_set:
+        return []
+    return [
+        "thermal: null (an empty 'thermal:' key) means no thermal section: this case runs "
+        "mechanics only, without heat; write thermal: {} for the heat with every default, or "
+        "remove the key"
+    ]
+
+
+#: A temperature below this [K] is told as a likely value in °C: colder than any natural
+#: temperature on Earth (the record is 184 K), while the Celsius values of a case (room
+#: temperature to a few hundred °C) all lie below it. Cryogenic cases are legitimate: a
+#: warning, never an error.
+CELSIUS_SUSPECT_BELOW = 200.0
+
+
+def _expression_minimum(expression: str, names: tuple[str, ...], grid: tuple) -> float:
+    """The smallest value of a temperature expression on ``grid`` (NaN if it fails)."""
+    from thermodem.engine.expressions import compile_expression
+
+    try:
+        values = np.asarray(compile_expression(expression, names)(*grid), dtype=np.float64)
+        return float(np.min(values))
+    except (ValueError, ArithmeticError, TypeError):
+        return math.nan
+
+
+def _grid_minimum(sim: Simulation, source: Any) -> tuple[str, float | None]:
+    """(key, smallest value) of the fluid temperature grid file as the run reads it (None when
+    no selected model reads the fluid temperature: the file is not read)."""
+    provider = getattr(sim.thermal, "field_provider", None)
+    values = provider.grid_values("temperature") if provider is not None else None
+    if values is None:
+        return "thermal.fluid.temperature", None
+    k = np.unravel_index(int(np.argmin(values)), values.shape)
+    where = tuple(int(v) for v in k[:3])
+    return (
+        f"thermal.fluid.temperature (grid file {source.file}, field {source.field!r}: its "
+        f"smallest value, at grid index {where})",
+        float(values[k]),
+    )
+
+
+def temperature_warnings(sim: Simulation) -> list[str]:
+    """Every temperature key of the case (and the particles' start temperatures, which files
+    give) below :data:`CELSIUS_SUSPECT_BELOW`: a warning each naming the key and the value
+    (``initial_temperature: 25`` meant in °C is 25 K). Expressions and tables: their
+    smallest value (an initial temperature on a grid spanning the domain, a wall temperature
+    from t = 0 to the end time)."""
+    case = sim.case
+    th = case.thermal
+    found: list[tuple[str, float]] = []
+
+    def add(key: str, value: Any) -> None:
+        if value is not None and math.isfinite(float(value)):
+            found.append((key, float(value)))
+
+    add("simulation.initial_temperature", case.simulation.initial_temperature)
+    for k, entry in enumerate(case.insertion):
+        add(f"insertion.{k}.temperature", getattr(entry, "temperature", None))
+        listed = getattr(entry, "temperatures", None)
+        if listed:
+            i = int(np.argmin(listed))
+            add(f"insertion.{k}.temperatures.{i}", listed[i])
+    times = np.linspace(0.0, case.simulation.end_time, 2001)
+    for k, wall in enumerate(case.walls):
+        value = wall.thermal.temperature if wall.thermal.kind == "fixed" else None
+        key = f"walls.{k}.thermal.temperature"
+        if isinstance(value, list):
+            i = int(np.argmin([row[1] for row in value]))
+            add(f"{key} (row {i})", value[i][1])
+        elif isinstance(value, str):
+            add(f"{key} (its smallest value)", _expression_minimum(value, ("t",), (times,)))
+        else:
+            add(key, value)
+    if th is not None:
+        rule = th.initial_temperature
+        key = "thermal.initial_temperature"
+        if rule is not None and rule.kind == "uniform":
+            add(f"{key}.value", rule.value)
+        elif rule is not None and rule.kind == "per_material":
+            for name, value in rule.values.items():
+                add(f"{key}.values.{name}", value)
+            add(f"{key}.default", rule.default)
+        elif rule is not None and rule.kind == "regions":
+            for i, (_, value) in enumerate(rule.regions):
+                add(f"{key}.regions.{i}", value)
+            add(f"{key}.default", rule.default)
+        elif rule is not None:
+            axes = [
+                np.linspace(lo, hi, 21)
+                for lo, hi in zip(case.domain.lower, case.domain.upper, strict=True)
+            ]
+            grid = tuple(np.meshgrid(*axes, indexing="ij"))
+            low = _expression_minimum(rule.expression, ("x", "y", "z"), grid)
+            add(f"{key}.expression (its smallest value in the domain)", low)
+        for k, entry in enumerate(th.fixed_temperature):
+            add(f"thermal.fixed_temperature.{k}.temperature", entry.temperature)
+        if "temperature" in th.gas.model_fields_set:
+            add("thermal.gas.temperature", th.gas.temperature)
+        fluid = th.fluid.temperature if th.fluid is not None else None
+        if fluid is not None and fluid.kind == "uniform":
+            add("thermal.fluid.temperature", fluid.value[0])
+        elif fluid is not None and fluid.kind == "table":
+            i = int(np.argmin([row[1] for row in fluid.table]))
+            add(f"thermal.fluid.temperature (row {i})", fluid.table[i][1])
+        elif fluid is not None and fluid.kind == "grid":
+            add(*_grid_minimum(sim, fluid))
+        for family in ("radiation",):
+            params = getattr(th, family).params
+            add(f"thermal.{family}.environment_temperature",
+                getattr(params, "environment_temperature", None))  # fmt: skip
+    bad = [(key, value) for key, value in found if value < CELSIUS_SUSPECT_BELOW]
+    p = sim.particles
+    n = sim.owned_count
+    if n and not any(k.startswith(("insertion", "thermal.initial", "simulation")) for k, _ in bad):
+        i = int(np.argmin(p.temperature[:n]))
+        if p.temperature[i] < CELSIUS_SUSPECT_BELOW:  # (a particle file's column)
+            bad.append((f"particle {int(p.global_id[i])} (its start temperature)",
+                        float(p.temperature[i])))  # fmt: skip
+    return [
+        f"{key}: {value:g} K is below {CELSIUS_SUSPECT_BELOW:g} K, colder than any natural "
+        "temperature on Earth (the record is 184 K): temperatures are in kelvin, is it a value "
+        f"in °C? ({value:g} °C = {value + 273.15:g} K); a cryogenic case can ignore this"
+        for key, value in bad
+    ]
+
+
+def output_interval_warnings(case: Case) -> list[str]:
+    """Output intervals longer than ``simulation.end_time``: frames (rows, checkpoints) only at
+    the start and the end. A value in steps (LIGGGHTS' dump every N steps) is the usual cause.
+    """
+    end = case.simulation.end_time
+    out = []
+    for key in ("interval", "timeseries_interval", "checkpoint_interval"):
+        value = getattr(case.output, key)
+        if value is not None and value > end:
+            out.append(
+                f"output.{key} = {value:g} s is longer than simulation.end_time = {end:g} s: "
+                "written at the start and the end only (intervals are simulated seconds, not "
+                "steps)"
+            )
+    return out
+
+
+def step_interval_warnings(sim: Simulation) -> list[str]:
+    """Output intervals shorter than the time step: written at every step (a frame per step
+    is 50 000 VTU files for 50 000 steps), said before the run; an interval meant in steps or
+    in another unit (ms) is the usual cause."""
+    case = sim.case
+    th = sim.thermal
+    frozen = th is not None and th.settings.frozen_mechanics
+    key = "thermal.time_step" if frozen else "simulation.time_step"
+    dt = th.settings.time_step if frozen else sim.dt
+    from thermodem.engine.validation import total_steps  # (validation imports this module)
+
+    steps = total_steps(sim)
+    shortened = case._shortened
+    target = "simulation.end_time" if shortened is None else f"the end of this run ({shortened[0]})"
+    out = []
+    for name in ("interval", "timeseries_interval", "checkpoint_interval"):
+        value = getattr(case.output, name)
+        if value is None or value >= dt * (1.0 - 1e-9):
+            continue
+        what = "a frame" if name == "interval" else "a row" if name[0] == "t" else "a checkpoint"
+        out.append(
+            f"output.{name} = {value:g} s is shorter than {key} = {dt:g} s: {what} is written at "
+            f"every step ({steps} steps to {target}); intervals are simulated "
+            f"seconds: give at least {dt:g} s"
+        )
+    return out
