@@ -43,7 +43,6 @@ import os
 import signal
 import socket
 import sys
-import threading
 import time as wallclock
 import uuid
 import warnings
@@ -70,6 +69,7 @@ from thermodem.engine.run_checks import (  # noqa: F401 (LOCK_FILE, process_star
     timeseries_repair,
 )
 from thermodem.engine.run_info import output_summary  # noqa: F401 (re-exported)
+from thermodem.engine.run_signals import Starting, StopRequest, not_started
 from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
     check_completeness,
@@ -114,72 +114,6 @@ __all__ = [
     "run_case",
     "run_from_checkpoint",
 ]
-
-
-class _SignalHandlers:
-    """SIGINT and SIGTERM handled inside the ``with`` block (main thread) by the subclass's
-    ``_handler(signum, frame)``."""
-
-    _handler: Callable[[int, object], None]
-
-    def __init__(self) -> None:
-        self.signum = 0
-        self._old: dict[int, Any] = {}
-
-    def __enter__(self) -> _SignalHandlers:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._old[sig] = signal.signal(sig, self._handler)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
-
-
-class _StopRequest(_SignalHandlers):
-    """SIGINT/SIGTERM handler: the first signal asks the loop to stop after the current step,
-    a second one aborts at once (KeyboardInterrupt)."""
-
-    def __init__(self, log: RunLog) -> None:
-        super().__init__()
-        self.log = log
-
-    def _handler(self, signum: int, frame: object) -> None:
-        if self.signum:
-            raise KeyboardInterrupt
-        self.signum = signum
-        self.log.info(
-            f"{signal.Signals(signum).name} received: finishing the step and writing a "
-            "checkpoint (send it again to abort without one)"
-        )
-
-
-class _Starting(_SignalHandlers):
-    """SIGINT/SIGTERM while a run is being set up (the simulation built, the checks, the
-    step-0 outputs): there is no state worth a checkpoint yet, so either signal stops at once
-    (KeyboardInterrupt, ``signum`` kept) and :func:`_not_started` records it. Without it
-    Ctrl-C here exited 130 without a word and SIGTERM killed the process, leaving a
-    ``run.log`` and ``case.resolved.yaml`` that made the same command refuse the directory."""
-
-    def _handler(self, signum: int, frame: object) -> None:
-        self.signum = signum
-        raise KeyboardInterrupt
-
-
-def _not_started(output: Path, log: RunLog, status: Status, signum: int) -> RunInterrupted:
-    """The record of a run stopped by a signal before its first step (:class:`_Starting`)."""
-    signum = signum or signal.SIGINT
-    name = signal.Signals(signum).name
-    record_only = only_run_record(output, ignore=LOCK_FILE)
-    again = "the same command" if record_only else "the same command with --overwrite"
-    message = (
-        f"interrupted ({name}) while the run was being set up, before its first step: nothing "
-        f"was computed and no checkpoint written; to start it: {again}"
-    )
-    log.info(message)
-    status.update(status="interrupted", message=message, not_started=True)
-    return RunInterrupted(message, checkpoint=None, exit_code=128 + signum)
 
 
 # ---------------------------------------------------------------------------------- driver
@@ -351,7 +285,7 @@ def _loop(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     started = wallclock.perf_counter()
     start_step = sim.step_count
     try:
-        with _StopRequest(log) as stop, progress, warnings.catch_warnings():
+        with StopRequest(log) as stop, progress, warnings.catch_warnings():
             warnings.simplefilter("always", RuntimeWarning)
             warnings.showwarning = lambda msg, cat, *a, **k: (
                 log.info if issubclass(cat, RunNotice) else log.warn
@@ -560,7 +494,7 @@ def run_case(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         _compile_note(runlog, case)
         run_id = status.data["run_id"]
-        starting = _Starting()
+        starting = Starting()
         try:
             with starting:
                 sim = Simulation(case, threads=threads)
@@ -576,7 +510,7 @@ def run_case(
         except RunInterrupted:
             raise
         except KeyboardInterrupt:
-            raise _not_started(output, runlog, status, starting.signum) from None
+            raise not_started(output, runlog, status, starting.signum) from None
         except ConfigError as exc:
             runlog.file_only(f"error: {exc}")
             status.update(status="failed", message=str(exc), refused_input=True)
@@ -710,7 +644,7 @@ def run_from_checkpoint(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         try:
             runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
-            starting = _Starting()
+            starting = Starting()
             try:
                 with starting:
                     for warning in check_simulation_time_step(sim):
@@ -724,7 +658,7 @@ def run_from_checkpoint(
             except RunInterrupted:
                 raise
             except KeyboardInterrupt:
-                raise _not_started(output, runlog, status, starting.signum) from None
+                raise not_started(output, runlog, status, starting.signum) from None
             return _drive(sim, run, fresh=False)
         finally:
             runlog.close()

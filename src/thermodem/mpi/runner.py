@@ -34,6 +34,7 @@ from thermodem.config.schema import Case
 from thermodem.engine import runner as R
 from thermodem.engine.checks import check_simulation_time_step
 from thermodem.engine.progress import Progress
+from thermodem.engine.run_signals import StopRequest
 from thermodem.engine.validation import (
     check_completeness,
     format_duration,
@@ -183,7 +184,7 @@ def _drive(sim: DistributedSimulation, out: _Outputs, fresh: bool) -> Distribute
     started = wallclock.perf_counter()
     start_step = sim.step_count
     in_step = False
-    stop = R._StopRequest(log if root else _Silent())
+    stop = StopRequest(log if root else _Silent())
     try:
         with stop, progress or _NoContext(), warnings.catch_warnings():
             warnings.simplefilter("always", RuntimeWarning)
