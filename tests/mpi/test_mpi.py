@@ -243,7 +243,7 @@ def test_settled_bed_matches_serial_on_2_ranks(runs: dict[str, Path]) -> None:
     _assert_same_state(_final(serial), _final(parallel))
     _assert_same_ledgers(serial, parallel)
     # one checkpoint and one frame per output time, the frames with every particle once
-    from thermodem.io.vtk import read_vtu
+    from thermodem.io.vtk_read import read_vtu
 
     names = sorted(p.name for p in (parallel / "checkpoints").iterdir())
     assert names == [f"checkpoint_{k:09d}.h5" for k in (0, 500, 1000)]

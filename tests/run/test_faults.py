@@ -29,7 +29,8 @@ from thermodem.config.load import case_from_dict
 from thermodem.engine.runner import LOCK_FILE, process_start, read_timeseries, run_case
 from thermodem.engine.simulation import Simulation
 from thermodem.io.checkpoint import list_checkpoints, write_checkpoint
-from thermodem.io.vtk import read_vtu, write_particles_vtu, write_walls_vtu
+from thermodem.io.vtk import write_particles_vtu, write_walls_vtu
+from thermodem.io.vtk_read import read_vtu
 
 BOX = {
     "simulation": {"time_step": 1.0e-5, "end_time": 0.0002, "seed": 2},

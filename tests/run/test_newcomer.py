@@ -300,7 +300,7 @@ def test_thermal_example_heats_in_its_first_steps(tmp_path: Path) -> None:
     walls = sorted((out / "vtk").glob("walls_*.vtu"))
     import meshio
 
-    from thermodem.io.vtk import read_name_table
+    from thermodem.io.vtk_read import read_name_table
 
     mesh = meshio.read(walls[-1])
     names = read_name_table(mesh.field_data, "wall_id")

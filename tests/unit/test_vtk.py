@@ -437,7 +437,7 @@ NAMES = ["glass", "steel beads", 'a = b <&> "q"', "Kupfer-Ø"]  # spaces, '=', X
 
 
 def test_particle_material_names_in_field_data(tmp_path):
-    from thermodem.io.vtk import read_name_table
+    from thermodem.io.vtk_read import read_name_table
 
     n = 6
     ids = np.array([0, 1, 2, 3, 1, 0], dtype=np.int32)
@@ -460,7 +460,7 @@ def test_particle_material_names_in_field_data(tmp_path):
 
 
 def test_wall_names_and_temperature_in_the_walls_vtu(tmp_path):
-    from thermodem.io.vtk import read_name_table
+    from thermodem.io.vtk_read import read_name_table
 
     rows = np.stack([plane_row([0, 0, 0], [0, 0, 1]), plane_row([0, 0, 1], [0, 0, -1])])
     fields = {"temperature": np.array([600.0, np.nan]), "material_id": np.array([1, 0])}
@@ -484,7 +484,8 @@ def test_simulation_frames_carry_names_and_wall_temperatures(tmp_path):
     (from the case), NaN for adiabatic walls."""
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
-    from thermodem.io.vtk import read_name_table, write_particle_frame, write_wall_frame
+    from thermodem.io.vtk import write_particle_frame, write_wall_frame
+    from thermodem.io.vtk_read import read_name_table
 
     props = {"density": 2500, "youngs_modulus": 1e7, "poisson_ratio": 0.3,
              "thermal_conductivity": 1.0, "specific_heat": 800.0}  # fmt: skip

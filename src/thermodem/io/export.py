@@ -68,7 +68,8 @@ class ParticleTable:
 def from_frame(directory: Path, frame: int) -> ParticleTable:
     """The particles of frame ``frame`` of ``directory/particles.pvd``."""
 
-    from thermodem.io.vtk import PVDWriter, read_name_table, read_vtu
+    from thermodem.io.vtk import PVDWriter
+    from thermodem.io.vtk_read import read_name_table, read_vtu
 
     pvd = directory / "particles.pvd"
     if not pvd.is_file():
