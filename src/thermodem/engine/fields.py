@@ -19,6 +19,9 @@ those terms run
   (``engine/range_set.py``: slab groups, rebuilt lazily, saved in checkpoints);
 - **walls in view** of the particle–wall radiation.
 
+The fluid rows (T_f, u_f, |u_f − v_p|, the fluid properties) are filled by the methods of
+its mixin :class:`~thermodem.engine.fluid_sources.FluidSources` (``engine/fluid_sources.py``).
+
 It also evaluates the convection correlation's dimensionless numbers and warns once (a
 ``RuntimeWarning``, logged by the runner) when a run leaves the correlation's validity range,
 naming the particle, the value, the range, the step and the time.
@@ -36,17 +39,13 @@ import numpy as np
 
 from thermodem.config.fluid import (
     CellPorosity,
-    ExpressionSource,
     GlobalPorosity,
-    GridSource,
-    LiquidFluid,
     ShellPorosity,
-    TableSource,
-    UniformSource,
     VoronoiPorosity,
 )
+from thermodem.engine.fluid_sources import FluidSources
 from thermodem.engine.range_set import RangePairSet
-from thermodem.errors import ConfigError, SimulationError
+from thermodem.errors import ConfigError
 from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as fk
 from thermodem.kernels import heat_terms
@@ -59,8 +58,6 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
     from thermodem.engine.terms import HeatTerm
 
-#: Ideal gas constant [J/(mol K)] (exact, SI 2019).
-GAS_CONSTANT = 8.314462618
 #: Prefix of the neighbourhood set's arrays in the engine's checkpoint.
 STATE_PREFIX = "fields__"
 #: Arrays of the neighbour listing of the continuum radiation models in checkpoints.
@@ -80,7 +77,7 @@ class PorosityProvider(Protocol):
 POROSITY_PROVIDERS: dict[str, Callable[[Simulation, Any], PorosityProvider]] = {}
 
 
-class FieldProvider:
+class FieldProvider(FluidSources):
     """Fills the per-particle field columns the terms need (see the module docstring)."""
 
     def __init__(self, sim: Simulation, settings: ThermalSettings, terms: list[HeatTerm]) -> None:
@@ -238,80 +235,6 @@ class FieldProvider:
         self._constants_for: np.ndarray | None = None
 
     # ---------------------------------------------------------------------- set-up
-    def _source(self, source: Any, name: str, components: int) -> Any:
-        key = f"thermal.fluid.{name}"
-        if isinstance(source, GridSource):
-            from thermodem.io.grid_field import read_grid_field
-
-            try:
-                axes, values = read_grid_field(source.file, source.field, components,
-                                               source.location)  # fmt: skip
-            except ValueError as exc:
-                raise ConfigError(f"{key}.file: {exc}") from None
-            if components == 1 and not (values > 0).all():
-                k = np.argwhere(values <= 0)[0]
-                raise ConfigError(
-                    f"{key}.file: temperature {float(values[tuple(k)])!r} K at grid index "
-                    f"{tuple(int(v) for v in k[:3])} of {source.file}; temperatures must be > 0"
-                )
-            return ("grid", axes, values, source.file)
-        if isinstance(source, ExpressionSource):
-            from thermodem.engine.expressions import compile_expression
-
-            return ("expression", [compile_expression(e, ("t", "x", "y", "z"))
-                                   for e in source.expression], source.expression)  # fmt: skip
-        if isinstance(source, TableSource):
-            table = np.asarray(source.table, np.float64)
-            return ("table", table)
-        assert isinstance(source, UniformSource)
-        return ("uniform", np.asarray(source.value, np.float64))
-
-    def _properties_setup(self) -> None:
-        props = self.fluid.properties
-        if isinstance(props, LiquidFluid):
-            for col, value in (
-                (fk.F_FLUID_CONDUCTIVITY, props.thermal_conductivity),
-                (fk.F_FLUID_DENSITY, props.density),
-                (fk.F_FLUID_SPECIFIC_HEAT, props.specific_heat),
-                (fk.F_FLUID_VISCOSITY, props.dynamic_viscosity),
-            ):
-                if isinstance(value, list):
-                    arr = np.asarray(value, np.float64)
-                    nodes = np.ascontiguousarray(arr[:, 0])
-                    vals = np.ascontiguousarray(arr[:, 1])
-                    self._property_tables.append((col, nodes, vals, False))
-                    if col == fk.F_FLUID_VISCOSITY:
-                        self._property_tables.append((fk.F_SURFACE_VISCOSITY, nodes, vals, True))
-                else:
-                    self._constant_properties[col] = float(value)
-                    if col == fk.F_FLUID_VISCOSITY:
-                        self._constant_properties[fk.F_SURFACE_VISCOSITY] = float(value)
-            if props.thermal_expansion is not None:
-                self.beta_mode, self.beta = 2, float(props.thermal_expansion)
-        else:
-            gas = self.settings.gas
-            density = gas_density(gas)
-            self._constant_properties = {
-                fk.F_FLUID_CONDUCTIVITY: gas.thermal_conductivity,
-                fk.F_FLUID_DENSITY: density,
-                fk.F_FLUID_SPECIFIC_HEAT: gas.specific_heat,
-                fk.F_FLUID_VISCOSITY: gas.dynamic_viscosity,
-                fk.F_SURFACE_VISCOSITY: gas.dynamic_viscosity,
-            }
-            self.beta_mode = 1  # ideal gas: β = 1/T_f
-        c = self._constant_properties
-        if not self._property_tables:
-            pr = (c[fk.F_FLUID_SPECIFIC_HEAT] * c[fk.F_FLUID_VISCOSITY]
-                  / c[fk.F_FLUID_CONDUCTIVITY])  # fmt: skip
-            c[fk.F_PRANDTL] = pr
-            c[fk.F_PRANDTL_CBRT] = pr ** (1.0 / 3.0)
-
-    def grid_values(self, name: str) -> np.ndarray | None:
-        """The values of the fluid field ``name`` ('temperature', 'velocity') as read from its
-        grid file, or None when it is not a grid (or no selected model reads it)."""
-        source = self._sources.get(name)
-        return source[2] if source is not None and source[0] == "grid" else None
-
     def _constant_columns(self) -> dict[int, float]:
         """Columns that are the same for every particle at every step."""
         out = dict(self._constant_properties)
@@ -374,95 +297,6 @@ class FieldProvider:
         if self.part.shape[0] < rows:
             self.part = np.zeros(rows)
         return self.part
-
-    def _outside_warning(self, key: str, file: str, count: int, axes: Any, time: float) -> None:
-        if count and key not in self.warned:
-            self.warned.append(key)
-            extent = ", ".join(
-                f"{a} {ax[0]:.6g}..{ax[-1]:.6g}" for a, ax in zip("xyz", axes, strict=True)
-            )
-            warnings.warn(
-                f"{key}: {count} particles outside the grid of {file} ({extent} m) at step "
-                f"{self.sim.step_count} (t = {time:.6g} s): they take the value at the nearest "
-                "point of the grid's boundary (reported once)",
-                RuntimeWarning,
-                stacklevel=2,
-            )
-
-    def _temperature(self, time: float, fields: np.ndarray) -> None:
-        p = self.sim.particles
-        source = self._sources["temperature"]
-        kind = source[0]
-        if kind == "uniform":
-            return  # a constant column
-        if kind == "table":
-            table = source[1]
-            fk.fill_column(fields, fk.F_FLUID_TEMPERATURE,
-                           float(np.interp(time, table[:, 0], table[:, 1])))  # fmt: skip
-        elif kind == "expression":
-            pos = p.position
-            values = np.broadcast_to(
-                source[1][0](time, pos[:, 0], pos[:, 1], pos[:, 2]), (p.count,)
-            )
-            bad = ~(np.isfinite(values) & (values > 0))
-            if bad.any():
-                k = int(np.argmax(bad))
-                raise SimulationError(
-                    f"thermal.fluid.temperature: the expression {source[2][0]!r} gives "
-                    f"{float(values[k])!r} K at particle {int(p.global_id[k])} (x, y, z = "
-                    f"{tuple(float(v) for v in pos[k])}) at step {self.sim.step_count} "
-                    f"(t = {time:.6g} s); temperatures must be finite and > 0",
-                    self.sim.step_count,
-                    time,
-                    int(p.global_id[k]),
-                )
-            fields[fk.F_FLUID_TEMPERATURE, :] = values
-        else:
-            _, axes, values, file = source
-            outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values, fields,
-                                     fk.F_FLUID_TEMPERATURE, self._part())  # fmt: skip
-            self._outside_warning("thermal.fluid.temperature", file, outside, axes, time)
-
-    def _velocity(self, time: float, fields: np.ndarray) -> None:
-        p = self.sim.particles
-        source = self._sources["velocity"]
-        kind = source[0]
-        uniform = kind in ("uniform", "table")
-        if kind == "uniform":
-            self.velocity_buffer[:, 0] = source[1]
-        elif kind == "table":
-            table = source[1]
-            for a in range(3):
-                self.velocity_buffer[a, 0] = np.interp(time, table[:, 0], table[:, 1 + a])
-        else:
-            if self.velocity_buffer.shape[1] != p.count:
-                self.velocity_buffer = np.zeros((3, p.count))
-            if kind == "expression":
-                pos = p.position
-                for a in range(3):
-                    self.velocity_buffer[a, :] = source[1][a](time, pos[:, 0], pos[:, 1],
-                                                              pos[:, 2])  # fmt: skip
-                bad = ~np.isfinite(self.velocity_buffer).all(axis=0)
-                if bad.any():
-                    k = int(np.argmax(bad))
-                    raise SimulationError(
-                        f"thermal.fluid.velocity: the expressions {list(source[2])} give "
-                        f"{self.velocity_buffer[:, k].tolist()} m/s at particle "
-                        f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s)",
-                        self.sim.step_count,
-                        time,
-                        int(p.global_id[k]),
-                    )
-            else:
-                _, axes, values, file = source
-                outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values,
-                                         self.velocity_buffer, 0, self._part())  # fmt: skip
-                self._outside_warning("thermal.fluid.velocity", file, outside, axes, time)
-        fk.relative_speed(p.velocity, self.velocity_buffer, uniform, fields)
-
-    def fluid_velocity(self) -> np.ndarray:
-        """u_f at the particles at the last update [m/s], (n, 3) (or (1, 3) if uniform)."""
-        return self.velocity_buffer.T.copy()
 
     # ----------------------------------------------------------------- neighbourhood
     def _neighbourhood_gap(self) -> float:
@@ -699,18 +533,4 @@ class FieldProvider:
         self._constants_for = None
 
 
-def gas_density(gas: Any) -> float:
-    """ρ of the case gas [kg/m³]: ``density`` if given, else the ideal gas P M / (R T) of its
-    ``pressure``, ``temperature`` and ``molar_mass``."""
-    if getattr(gas, "density", None) is not None:
-        return float(gas.density)
-    if gas.pressure is None or gas.temperature is None:
-        raise ConfigError(
-            "thermal.gas.density: missing; needed by the convection models (the Reynolds "
-            "number) when the gas gives mean_free_path instead of pressure and temperature: "
-            "give thermal.gas.density [kg/m³]"
-        )
-    return float(gas.pressure * gas.molar_mass / (GAS_CONSTANT * gas.temperature))
-
-
-__all__ = ["FieldProvider", "POROSITY_PROVIDERS", "PorosityProvider", "gas_density"]
+__all__ = ["FieldProvider", "POROSITY_PROVIDERS", "PorosityProvider"]
