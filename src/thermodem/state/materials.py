@@ -78,7 +78,9 @@ class Material(StrictModel):
         stored = bool(info.context and info.context.get(STORED_CASE_KEY))
         for name, unit in (("thermal_conductivity", "W/(m K)"), ("specific_heat", "J/(kg K)")):
             table = getattr(self, f"{name}_table")
-            if table and name in self.model_fields_set and not stored:
+            # (an explicit null is the key left out: the table alone)
+            given = name in self.model_fields_set and getattr(self, name) is not None
+            if table and given and not stored:
                 rows = [list(row) for row in table]
                 raise ValueError(
                     f"{name}: {getattr(self, name):g} {unit} is given together with "

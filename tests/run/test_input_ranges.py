@@ -1,0 +1,86 @@
+"""Inputs of a demanding user (third round): thermal parameters out of their physical range,
+property and time tables, restarts with a changed case, output settings that contradict each
+other. Each through the installed command in a subprocess, as a user runs it."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import yaml
+
+EXE = str(Path(sys.executable).with_name("thermodem"))
+
+CASE = {
+    "simulation": {"time_step": 1.0e-5, "end_time": 1.0e-4},
+    "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
+    "materials": {
+        "glass": {
+            "density": 2500,
+            "youngs_modulus": 1.0e7,
+            "poisson_ratio": 0.3,
+            "thermal_conductivity": 1.0,
+            "specific_heat": 800,
+        }
+    },
+    "walls": [
+        {
+            "kind": "plane",
+            "point": [0, 0, 0],
+            "normal": [0, 0, 1],
+            "material": "glass",
+            "thermal": {"kind": "fixed", "temperature": 350.0},
+        }
+    ],
+    "insertion": [
+        {
+            "kind": "lattice",
+            "material": "glass",
+            "distribution": {"kind": "mono", "radius": 0.0008},
+            "lower": [0, 0, 0],
+            "upper": [0.004, 0.004, 0.004],
+            "spacing": 0.002,
+        }
+    ],
+    "thermal": {},
+}
+
+
+def _case(tmp_path: Path, name: str = "case", **sections) -> Path:  # noqa: ANN003
+    data = json.loads(json.dumps(CASE))
+    for key, value in sections.items():
+        data[key] = value
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def _glass(**changes) -> dict:  # noqa: ANN003
+    glass = {**CASE["materials"]["glass"], **changes}
+    return {"glass": {k: v for k, v in glass.items() if v != "-"}}
+
+
+def _cli(*args: object) -> subprocess.CompletedProcess:
+    res = subprocess.run(
+        [EXE, *[str(a) for a in args]], capture_output=True, text=True, timeout=300
+    )
+    assert "Traceback" not in res.stdout + res.stderr, res.stdout + res.stderr
+    return res
+
+
+def test_an_explicit_null_constant_beside_a_table_is_the_table_alone(tmp_path: Path) -> None:
+    """``thermal_conductivity: null`` next to ``thermal_conductivity_table`` (a user who keeps
+    every key and empties the one not used) ended in a TypeError traceback."""
+    table = [[300.0, 1.0], [400.0, 2.0]]
+    for name in ("thermal_conductivity", "specific_heat"):
+        glass = _glass(**{name: None, f"{name}_table": table})
+        res = _cli("validate", _case(tmp_path, materials=glass))
+        assert res.returncode == 0, res.stdout + res.stderr
+        assert f"{name}_table:" in res.stdout
+    # a value beside the table is still refused
+    glass = _glass(thermal_conductivity=1.0, thermal_conductivity_table=table)
+    res = _cli("validate", _case(tmp_path, materials=glass))
+    assert res.returncode == 2
+    assert "thermal_conductivity: 1 W/(m K) is given together with" in res.stderr
