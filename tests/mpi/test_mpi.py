@@ -187,7 +187,7 @@ def test_plain_run_does_not_import_mpi4py(tmp_path: Path) -> None:
          "thermal.convection"),
         (lambda c: c["thermal"].update(indirect_conduction="vargas_mccarthy2002"),
          "thermal.indirect_conduction"),
-        (lambda c: c["output"].update(contacts=True), "output.contacts"),
+        (lambda c: c["output"].update(vtu=True, contacts=True), "output.contacts"),
     ],
 )  # fmt: skip
 def test_refused_under_mpi(change, key: str) -> None:  # noqa: ANN001
@@ -404,7 +404,7 @@ def test_failure_stops_every_rank_with_one_message(tmp_path: Path) -> None:
 @needs_mpi
 def test_unsupported_key_refused_by_mpiexec(tmp_path: Path) -> None:
     case = bed_case(DATA / "mpi_bed_box.txt", end_time=10 * DT)
-    case["output"]["contacts"] = True
+    case["output"].update(vtu=True, contacts=True)  # (vtu: false refuses contacts itself)
     path = _write_case(tmp_path / "c.yaml", case)
     res = _run(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"], 2, timeout=300)
     assert res.returncode == 2

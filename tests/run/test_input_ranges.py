@@ -84,3 +84,22 @@ def test_an_explicit_null_constant_beside_a_table_is_the_table_alone(tmp_path: P
     res = _cli("validate", _case(tmp_path, materials=glass))
     assert res.returncode == 2
     assert "thermal_conductivity: 1 W/(m K) is given together with" in res.stderr
+
+
+def test_frame_settings_with_vtu_false_are_refused(tmp_path: Path) -> None:
+    """``vtu: false`` with ``contacts: true`` ran and wrote no contact (nor any frame) without
+    a word; the frame interval and wall extent were ignored the same way."""
+    output = {"vtu": False, "contacts": True, "interval": 2.0e-5}
+    case = _case(tmp_path, output=output)
+    res = _cli("run", case, "--output", tmp_path / "out", "--no-progress")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "output.vtu: false writes no VTU frame, so contacts: true, interval: 2e-05 would be "
+        "ignored (settings of the frames); allowed: vtu: true to write the frames, or leave "
+        "contacts and interval out"
+    ) in res.stderr
+    assert not (tmp_path / "out" / "timeseries.csv").exists()
+    # vtu: false alone, and frames with contacts, are fine
+    assert _cli("validate", _case(tmp_path, output={"vtu": False})).returncode == 0
+    both = {"vtu": True, "contacts": True}
+    assert _cli("validate", _case(tmp_path, output=both)).returncode == 0

@@ -281,6 +281,30 @@ class Output(StrictModel):
         default=2, ge=1, description="newest periodic checkpoints kept; null: keep all"
     )
 
+    @model_validator(mode="after")
+    def _frame_keys_need_frames(self, info: ValidationInfo) -> Output:
+        # contacts, interval and wall_extent are the frames' keys: with vtu false no frame is
+        # written and each would be ignored (contacts: true wrote no contact at all, silently).
+        # A checkpoint's stored case is read as an earlier version wrote it.
+        from thermodem.state.materials import STORED_CASE_KEY
+
+        if self.vtu or (info.context and info.context.get(STORED_CASE_KEY)):
+            return self
+        given = [
+            f"{key}: {str(value).lower() if isinstance(value, bool) else f'{value:g}'}"
+            for key in ("contacts", "interval", "wall_extent")
+            if (value := getattr(self, key)) not in (None, False)
+        ]
+        if given:
+            keys = [g.split(":")[0] for g in given]
+            listed = keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} and {keys[-1]}"
+            raise ValueError(
+                f"vtu: false writes no VTU frame, so {', '.join(given)} would be ignored "
+                "(settings of the frames); allowed: vtu: true to write the frames, or leave "
+                f"{listed} out"
+            )
+        return self
+
 
 def _cylinder_bbox(region: Any) -> tuple[list[float], list[float]]:
     """Axis-aligned bounding box of a (validated, unit-axis) cylinder region."""
