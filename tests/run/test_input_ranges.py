@@ -103,3 +103,43 @@ def test_frame_settings_with_vtu_false_are_refused(tmp_path: Path) -> None:
     assert _cli("validate", _case(tmp_path, output={"vtu": False})).returncode == 0
     both = {"vtu": True, "contacts": True}
     assert _cli("validate", _case(tmp_path, output=both)).returncode == 0
+
+
+def test_lengths_in_another_unit_are_refused_before_the_run(tmp_path: Path) -> None:
+    """A roughness of 10 mm on 0.8 mm beads (the resistance network) and a minimum conduction
+    distance of 2.75 m (Rong & Horio, S meant as 2.75e-8 m) ran without a word."""
+    surface = {"microhardness": 1.0e9, "surface_slope": 0.1, "thermal_accommodation": 0.9}
+    glass = _glass(surface_roughness=0.01, **surface)
+    thermal = {"direct_conduction": "resistance_network"}
+    res = _cli("run", _case(tmp_path, materials=glass, thermal=thermal), "--output",
+               tmp_path / "a", "--no-progress")  # fmt: skip
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: materials.glass.surface_roughness = 0.01 m is not below the radius of the "
+        "smallest particle it touches, 0.0008 m"
+    ) in res.stderr
+    assert not (tmp_path / "a" / "timeseries.csv").exists()
+    # the pair's equivalent roughness of an interactions entry, a poured smaller particle
+    region = {"kind": "box", "lower": [0, 0, 0.006], "upper": [0.01, 0.01, 0.01]}
+    pour = {"kind": "pour", "material": "glass", "distribution": {"kind": "mono",
+            "radius": 0.0002}, "rate": 1.0e5, "interval": 1.0e-5, "region": region}  # fmt: skip
+    insertion = [CASE["insertion"][0], pour]
+    pair = [{"materials": ["glass", "glass"], "surface_roughness": 0.0005}]
+    case = _case(tmp_path, materials=_glass(surface_roughness=1e-7, **surface),
+                 thermal=thermal, interactions=pair, insertion=insertion)  # fmt: skip
+    res = _cli("validate", case)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert "interactions.0.surface_roughness = 0.0005 m is not below the radius" in res.stderr
+    assert "0.0002 m" in res.stderr
+    # S of a surrounding layer model
+    thermal = {"indirect_conduction": {"model": "musser2011", "min_separation": 2.75}}
+    res = _cli("validate", _case(tmp_path, thermal=thermal))
+    assert res.returncode == 2
+    assert (
+        "thermal.indirect_conduction.min_separation = 2.75 m is not below the fluid layer of "
+        "the smallest particles, layer_thickness_ratio 0.4 × radius 0.0008 m (glass) = "
+        "0.00032 m"
+    ) in res.stderr
+    # values in range run
+    thermal = {"indirect_conduction": {"model": "musser2011", "min_separation": 1e-7}}
+    assert _cli("validate", _case(tmp_path, thermal=thermal)).returncode == 0

@@ -7,6 +7,7 @@ region a wall passes through or that lies outside the walls). Called by
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -356,3 +357,85 @@ def check_walls_in_domain(sim: Simulation) -> list[str]:
             "the wall"
         )
     return warnings
+
+
+def smallest_radii(sim: Simulation) -> dict[str, float]:
+    """The smallest radius [m] of each material's particles: those present at the start and
+    those its pour entries can draw (a material of no particle is left out; every rank's)."""
+    p = sim.particles
+    n = sim.owned_count
+    found: dict[str, float] = {}
+
+    def add(name: str, r: float) -> None:
+        if r > 0.0:
+            found[name] = min(found.get(name, math.inf), r)
+
+    for k, name in enumerate(sim.material_names):
+        mine = p.radius[:n][p.type_id[:n] == k]
+        if mine.size:
+            add(name, float(mine.min()))
+    for entry in sim.case.insertion:
+        if entry.kind == "pour":
+            add(entry.material, _radius_range(entry.distribution)[0])
+    comm = getattr(sim, "comm", None)
+    if comm is not None:
+        merged: dict[str, float] = {}
+        for part in comm.allgather(found):
+            for name, r in part.items():
+                merged[name] = min(merged.get(name, math.inf), r)
+        found = merged
+    return found
+
+
+def check_length_scales(sim: Simulation) -> None:
+    """Refuse a length of a thermal model that cannot be what it is meant to be beside the
+    particles' radii (a value in mm or µm written as metres is the usual cause): a surface
+    roughness σ (the resistance network) not below the radius of the smallest particle that
+    surface touches, a minimum conduction distance S of a surrounding fluid layer model not
+    below the layer δ_f = layer_thickness_ratio × R of the smallest particle (every path of the
+    layer would be cut at S: S is a molecular distance, about the gas mean free path).
+    ConfigError naming the key, the value, the radius and the bound."""
+    case = sim.case
+    th = case.thermal
+    radii = smallest_radii(sim)
+    if th is None or not radii:
+        return
+    r_all = min(radii.values())
+    name, r_min = min(radii.items(), key=lambda kv: kv[1])
+    if th.direct_conduction.model == "resistance_network":
+        for mat, material in case.materials.items():
+            sigma = material.surface_roughness
+            # a particle material: its own particles; a wall's: every particle may touch it
+            r = radii.get(mat, r_all)
+            if sigma is not None and sigma >= r:
+                raise ConfigError(
+                    f"materials.{mat}.surface_roughness = {sigma:g} m is not below the radius "
+                    f"of the smallest particle it touches, {r:g} m: an RMS roughness is a small "
+                    "fraction of the radius (µm for mm particles); is it in another unit? "
+                    f"allowed: surface_roughness below {r:g} m (thermal.direct_conduction: "
+                    "resistance_network reads it)"
+                )
+        for k, entry in enumerate(case.interactions):
+            sigma = entry.surface_roughness
+            r = min(radii.get(m, r_all) for m in entry.materials)
+            if sigma is not None and sigma >= r:
+                raise ConfigError(
+                    f"interactions.{k}.surface_roughness = {sigma:g} m is not below the radius "
+                    f"of the smallest particle of the pair, {r:g} m: an RMS roughness is a "
+                    "small fraction of the radius (µm for mm particles); is it in another "
+                    f"unit? allowed: surface_roughness below {r:g} m"
+                )
+    choice = th.indirect_conduction
+    if choice.model in ("rong_horio1999", "musser2011"):
+        s = float(choice.params.min_separation)
+        ratio = float(choice.params.layer_thickness_ratio)
+        layer = ratio * r_min
+        if s >= layer:
+            raise ConfigError(
+                f"thermal.indirect_conduction.min_separation = {s:g} m is not below the fluid "
+                f"layer of the smallest particles, layer_thickness_ratio {ratio:g} × radius "
+                f"{r_min:g} m ({name}) = {layer:g} m: every conduction path of the layer would "
+                "be cut at S, which is a molecular distance (about the gas mean free path; "
+                "2.75e-8 m in Morris et al. 2015); is it in another unit? allowed: "
+                f"min_separation below {layer:g} m"
+            )

@@ -34,6 +34,7 @@ from thermodem.engine.case_warnings import (
     temperature_warnings,
 )
 from thermodem.engine.start_checks import (
+    check_length_scales,
     check_pour_walls,
     check_wall_overlaps,
     check_walls_in_domain,
@@ -499,6 +500,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_step_count(sim)
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
+    check_length_scales(sim)
     notes = check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
     notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
     notes += temperature_warnings(sim) + step_interval_warnings(sim)

@@ -173,6 +173,14 @@ class VargasMcCarthy2002Params(StrictModel):
                 f"liquid_conductivity is required when filling_angle > 0 (got filling_angle = "
                 f"{self.filling_angle!r} rad and no liquid_conductivity)"
             )
+        if self.filling_angle == 0.0 and self.liquid_conductivity is not None:
+            # (it ran as gas only, the liquid ignored without a word)
+            raise ValueError(
+                f"liquid_conductivity = {self.liquid_conductivity:g} W/(m K) is given but "
+                "filling_angle is 0 (the default: gas only, no liquid bridge), so it would be "
+                "ignored; allowed: a filling_angle > 0 and < π/2 rad for a liquid bridge, or "
+                "leave liquid_conductivity out for gas only"
+            )
         return self
 
 
