@@ -10,8 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from thermodem.models import registry
+from thermodem.models.thermal import batchelor_obrien_contact as bob
 from thermodem.models.thermal import direct_conduction as dc
 from thermodem.models.thermal.contact_radius import geometric_contact_radius
+from thermodem.models.thermal.direct_conduction_family import swap_row
 from thermodem.state.gas import GasProperties
 from thermodem.state.materials import Material, resolve_pair
 
@@ -80,16 +82,16 @@ def test_bob_complete_contact_regimes(eta, h):
 
 def test_bob_spec_blend_is_not_monotonic_and_hermite_is():
     eta = np.linspace(0.5, 120.0, 4001)
-    spec = np.array([dc.bob_contact_h(e, dc.BLEND_SPEC_LINEAR) for e in eta])
-    herm = np.array([dc.bob_contact_h(e, dc.BLEND_HERMITE) for e in eta])
-    assert spec.max() > 5 * dc.bob_contact_h(100.0, 0)  # peak ≈ 277.8 near η ≈ 68.8
+    spec = np.array([bob.bob_contact_h(e, bob.BLEND_SPEC_LINEAR) for e in eta])
+    herm = np.array([bob.bob_contact_h(e, bob.BLEND_HERMITE) for e in eta])
+    assert spec.max() > 5 * bob.bob_contact_h(100.0, 0)  # peak ≈ 277.8 near η ≈ 68.8
     assert np.all(np.diff(herm) > 0)
     for e0 in (1.0, 100.0):  # hermite: value and slope continuous at both ends
-        lo = dc.bob_contact_h(e0 - 1e-7, 1)
-        hi = dc.bob_contact_h(e0 + 1e-7, 1)
+        lo = bob.bob_contact_h(e0 - 1e-7, 1)
+        hi = bob.bob_contact_h(e0 + 1e-7, 1)
         assert hi - lo == pytest.approx(0.0, abs=1e-6)
-        s_lo = (lo - dc.bob_contact_h(e0 - 1e-4, 1)) / (1e-4 - 1e-7)
-        s_hi = (dc.bob_contact_h(e0 + 1e-4, 1) - hi) / (1e-4 - 1e-7)
+        s_lo = (lo - bob.bob_contact_h(e0 - 1e-4, 1)) / (1e-4 - 1e-7)
+        s_hi = (bob.bob_contact_h(e0 + 1e-4, 1) - hi) / (1e-4 - 1e-7)
         assert s_lo == pytest.approx(s_hi, rel=1e-3)
 
 
@@ -165,7 +167,7 @@ def test_bob_separated_part_regimes_and_named_cylinders(model, regime, cylinder)
     ratio = {"kanuparthi2008": 1.0, "yun_evans2010": 1.0, "moscardini2018": 1.42,
              "dai2019": 2.0}.get(cylinder, cylinder)  # fmt: skip
     p = row(model, K_HIGH, K_HIGH, k_f=SEP_KF, regime=regime, cylinder_radius=cylinder)
-    assert p[dc.BOB_CYLINDER_RATIO] == ratio
+    assert p[bob.BOB_CYLINDER_RATIO] == ratio
     r_bar = ratio * R_EFF
     h_inner = 0.5 * (1000.0 * PI * r_bar**2 / 1e-3)  # two particles k π r̄² / R in series
     for lam in (0.009, 0.05, 0.2, 50.0, 150.0):
@@ -368,7 +370,7 @@ def test_antisymmetric_and_zero_at_equal_temperature(
     assert np.isfinite(q_ij)
     assert rate(model, p, t_i, t_i, r_i, r_j, *args) == 0.0
     if not math.isinf(r_j):
-        q_ji = rate(model, dc.swap_row(p), t_j, t_i, r_j, r_i, *args)
+        q_ji = rate(model, swap_row(p), t_j, t_i, r_j, r_i, *args)
         assert q_ji == -q_ij
     if t_j > t_i:
         assert q_ij >= 0.0

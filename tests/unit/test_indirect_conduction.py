@@ -16,8 +16,8 @@ from scipy.integrate import IntegrationWarning, quad
 from thermodem.models import registry
 from thermodem.models.thermal import indirect_conduction as ic
 from thermodem.models.thermal import vargas_mccarthy as vm
+from thermodem.models.thermal.batchelor_obrien_contact import bob_complete_rate, pack_bob_complete
 from thermodem.models.thermal.contact_radius import geometric_contact_radius
-from thermodem.models.thermal.direct_conduction import bob_complete_rate, pack_bob_complete
 from thermodem.state.gas import GasProperties
 from thermodem.state.materials import Material, resolve_pair
 

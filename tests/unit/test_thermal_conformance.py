@@ -13,7 +13,8 @@ import pytest
 
 from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
-from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch, swap_row
+from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch
+from thermodem.models.thermal.direct_conduction_family import swap_row
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.voronoi import voronoi_dispatch
 from thermodem.state.materials import Material, resolve_pair

@@ -21,13 +21,8 @@ from numba.extending import overload
 
 from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import contact_radius_dispatch
-from thermodem.models.thermal.direct_conduction import (
-    K_I,
-    K_J,
-    RHOC_I,
-    RHOC_J,
-    direct_conduction_dispatch,
-)
+from thermodem.models.thermal.direct_conduction import direct_conduction_dispatch
+from thermodem.models.thermal.direct_conduction_family import K_I, K_J, RHOC_I, RHOC_J
 
 _INLINE: dict[tuple[str, int], Any] = {}
 

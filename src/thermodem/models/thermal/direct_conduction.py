@@ -1,5 +1,12 @@
 """Direct (particle-particle contact) conduction models (family ``direct_conduction``).
 
+This module: the conventions of the family, ``none``, the thermal pipes (``thermal_pipe``,
+``quintana_ruiz_campello2020``, ``rojek2014``), the collisional models (``sun_chen1988``,
+``zhou2008``) and the dispatchers. Batchelor & O'Brien (``batchelor_obrien_simple``,
+``_complete``, ``_modified``) are in ``batchelor_obrien_contact.py``, the resistance network
+in ``resistance_network.py``, the row head and registration helper they share in
+``direct_conduction_family.py``.
+
 Kernel signature (all float64 scalars, ``p`` the packed row of the type pair)::
 
     kernel(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff)
@@ -13,15 +20,16 @@ with the wall material as ``mat_j`` in ``pack``.
 
 Antisymmetry: every kernel returns H (T_j - T_i) with a conductance H built only from
 exactly commutative operations (a + b, a * b, min) of the two sides' terms, so swapping i and
-j — temperatures, radii and the row columns listed in ``swap_pairs`` (see :func:`swap_row`) —
-negates the result bit for bit, and it is 0 at equal temperatures.
+j — temperatures, radii and the row columns listed in ``swap_pairs`` (see
+``direct_conduction_family.swap_row``) — negates the result bit for bit, and it is 0 at equal
+temperatures.
 
 Row layout shared by the family: the named columns ``k_i, k_j, rhoc_i, rhoc_j`` first
-(:data:`HEAD`, indices :data:`K_I`, :data:`K_J`, :data:`RHOC_I`, :data:`RHOC_J`), then each
-model's own symmetric columns, named in its ``register(columns=...)`` and indexed by module
-constants; ``swap_pairs = ((0, 1), (2, 3))``. The static kernels read only ``k_i`` and ``k_j``,
-which is what lets the collisional models call them with their own row, and the k(T)/ρc(T)
-override of the engine replaces exactly these four columns.
+(``HEAD``, indices ``K_I``, ``K_J``, ``RHOC_I``, ``RHOC_J`` of ``direct_conduction_family``),
+then each model's own symmetric columns, named in its ``register(columns=...)`` and indexed by
+module constants; ``swap_pairs = ((0, 1), (2, 3))``. The static kernels read only ``k_i`` and
+``k_j``, which is what lets the collisional models call them with their own row, and the
+k(T)/ρc(T) override of the engine replaces exactly these four columns.
 
 Kernels are compiled with ``error_model="numpy"``: they never raise (a division by zero gives
 inf/NaN, which the NaN flag of the pair loop catches), as the architecture asks of kernels.
@@ -38,25 +46,34 @@ from typing import Literal
 
 import numpy as np
 from numba import njit
-from pydantic import Field, field_validator
+from pydantic import Field
 
 from thermodem.config.base import StrictModel
-from thermodem.models.registry import packed, register
-from thermodem.models.thermal.batchelor_obrien import (
-    CYLINDER_HELP,
-    REGIMES,
-    CylinderName,
-    RegimeName,
-    check_cylinder,
-    cylinder_ratio,
-    gap_conductance,
-    regime_field,
+from thermodem.models.registry import packed
+from thermodem.models.thermal.batchelor_obrien_contact import (
+    BATCHELOR_OBRIEN_COMPLETE,
+    BATCHELOR_OBRIEN_MODIFIED,
+    BATCHELOR_OBRIEN_SIMPLE,
+    bob_complete_rate,
+    bob_modified_rate,
+    bob_simple_rate,
 )
 from thermodem.models.thermal.contact_radius import (
     effective_radius,
     hertz_collision_time,
     hertz_max_contact_radius,
-    require,
+)
+from thermodem.models.thermal.direct_conduction_family import (
+    FAMILY,
+    HEAD,
+    K_I,
+    K_J,
+    RHOC_I,
+    RHOC_J,
+    conductivities,
+    head_values,
+    heat_capacities,
+    register_model,
 )
 from thermodem.models.thermal.resistance_network import (
     RESISTANCE_NETWORK,
@@ -65,9 +82,8 @@ from thermodem.models.thermal.resistance_network import (
 from thermodem.state.materials import PairContext
 
 NONE = 0
-BATCHELOR_OBRIEN_SIMPLE = 1
-BATCHELOR_OBRIEN_COMPLETE = 2
-BATCHELOR_OBRIEN_MODIFIED = 3
+# BATCHELOR_OBRIEN_SIMPLE, _COMPLETE, _MODIFIED = 1, 2, 3 are defined in
+# batchelor_obrien_contact.py
 THERMAL_PIPE = 4
 QUINTANA_RUIZ_CAMPELLO2020 = 5
 ROJEK2014 = 6
@@ -75,45 +91,9 @@ SUN_CHEN1988 = 7
 ZHOU2008 = 8
 # RESISTANCE_NETWORK = 9 is defined in resistance_network.py
 
-FAMILY = "direct_conduction"
-SWAP_PAIRS = ((0, 1), (2, 3))
-
-#: The columns every row of the family starts with (the override replaces them).
-HEAD = ("k_i", "k_j", "rhoc_i", "rhoc_j")
-K_I, K_J, RHOC_I, RHOC_J = 0, 1, 2, 3
-#: Batchelor & O'Brien complete (and modified: one column more).
-BOB_COLUMNS = (*HEAD, "k_f", "blend", "cylinder_ratio", "cutoff_gap_ratio", "regime")
-BOB_K_F, BOB_BLEND, BOB_CYLINDER_RATIO, BOB_CUTOFF_RATIO, BOB_REGIME = 4, 5, 6, 7, 8
-BOB_MODIFIED_COLUMNS = (*BOB_COLUMNS, "dai2019_correlation")
-BOB_DAI2019 = 9
 #: Collisional models (Sun & Chen, Zhou).
 COLLISIONAL_COLUMNS = (*HEAD, "e_star", "correction_factor", "static_model")
 COL_E_STAR, COL_CORRECTION, COL_STATIC_MODEL = 4, 5, 6
-
-BLEND_SPEC_LINEAR = 0
-BLEND_HERMITE = 1
-_BLENDS = {"spec_linear": BLEND_SPEC_LINEAR, "hermite": BLEND_HERMITE}
-
-
-def swap_row(row: np.ndarray, swap_pairs: tuple[tuple[int, int], ...] = SWAP_PAIRS) -> np.ndarray:
-    """The row of the swapped pair (j, i): columns of each pair in ``swap_pairs`` exchanged."""
-    out = np.array(row, dtype=np.float64, copy=True)
-    for a, b in swap_pairs:
-        out[a], out[b] = row[b], row[a]
-    return out
-
-
-def _conductivities(pair: PairContext, model: str) -> list[float]:
-    return [require(m, "thermal_conductivity", model) for m in (pair.mat_i, pair.mat_j)]
-
-
-def _heat_capacities(pair: PairContext, model: str) -> list[float]:
-    return [m.density * require(m, "specific_heat", model) for m in (pair.mat_i, pair.mat_j)]
-
-
-def head_values(k: list[float], rhoc: tuple[float, float] = (0.0, 0.0)) -> dict[str, float]:
-    """The family's head columns from the two conductivities (and heat capacities)."""
-    return {"k_i": k[0], "k_j": k[1], "rhoc_i": rhoc[0], "rhoc_j": rhoc[1]}
 
 
 # --------------------------------------------------------------------------------- none
@@ -130,208 +110,6 @@ def none_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impac
     return 0.0
 
 
-# ------------------------------------------------------------ Batchelor & O'Brien, simple
-class BatchelorOBrienSimpleParams(StrictModel):
-    """Q = 4 k̄ R_c (T_j - T_i), k̄ = k_i k_j / (k_i + k_j) (spec 2.3 and appendix A).
-
-    Batchelor & O'Brien (1977) Proc. R. Soc. Lond. A 355, 313-333, large-η limit Q = 2 k_p R_c
-    ΔT, generalised to two materials with the effective conductivity of Cheng et al. (1999):
-    k̄ is the *series* combination (half the harmonic mean), so equal materials give 2 k R_c;
-    each body contributes the constriction resistance 1/(4 k a) of a half space. A wall is the
-    half space k_j. Row: [k_i, k_j].
-    """
-
-
-@njit(cache=True, error_model="numpy")
-def bob_simple_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
-    if overlap <= 0.0 or r_c <= 0.0:
-        return 0.0
-    k_bar = p[K_I] * p[K_J] / (p[K_I] + p[K_J])
-    return 4.0 * k_bar * r_c * (t_j - t_i)
-
-
-# --------------------------------------------------------- Batchelor & O'Brien, complete
-@njit(cache=True, error_model="numpy")
-def bob_contact_h(eta, blend):
-    """H̃_c + H̃_f of Batchelor & O'Brien (1977) for the contact parameter η (spec 2.3).
-
-    η < 1: 0.17 η²;  η > 100: 2η/π - 2 ln η;  1 <= η <= 100: ``spec_linear`` blends the two
-    formulas with weight w = (η - 1)/99 (continuous but NOT monotonic: it peaks at ≈ 277.8 near
-    η ≈ 68.8 and falls to 54.45 at η = 100); ``hermite`` is the cubic Hermite curve that matches
-    both regimes' values and slopes at η = 1 and η = 100 (C¹ and monotonic).
-    """
-    if eta < 1.0:
-        return 0.17 * eta * eta
-    if eta > 100.0:
-        return 2.0 * eta / math.pi - 2.0 * math.log(eta)
-    if blend == BLEND_HERMITE:
-        y0, m0 = 0.17, 0.34
-        y1, m1 = 200.0 / math.pi - 2.0 * math.log(100.0), 2.0 / math.pi - 0.02
-        t = (eta - 1.0) / 99.0
-        t2 = t * t
-        t3 = t2 * t
-        return (
-            (2.0 * t3 - 3.0 * t2 + 1.0) * y0
-            + (t3 - 2.0 * t2 + t) * 99.0 * m0
-            + (3.0 * t2 - 2.0 * t3) * y1
-            + (t3 - t2) * 99.0 * m1
-        )
-    w = (eta - 1.0) / 99.0
-    return (1.0 - w) * 0.17 * eta * eta + w * (2.0 * eta / math.pi - 2.0 * math.log(eta))
-
-
-@njit(cache=True, error_model="numpy")
-def bob_conductance(k_p, k_f, r_eff, r_c, overlap, blend, r_cyl, cutoff_gap, regime):
-    """Batchelor & O'Brien (1977) conductance H [W/K] between two surfaces (spec 2.3).
-
-    Contact (δ >= 0): 2π R* k_f (H̃_c + H̃_f + ln k_pf²), η = k_pf R_c/(2R*).
-    Separated (gap d_s = -δ < cutoff): 2π R* k_f X(λ), X = ln k_pf² or ln(1 + r̄²/(2 R* d_s))
-    by the λ rule ``regime`` (models/thermal/batchelor_obrien.py). 0 beyond the cut-off.
-    """
-    kpf = k_p / k_f
-    if overlap >= 0.0:
-        eta = kpf * r_c / (2.0 * r_eff)
-        return 2.0 * math.pi * r_eff * k_f * (bob_contact_h(eta, blend) + 2.0 * math.log(kpf))
-    gap = -overlap
-    if gap >= cutoff_gap:
-        return 0.0
-    return gap_conductance(k_p, k_f, r_eff, gap, r_cyl / r_eff, regime)
-
-
-class BatchelorOBrienCompleteParams(StrictModel):
-    """Batchelor & O'Brien (1977) Proc. R. Soc. Lond. A 355, 313-333: contact through the
-    contact circle and the surrounding fluid, and near (separated) particles (spec 2.3).
-
-    Total conduction (direct + through the fluid near the contact): do not combine it with an
-    indirect_conduction model. k_f is the conductivity of the case's gas (``thermal.gas``,
-    ``pair.gas``). k_p = 2 k_i k_j/(k_i + k_j) (harmonic mean, so that the large-η limit is
-    batchelor_obrien_simple), k_pf = k_p/k_f must exceed 1. The 1 <= η <= 100 blend
-    of the spec is not monotonic (see bob_contact_h); ``blend="hermite"`` is a monotonic one.
-    Separated pairs conduct up to a gap ``cutoff_gap_ratio`` R* (Yun & Evans 2010: d_s < R̄),
-    through a cylinder of radius ``cylinder_radius`` R* (a number, or a named choice of the
-    spec: dai2019 = 2.00, Dai et al. 2019; for equal spheres R* = R/2, so 2.00 is a cylinder of
-    the particle radius), with the λ rule ``regime`` (as batchelor_obrien_separated).
-    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime].
-    """
-
-    blend: Literal[tuple(_BLENDS)] = Field(
-        default="spec_linear", description="H̃ for 1 <= η <= 100: spec's blend or monotonic"
-    )
-    regime: RegimeName = regime_field()
-    cylinder_radius: float | CylinderName = Field(default=2.0, description=CYLINDER_HELP)
-    cutoff_gap_ratio: float = Field(
-        default=1.0,
-        ge=0,
-        allow_inf_nan=False,
-        description="largest conducting gap d_s / R* [-] of separated pairs",
-    )
-
-    @field_validator("cylinder_radius")
-    @classmethod
-    def _cylinder(cls, v: float | str) -> float | str:
-        return check_cylinder(v)
-
-
-def _check_kpf(k_i: float, k_j: float, k_f: float, model: str) -> None:
-    k_p = 2.0 * k_i * k_j / (k_i + k_j)
-    if k_p <= k_f:
-        raise ValueError(
-            f"{model} needs particle conductivity above the gas's (k_p/k_f > 1): "
-            f"k_p = {k_p:g} W/(m K), thermal.gas.thermal_conductivity = {k_f:g} W/(m K)"
-        )
-
-
-def pack_bob_complete(params: BatchelorOBrienCompleteParams, pair: PairContext) -> np.ndarray:
-    model = "direct_conduction.batchelor_obrien_complete"
-    k_i, k_j = _conductivities(pair, model)
-    k_f = pair.gas.thermal_conductivity
-    _check_kpf(k_i, k_j, k_f, model)
-    values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
-                                        "cylinder_ratio": cylinder_ratio(params.cylinder_radius),
-                                        "cutoff_gap_ratio": params.cutoff_gap_ratio,
-                                        "regime": REGIMES[params.regime]}  # fmt: skip
-    return packed(BOB_COLUMNS, values)
-
-
-def bob_interaction_range(params: StrictModel, radius_i: float, radius_j: float) -> float:
-    """Largest surface gap [m] at which a separated pair conducts: cutoff_gap_ratio × R*."""
-    r_eff = radius_i if math.isinf(radius_j) else radius_i * radius_j / (radius_i + radius_j)
-    return params.cutoff_gap_ratio * r_eff
-
-
-@njit(cache=True, error_model="numpy")
-def bob_complete_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
-    r_eff = effective_radius(r_i, r_j)
-    k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
-    r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
-    cutoff = p[BOB_CUTOFF_RATIO] * r_eff
-    h = bob_conductance(
-        k_p, p[BOB_K_F], r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff, p[BOB_REGIME]
-    )
-    return h * (t_j - t_i)
-
-
-# --------------------------------------------------------- Batchelor & O'Brien, modified
-class BatchelorOBrienModifiedParams(BatchelorOBrienCompleteParams):
-    """Yun & Evans (2010) Comput. Geotech. 37, 991-998: BOB in series with the two particles'
-    inner resistances, H = (1/H_i + 1/H_j + 1/H_BOB)^-1, H_i = k_i π r̄² / R_i (spec 2.4),
-    for touching and separated pairs (the spec's "resistance of the interaction type").
-
-    H_BOB is batchelor_obrien_complete's conductance (same parameters). ``cylinder_radius`` is
-    r̄/R*, a named choice of the spec (as complete), or ``"dai2019_correlation"``: r̄ = 1.3121
-    k_pf^-0.19 min(R_i, R_j) (Dai, Hanaor & Gan 2019, Int. J. Therm. Sci. 142, 266-279; fitted
-    for k_pf < 1e3). A wall is isothermal: 1/H_j is dropped.
-    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime, 1 if dai2019_correlation].
-    """
-
-    cylinder_radius: float | CylinderName | Literal["dai2019_correlation"] = Field(
-        default=2.0,
-        description=CYLINDER_HELP + ", or dai2019_correlation: r̄ = 1.3121 k_pf^-0.19 "
-        "min(R_i, R_j) (Dai et al. 2019)",
-    )
-
-    @field_validator("cylinder_radius")
-    @classmethod
-    def _cylinder(cls, v: float | str) -> float | str:
-        return check_cylinder(v, ("dai2019_correlation",))
-
-
-def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) -> np.ndarray:
-    model = "direct_conduction.batchelor_obrien_modified"
-    k_i, k_j = _conductivities(pair, model)
-    k_f = pair.gas.thermal_conductivity
-    _check_kpf(k_i, k_j, k_f, model)
-    dai = params.cylinder_radius == "dai2019_correlation"
-    ratio = 0.0 if dai else cylinder_ratio(params.cylinder_radius)
-    values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
-                                        "cylinder_ratio": ratio,
-                                        "cutoff_gap_ratio": params.cutoff_gap_ratio,
-                                        "regime": REGIMES[params.regime],
-                                        "dai2019_correlation": 1.0 if dai else 0.0}  # fmt: skip
-    return packed(BOB_MODIFIED_COLUMNS, values)
-
-
-@njit(cache=True, error_model="numpy")
-def bob_modified_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
-    r_eff = effective_radius(r_i, r_j)
-    k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
-    k_f = p[BOB_K_F]
-    if p[BOB_DAI2019] == 1.0:
-        r_cyl = 1.3121 * (k_p / k_f) ** -0.19 * min(r_i, r_j)
-    else:
-        r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
-    cutoff = p[BOB_CUTOFF_RATIO] * r_eff
-    h_bob = bob_conductance(
-        k_p, k_f, r_eff, max(r_c, 0.0), overlap, p[BOB_BLEND], r_cyl, cutoff, p[BOB_REGIME]
-    )
-    if h_bob <= 0.0:
-        return 0.0
-    area = math.pi * r_cyl * r_cyl
-    res_i = r_i / (p[K_I] * area)
-    res_j = 0.0 if math.isinf(r_j) else r_j / (p[K_J] * area)
-    return (t_j - t_i) / ((res_i + res_j) + 1.0 / h_bob)
-
-
 # ------------------------------------------------------------------------- thermal pipes
 #: Rows of the two models with a 2D form: the head, then the disc thickness b [m] of a 2D
 #: case of discs (0: the 3D form, also for spheres kept in a plane).
@@ -341,7 +119,7 @@ PIPE_THICKNESS = 4
 
 def pack_pipe(params: StrictModel, pair: PairContext, model: str) -> np.ndarray:
     """[k_i, k_j, 0, 0, b]: b = ``pair.thickness`` (0 in 3D and for spheres in a plane)."""
-    values = head_values(_conductivities(pair, model)) | {"thickness": pair.thickness}
+    values = head_values(conductivities(pair, model)) | {"thickness": pair.thickness}
     return packed(PIPE_COLUMNS, values)
 
 
@@ -512,7 +290,7 @@ class Zhou2008Params(StrictModel):
 
 
 def _pack_collisional(params: StrictModel, pair: PairContext, model: str, c: float) -> np.ndarray:
-    values = head_values(_conductivities(pair, model), _heat_capacities(pair, model))
+    values = head_values(conductivities(pair, model), heat_capacities(pair, model))
     values |= {"e_star": pair.effective_youngs_modulus, "correction_factor": c,
                "static_model": _STATIC_MODELS[params.static_model]}  # fmt: skip
     return packed(COLLISIONAL_COLUMNS, values)
@@ -622,85 +400,45 @@ def direct_conduction_dispatch(
 
 
 # --------------------------------------------------------------------------- registration
-_BOB = "Batchelor & O'Brien (1977) Proc. R. Soc. Lond. A 355, 313-333"
 #: 2D (``planar``): rojek2014 and thermal_pipe have a 2D form for discs (a bar / strip of the
 #: disc thickness); the other models are the conduction between spheres (their 3D form holds
-#: for spheres kept in a plane, refused for discs); none needs no form.
+#: for spheres kept in a plane, refused for discs: register_model's default); none needs no
+#: form.
 _BOTH = ("disc", "sphere")
-_SPHERE = ("sphere",)
 _COLL = ("thermal_conductivity", "density", "specific_heat", "youngs_modulus", "poisson_ratio")
 
 
-def _register(name, model_id, kernel, params, summary, reference, pack=None, **kw):
-    """register() with this family's swap pairs; default pack: [k_i, k_j]."""
-
-    def pack_k(params: StrictModel, pair: PairContext) -> np.ndarray:
-        return packed(HEAD, head_values(_conductivities(pair, f"{FAMILY}.{name}")))
-
-    kw.setdefault("requires", ("thermal_conductivity",))
-    kw.setdefault("columns", HEAD)
-    kw.setdefault("planar", _SPHERE)
-    register(family=FAMILY, name=name, model_id=model_id, kernel=kernel, params=params,
-             pack=pack or pack_k, summary=summary, reference=reference, swap_pairs=SWAP_PAIRS,
-             **kw)  # fmt: skip
-
-
-_register(
+register_model(
     "none", NONE, none_rate, NoneParams, "no direct conduction", "-", pack_none, requires=(),
     planar=_BOTH,
 )  # fmt: skip
-_register(
-    "batchelor_obrien_simple", BATCHELOR_OBRIEN_SIMPLE, bob_simple_rate,
-    BatchelorOBrienSimpleParams,
-    "Q = 4 k̄ R_c ΔT, k̄ = k_i k_j/(k_i + k_j) (large-η Batchelor & O'Brien)",
-    _BOB + "; Cheng, Yu & Zulli (1999) Chem. Eng. Sci. 54, 4199-4209",
-)  # fmt: skip
-_register(
-    "batchelor_obrien_complete", BATCHELOR_OBRIEN_COMPLETE, bob_complete_rate,
-    BatchelorOBrienCompleteParams,
-    "Batchelor & O'Brien contact (η regimes) and separated-particle conduction",
-    _BOB + "; Dai, Hanaor & Gan (2019); Moscardini et al. (2018)",
-    pack_bob_complete, interaction_range=bob_interaction_range, columns=BOB_COLUMNS,
-    range_parameter="cutoff_gap_ratio",
-    uses_gas=("thermal_conductivity",),
-)  # fmt: skip
-_register(
-    "batchelor_obrien_modified", BATCHELOR_OBRIEN_MODIFIED, bob_modified_rate,
-    BatchelorOBrienModifiedParams,
-    "Batchelor & O'Brien in series with the particles' inner resistances (Yun & Evans)",
-    "Yun & Evans (2010) Comput. Geotech. 37, 991-998; Dai, Hanaor & Gan (2019) Int. J. Therm. "
-    "Sci. 142, 266-279",
-    pack_bob_modified, interaction_range=bob_interaction_range, columns=BOB_MODIFIED_COLUMNS,
-    range_parameter="cutoff_gap_ratio",
-    uses_gas=("thermal_conductivity",),
-)  # fmt: skip
-_register(
+register_model(
     "thermal_pipe", THERMAL_PIPE, thermal_pipe_rate, ThermalPipeParams,
     "thermal pipe Q = k_h A_p / d ΔT between the centres, A_p = π R_c² (2D: 2 R_c b)",
     "Jebahi et al. (2015) DEM for 3D continuous materials, Wiley; Hahn et al. (2011)",
     lambda params, pair: pack_pipe(params, pair, f"{FAMILY}.thermal_pipe"),
     columns=PIPE_COLUMNS, planar=_BOTH,
 )  # fmt: skip
-_register(
+register_model(
     "quintana_ruiz_campello2020", QUINTANA_RUIZ_CAMPELLO2020, qrc2020_rate,
     QuintanaRuizCampello2020Params,
     "thermal pipe with k̃ = (R_i + R_j)/(R_i/k_i + R_j/k_j), A = π R_c²",
     "Quintana-Ruiz & Campello (2020) J. Braz. Soc. Mech. Sci. Eng. 42, 387",
 )  # fmt: skip
-_register(
+register_model(
     "rojek2014", ROJEK2014, rojek2014_rate, Rojek2014Params,
     "bar Q = k_h b ΔT: 3D b = r̃ = (R_i + R_j)/2, 2D b = the disc thickness",
     "Rojek (2014) Comput. Part. Mech. 1, 71-84",
     lambda params, pair: pack_pipe(params, pair, f"{FAMILY}.rojek2014"),
     columns=PIPE_COLUMNS, planar=_BOTH,
 )  # fmt: skip
-_register(
+register_model(
     "sun_chen1988", SUN_CHEN1988, sun_chen1988_rate, SunChen1988Params,
     "collisional conduction U/t_c of a Hertz impact, then a static model after t_c",
     "Sun & Chen (1988) Int. J. Heat Mass Transf. 31, 969-975; Zhou, Yu & Zulli (2009)",
     pack_sun_chen1988, requires=_COLL, columns=COLLISIONAL_COLUMNS,
 )  # fmt: skip
-_register(
+register_model(
     "zhou2008", ZHOU2008, zhou2008_rate, Zhou2008Params,
     "collisional conduction with Zhou's explicit C(Fo), then a static model after t_c",
     "Zhou, Yu & Horio (2008) Chem. Eng. J. 139, 510-516; Zhou, Yu & Zulli (2009)",
