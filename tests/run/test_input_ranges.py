@@ -143,3 +143,32 @@ def test_lengths_in_another_unit_are_refused_before_the_run(tmp_path: Path) -> N
     # values in range run
     thermal = {"indirect_conduction": {"model": "musser2011", "min_separation": 1e-7}}
     assert _cli("validate", _case(tmp_path, thermal=thermal)).returncode == 0
+
+
+def test_tables_in_another_unit_are_warned_about(tmp_path: Path) -> None:
+    """A k(T) table in °C ([[20, 1.0], [100, 1.2]]: the particles at 293 K read its last row)
+    and a wall temperature table whose first change comes after the end (times in ms) ran
+    without a word."""
+    glass = _glass(thermal_conductivity="-", thermal_conductivity_table=[[20, 1.0], [100, 1.2]])
+    wall = {**CASE["walls"][0], "thermal": {"kind": "fixed", "temperature": [[0, 350], [2, 400]]}}
+    case = _case(tmp_path, materials=glass, walls=[wall])
+    res = _cli("run", case, "--output", tmp_path / "out", "--no-progress")
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (
+        "warning: materials.glass.thermal_conductivity_table (row 0, its lowest temperature): "
+        "20 K is below 200 K"
+    ) in res.stdout + res.stderr
+    assert (
+        "warning: walls.0.thermal.temperature: the table's first change is at t = 2 s (row 1), "
+        "after simulation.end_time = 0.0001 s: the value of row 0, 350 K, holds for the whole "
+        "run; table times are simulated seconds"
+    ) in res.stdout + res.stderr
+    # a table that changes within the run, in kelvin: nothing said
+    glass = _glass(thermal_conductivity="-", thermal_conductivity_table=[[293, 1.0], [400, 2]])
+    wall["thermal"]["temperature"] = [[0, 350], [5.0e-5, 400]]
+    res = _cli("validate", _case(tmp_path, materials=glass, walls=[wall]))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (
+        "warning: materials" not in res.stdout + res.stderr
+        and "first change" not in res.stdout + res.stderr
+    )

@@ -56,6 +56,36 @@ def insertion_warnings(case: Case) -> list[str]:
     return out
 
 
+def time_table_warnings(case: Case) -> list[str]:
+    """Tables of time (a fixed wall's temperature, the fluid's temperature and velocity) whose
+    first change (row 1) comes after the end of the run: the first row's value holds for the
+    whole run, and the table does nothing (times in ms, or a table of another case)."""
+    end = case.simulation.end_time
+    tables: list[tuple[str, list]] = []
+    for k, wall in enumerate(case.walls):
+        value = wall.thermal.temperature if wall.thermal.kind == "fixed" else None
+        if isinstance(value, list):
+            tables.append((f"walls.{k}.thermal.temperature", value))
+    fluid = case.thermal.fluid if case.thermal is not None else None
+    for name in ("temperature", "velocity"):
+        source = getattr(fluid, name, None)
+        if getattr(source, "kind", None) == "table":
+            tables.append((f"thermal.fluid.{name}", source.table))
+    out = []
+    for key, table in tables:
+        if len(table) < 2 or not table[1][0] > end:
+            continue
+        unit = " K" if key.endswith("temperature") else " m/s"
+        first = ", ".join(f"{v:g}" for v in table[0][1:])
+        first = f"[{first}]{unit}" if len(table[0]) > 2 else f"{first}{unit}"
+        out.append(
+            f"{key}: the table's first change is at t = {table[1][0]:g} s (row 1), after "
+            f"{end_time_text(case)}: the value of row 0, {first}, holds for the whole run; "
+            "table times are simulated seconds (are they in another unit?)"
+        )
+    return out
+
+
 #: A Verlet skin above this many largest particle diameters is warned about.
 SKIN_WARN_DIAMETERS = 2.0
 
@@ -188,6 +218,11 @@ def temperature_warnings(sim: Simulation) -> list[str]:
         if listed:
             i = int(np.argmin(listed))
             add(f"insertion.{k}.temperatures.{i}", listed[i])
+    for name, material in case.materials.items():
+        for prop in ("thermal_conductivity_table", "specific_heat_table"):
+            table = getattr(material, prop)
+            if table and th is not None:  # (the abscissae: T [K]; row 0 is the lowest)
+                add(f"materials.{name}.{prop} (row 0, its lowest temperature)", table[0][0])
     times = np.linspace(0.0, case.simulation.end_time, 2001)
     for k, wall in enumerate(case.walls):
         value = wall.thermal.temperature if wall.thermal.kind == "fixed" else None

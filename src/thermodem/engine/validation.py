@@ -32,6 +32,7 @@ from thermodem.engine.case_warnings import (
     skin_warnings,
     step_interval_warnings,
     temperature_warnings,
+    time_table_warnings,
 )
 from thermodem.engine.start_checks import (
     check_length_scales,
@@ -503,6 +504,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_length_scales(sim)
     notes = check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
     notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
+    notes += time_table_warnings(case)
     notes += temperature_warnings(sim) + step_interval_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
 
