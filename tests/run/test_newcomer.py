@@ -89,6 +89,19 @@ def test_version() -> None:
     assert proc.returncode == 0 and proc.stdout.strip() == f"thermodem {thermodem.__version__}"
 
 
+def test_python_dash_m_runs_the_same_command_line() -> None:
+    """``python -m thermodem`` (what users type when the script is not on PATH) is the same
+    command line, and its usage names the program ``thermodem``, not ``__main__.py``."""
+    version = subprocess.run([sys.executable, "-m", "thermodem", "--version"],
+                             capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert (
+        version.returncode == 0 and version.stdout.strip() == f"thermodem {thermodem.__version__}"
+    )
+    usage = subprocess.run([sys.executable, "-m", "thermodem", "run"], capture_output=True,
+                           text=True, timeout=60)  # fmt: skip
+    assert usage.returncode == 2 and "Usage: thermodem run" in usage.stderr, usage.stderr
+
+
 def test_run_steps_and_end_time_shorten_a_case(tmp_path: Path) -> None:
     case = _case_file(tmp_path)
     out = tmp_path / "steps"
