@@ -30,10 +30,10 @@ from thermodem.io.vtk import (
     PART_PARTICLES,
     PART_WALLS,
     PVDWriter,
-    wall_surface_mesh,
     write_particles_vtu,
     write_walls_vtu,
 )
+from thermodem.io.wall_mesh import wall_surface_mesh
 
 # ---------------------------------------------------------------------------- helpers
 
