@@ -172,3 +172,28 @@ def test_tables_in_another_unit_are_warned_about(tmp_path: Path) -> None:
         "warning: materials" not in res.stdout + res.stderr
         and "first change" not in res.stdout + res.stderr
     )
+
+
+def test_a_restart_with_other_particles_of_t0_is_refused(tmp_path: Path) -> None:
+    """run CASE --restart CKPT with a larger lattice in CASE ran on with the checkpoint's 8
+    particles, not the 27 the case describes, without a word; a changed material value still
+    restarts (a case may change its properties)."""
+    first = _case(tmp_path, "first")
+    out = tmp_path / "first_out"
+    assert _cli("run", first, "--output", out, "--no-progress").returncode == 0
+    ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
+    lattice = {**CASE["insertion"][0], "upper": [0.006, 0.006, 0.006]}
+    larger = _case(tmp_path, "larger", insertion=[lattice])
+    again = tmp_path / "again"
+    res = _cli("run", larger, "--restart", ckpt, "--output", again, "--end-time", "2e-4")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: insertion.0.upper.0 differs from the case stored in the checkpoint "
+        f"{ckpt}: the particles of t = 0 (lattice, random, list, file entries) are not "
+        "inserted again on a restart, so the run would continue the checkpoint's 8 particles"
+    ) in res.stderr
+    assert not again.exists()
+    denser = _case(tmp_path, "denser", materials=_glass(density=3000))
+    res = _cli("run", denser, "--restart", ckpt, "--output", again, "--end-time", "2e-4",
+               "--no-progress")  # fmt: skip
+    assert res.returncode == 0, res.stdout + res.stderr

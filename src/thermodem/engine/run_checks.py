@@ -158,8 +158,57 @@ def read_newest_checkpoint(checkpoints: list[Path]) -> Checkpoint:
         raise ConfigError(f"{exc}; nothing was changed in the run directory{hint}") from None
 
 
+def check_static_insertion(ckpt: Checkpoint, case: Case) -> None:
+    """Refuse a changed case whose static insertion entries (lattice, random, list, file: the
+    particles of t = 0) differ from the checkpoint's: they are not run again on a restart, so
+    the run would continue the checkpoint's particles, not the ones the case describes (the
+    entries' file paths aside: a case moved with its particle file is the same case). Pour
+    entries are compared when the state is loaded."""
+    from thermodem.config.dump import case_to_dict
+
+    def static(entries: Any) -> tuple[list[int], list[Any]]:
+        """(index in ``insertion``, entry without its file path) of every static entry."""
+        if not isinstance(entries, list):
+            return [], []
+        kept = [
+            (k, {key: v for key, v in e.items() if key != "path"} if isinstance(e, dict) else e)
+            for k, e in enumerate(entries)
+            if not (isinstance(e, dict) and e.get("kind") == "pour")
+        ]
+        return [k for k, _ in kept], [e for _, e in kept]
+
+    if case is None:
+        return
+    # both through the schema, so that keys a later version added with their defaults compare
+    # equal (the stored case of an older checkpoint lacks them)
+    index, mine = static(case_to_dict(case).get("insertion"))
+    _, theirs = static(case_to_dict(ckpt.case()).get("insertion"))
+    where = first_difference(mine, theirs)
+    if where is None:
+        return
+    head, _, rest = where.partition(".")
+    if head.isdigit() and int(head) < len(index):  # (the entry's index in the case)
+        where = f"insertion.{index[int(head)]}" + (f".{rest}" if rest else "")
+    else:
+        where = "insertion (its static entries: another number of them)"
+    particles = ckpt.state.get("particles", {})
+    n = int(particles["radius"].shape[0]) if "radius" in particles else None
+    held = f"the checkpoint's {n} particles" if n is not None else "the checkpoint's particles"
+    raise ConfigError(
+        f"{where} differs from the case stored in the checkpoint {ckpt.path}: the particles "
+        f"of t = 0 (lattice, random, list, file entries) are not inserted again on a "
+        f"restart, so the run would continue {held}, not the ones this case describes; "
+        "nothing was "
+        "changed. Allowed: the checkpoint's static insertion entries (as in the "
+        "case.resolved.yaml of the run that wrote it), or a new run from t = 0 without "
+        "--restart"
+    )
+
+
 def restored_simulation(ckpt: Checkpoint, threads: int | None, case: Case) -> Simulation:
-    """A simulation continuing from ``ckpt`` (ConfigError for a state that does not load)."""
+    """A simulation continuing from ``ckpt`` (ConfigError for a state that does not load, or
+    a changed case whose t = 0 particles differ from the checkpoint's)."""
+    check_static_insertion(ckpt, case)
     try:
         return Simulation.from_checkpoint(ckpt, threads=threads, case=case)
     except ConfigError as exc:
