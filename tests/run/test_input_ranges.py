@@ -197,3 +197,22 @@ def test_a_restart_with_other_particles_of_t0_is_refused(tmp_path: Path) -> None
     res = _cli("run", denser, "--restart", ckpt, "--output", again, "--end-time", "2e-4",
                "--no-progress")  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_etc_of_a_packing_that_touches_nowhere_names_the_packing(tmp_path: Path) -> None:
+    """thermodem etc of a lattice whose spacing is the diameter (no contact at t = 0) said
+    'steady state: ... exchange heat with no fixed temperature (a thermal.walls kind fixed,
+    thermal.fixed_temperature, ...)': advice etc itself refuses; --axes zz measured z twice."""
+    lattice = {**CASE["insertion"][0], "upper": [0.01, 0.01, 0.01], "spacing": 0.0016}
+    case = _case(tmp_path, walls=[], insertion=[lattice])
+    res = _cli("etc", case, "--axes", "z")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: effective conductivity along z: 108 particles in 9 clusters are linked to "
+        "neither boundary layer of 0.0016 m by conducting pairs, so the packing does not "
+        "conduct from one layer to the other"
+    ) in res.stderr
+    assert "thermal.walls kind fixed" not in res.stderr
+    res = _cli("etc", case, "--axes", "zz")
+    assert res.returncode == 2
+    assert "axes = 'zz'; allowed: letters of 'xyz', each once" in res.stderr

@@ -113,9 +113,10 @@ def effective_conductivity(
     _check_case(sim)
     allowed = "xy" if getattr(sim, "planar", False) else "xyz"  # 2D: in the plane
     bad = [a for a in axes if a not in allowed]
-    if bad or not axes:
+    if bad or not axes or len(set(axes)) < len(axes):
         raise ConfigError(
-            f"effective conductivity: axes = {axes!r}; allowed: letters of {allowed!r}"
+            f"effective conductivity: axes = {axes!r}; allowed: letters of {allowed!r}, "
+            "each once"
         )
     p = sim.particles
     if p.count == 0:
@@ -161,7 +162,23 @@ def effective_conductivity(
             p.temperature[:] = base_temperature + 0.5 * difference
             p.temperature[hot] = base_temperature + difference
             p.temperature[cold] = base_temperature
-            net = solver.steady(extra_fixed=hot | cold)
+            try:
+                net = solver.steady(extra_fixed=hot | cold)
+            except ConfigError as exc:
+                if not str(exc).startswith("steady state:"):
+                    raise
+                # (the steady solver's advice, a fixed wall or particle, is what etc refuses)
+                raise ConfigError(
+                    f"effective conductivity along {name}: "
+                    + str(exc).split(": ", 1)[1].split(" exchange heat")[0]
+                    + f" are linked to neither boundary layer of {s:.4g} m by conducting "
+                    "pairs, so the packing does not conduct from one layer to the other (the "
+                    "contacts come from the overlaps at t = 0: a lattice whose spacing is the "
+                    "diameter touches nowhere; direct_conduction: none conducts through no "
+                    "contact); allowed: a packing whose particles overlap (a bed settled by a "
+                    "run, as a particle file), or a model that conducts across gaps "
+                    "(thermal.indirect_conduction)"
+                ) from None
             t = p.temperature
             q = net.rhs - net.conductance @ t  # heat into each particle [W]
             q_hot = -float(q[hot].sum())
@@ -201,8 +218,10 @@ def periodic_gradient(
 
     _check_case(sim)
     bad = [a for a in axes if a not in AXES]
-    if bad or not axes:
-        raise ConfigError(f"effective conductivity: axes = {axes!r}; allowed: letters of 'xyz'")
+    if bad or not axes or len(set(axes)) < len(axes):
+        raise ConfigError(
+            f"effective conductivity: axes = {axes!r}; allowed: letters of 'xyz', each once"
+        )
     p = sim.particles
     if p.count == 0:
         raise ConfigError("effective conductivity: the case has no particles")
