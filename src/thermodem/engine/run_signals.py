@@ -1,9 +1,14 @@
 """Signals (SIGINT, SIGTERM) during a run (:mod:`thermodem.engine.runner` and the MPI runner).
 
 While the run steps, :class:`StopRequest`: the first signal asks the loop to stop after the
-current step with a checkpoint, a second one aborts at once. While it is being set up (the
-simulation built, the checks, the step-0 outputs), :class:`Starting`: either signal stops at
-once and :func:`not_started` records it so that the same command can be run again.
+current step with a checkpoint, a second one aborts at once. Once the run is stopping or
+ending (the interrupt checkpoint, the record of a failure, the final outputs:
+:meth:`StopRequest.finish`), a further signal is noted with a line and not obeyed, so that
+the checkpoint and ``status.json`` are finished. While it is being set up (the simulation
+built, the checks, the step-0 outputs), :class:`Starting`: either signal stops at once and
+:func:`not_started` records it so that the same command can be run again; on several MPI
+ranks :class:`StartingTogether`: the signal is noted and every rank stops at the next point
+the ranks agree on (:mod:`thermodem.mpi.runner`).
 """
 
 from __future__ import annotations
@@ -47,15 +52,37 @@ class StopRequest(SignalHandlers):
     def __init__(self, log: RunLog) -> None:
         super().__init__()
         self.log = log
+        self.finishing = ""
+
+    def finish(self, what: str) -> None:
+        """From here on the run is stopping or ending (``what``: "writing the interrupt
+        checkpoint", ...): a signal is noted with a line, not obeyed. Obeyed, a second signal
+        while the interrupt checkpoint was written exited without a word and left status.json
+        saying 'running' (SIGTERM), or was reported as a stop before the first step (SIGINT)."""
+        self.finishing = what
 
     def _handler(self, signum: int, frame: object) -> None:
+        name = signal.Signals(signum).name
+        if self.finishing:
+            self.signum = self.signum or signum
+            self._say(
+                f"{name} received while {self.finishing}: finishing it first, the run stops "
+                "as soon as it is on disk (stopping halfway would lose it)"
+            )
+            return
         if self.signum:
             raise KeyboardInterrupt
         self.signum = signum
-        self.log.info(
-            f"{signal.Signals(signum).name} received: finishing the step and writing a "
-            "checkpoint (send it again to abort without one)"
+        self._say(
+            f"{name} received: finishing the step and writing a checkpoint (send it again to "
+            "abort without one)"
         )
+
+    def _say(self, message: str) -> None:
+        try:
+            self.log.info(message)
+        except RuntimeError:  # (the signal came while the run was writing the same stream)
+            pass
 
 
 class Starting(SignalHandlers):
@@ -68,6 +95,23 @@ class Starting(SignalHandlers):
     def _handler(self, signum: int, frame: object) -> None:
         self.signum = signum
         raise KeyboardInterrupt
+
+
+class StartingTogether(Starting):
+    """:class:`Starting` on several MPI ranks: the set-up is full of collectives (the build,
+    the checks, the step-0 gathers), so a rank that stopped at once would leave the others
+    waiting in one. The first signal is noted; the ranks agree on it at fixed points of the
+    set-up and stop there together (:mod:`thermodem.mpi.runner`). A second one stops this
+    rank at once (KeyboardInterrupt, ``agreed`` False): the job is then aborted."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.agreed = False
+
+    def _handler(self, signum: int, frame: object) -> None:
+        if self.signum:
+            raise KeyboardInterrupt
+        self.signum = signum
 
 
 def not_started(output: Path, log: RunLog, status: Status, signum: int) -> RunInterrupted:

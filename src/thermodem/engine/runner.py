@@ -32,7 +32,9 @@ dropped at a restart with a message.
 Failures: a :class:`SimulationError` from the engine writes ``failed.h5`` (the state at the
 failure, for inspection) and is raised again with the last good checkpoint named in the
 message. SIGINT (Ctrl-C) and SIGTERM finish the current step, write a checkpoint and raise
-:class:`~thermodem.errors.RunInterrupted`; a second signal aborts at once without writing.
+:class:`~thermodem.errors.RunInterrupted`; a second signal during a step aborts at once
+without writing, one while the interrupt checkpoint (or the failure's record, or the final
+outputs) is being written is noted and the writing finished (engine/run_signals.py).
 """
 
 from __future__ import annotations
@@ -275,17 +277,24 @@ def _unwritable(sim: Simulation, run: _Run, exc: OSError, ranks: int = 1) -> Sim
 
 
 def _loop(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
+    # the signal handlers stay until the run's end is on disk: once it is stopping or ending
+    # (the interrupt checkpoint, the record of a failure, the final outputs) a signal is
+    # noted, not obeyed (run_signals.StopRequest.finish)
+    with StopRequest(run.log) as stop:
+        return _stepped(sim, run, fresh, stop)
+
+
+def _stepped(sim: Simulation, run: _Run, fresh: bool, stop: StopRequest) -> Simulation:
     log = run.log
     if fresh:
         _first_outputs(sim, run)
     run.status.update(status="running", pid=os.getpid(), message="", **_status_numbers(sim, run))
     in_step = False
-    stop = None
     progress = Progress(log, sim, run.total, run.log_interval, run.progress_bar)
     started = wallclock.perf_counter()
     start_step = sim.step_count
     try:
-        with StopRequest(log) as stop, progress, warnings.catch_warnings():
+        with progress, warnings.catch_warnings():
             warnings.simplefilter("always", RuntimeWarning)
             warnings.showwarning = lambda msg, cat, *a, **k: (
                 log.info if issubclass(cat, RunNotice) else log.warn
@@ -309,10 +318,15 @@ def _loop(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
                     sim.complete_rates()
                     run.callback(sim)
     except SimulationError as exc:
+        stop.finish("writing the state at the failure and the record of it")
         raise _failed(sim, run, exc) from None
     except KeyboardInterrupt:
-        raise _interrupted(sim, run, in_step, stop.signum if stop else 0) from None
+        stop.finish(
+            "recording the stop in status.json" if in_step else "writing the interrupt checkpoint"
+        )
+        raise _interrupted(sim, run, in_step, stop.signum) from None
     # the last step: a row, a frame and a checkpoint even off their schedules
+    stop.finish("writing the final outputs")
     if run.timeseries.last_step != sim.step_count:
         run.timeseries.write(sim)
     if run.frames and run.frames.last_step != sim.step_count:
@@ -496,25 +510,27 @@ def run_case(
         run_id = status.data["run_id"]
         starting = Starting()
         try:
-            with starting:
-                sim = Simulation(case, threads=threads)
-                for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
-                    runlog.warn(warning)
-                _header(runlog, sim, threads, output)
-                run = _make_run(
-                    sim, output, runlog, status, False, progress, log_interval, callback, every
-                )
-                run.run_id = run_id
-                _first_outputs(sim, run)
+            try:
+                with starting:
+                    sim = Simulation(case, threads=threads)
+                    for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
+                        runlog.warn(warning)
+                    _header(runlog, sim, threads, output)
+                    run = _make_run(
+                        sim, output, runlog, status, False, progress, log_interval, callback, every
+                    )
+                    run.run_id = run_id
+                    _first_outputs(sim, run)
+            except KeyboardInterrupt:
+                raise not_started(output, runlog, status, starting.signum) from None
+            except ConfigError as exc:
+                runlog.file_only(f"error: {exc}")
+                status.update(status="failed", message=str(exc), refused_input=True)
+                raise
+            # a signal from here on is the loop's (run_signals.StopRequest), not a stop before
+            # the first step (a second SIGINT while the interrupt checkpoint was written was
+            # reported as one)
             return _drive(sim, run, fresh=False)
-        except RunInterrupted:
-            raise
-        except KeyboardInterrupt:
-            raise not_started(output, runlog, status, starting.signum) from None
-        except ConfigError as exc:
-            runlog.file_only(f"error: {exc}")
-            status.update(status="failed", message=str(exc), refused_input=True)
-            raise
         finally:
             runlog.close()
     finally:
