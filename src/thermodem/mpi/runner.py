@@ -12,7 +12,9 @@ Failures: a :class:`SimulationError` is agreed inside the step (every rank raise
 message, :meth:`DistributedSimulation.agree`), the state at the failure is gathered to
 ``failed.h5`` and the message names the last good checkpoint, on every rank. A signal
 (SIGINT, SIGTERM) on any rank stops every rank after the same step with a checkpoint (the
-stop request travels with the step's reduction). An output the system refuses on rank 0 (a
+stop request travels with the step's reduction); one while the run is being set up is agreed
+at fixed points of the set-up and every rank stops there (engine/run_signals.py:
+StartingTogether, not_started). An output the system refuses on rank 0 (a
 full disk, the run directory removed) is agreed after each write: every rank stops with rank
 0's message (engine/runner.py's ``_unwritable``). Any other exception on one rank cannot be
 agreed (the others wait in a collective): the rank prints it and aborts the MPI job
@@ -23,6 +25,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import time as wallclock
 import warnings
 from collections.abc import Callable
@@ -34,7 +37,7 @@ from thermodem.config.schema import Case
 from thermodem.engine import runner as R
 from thermodem.engine.checks import check_simulation_time_step
 from thermodem.engine.progress import Progress
-from thermodem.engine.run_signals import StopRequest
+from thermodem.engine.run_signals import StartingTogether, StopRequest, not_started
 from thermodem.engine.validation import (
     check_completeness,
     format_duration,
@@ -166,27 +169,38 @@ def _outputs(
     )
 
 
-def _drive(sim: DistributedSimulation, out: _Outputs, fresh: bool) -> DistributedSimulation:
-    """The time loop of every rank (engine/runner.py: _drive, with collective outputs)."""
+def _first_outputs(sim: DistributedSimulation, out: _Outputs) -> None:
+    """The outputs of the starting state (collective): a row, a frame and the first
+    checkpoint."""
+    out.series(sim)
+    if out.frame_every:
+        out.frame(sim)
+    out.checkpoint(sim, "checkpoint")
+
+
+def _drive(sim: DistributedSimulation, out: _Outputs, pending: int = 0) -> DistributedSimulation:
+    """The time loop of every rank (engine/runner.py: _loop, with collective outputs); the
+    signal handlers stay until the run's end is on disk. ``pending``: a signal noted after
+    the set-up's last agreed point (run_signals.StartingTogether): the run stops after the
+    first step."""
+    with StopRequest(out.run.log if out.run is not None else _Silent()) as stop:
+        stop.signum = pending
+        return _stepped(sim, out, stop)
+
+
+def _stepped(sim: DistributedSimulation, out: _Outputs, stop: StopRequest) -> DistributedSimulation:
     run = out.run
     root = run is not None
     log = run.log if root else None
-    if fresh:
-        out.series(sim)
-        if out.frame_every:
-            out.frame(sim)
-        out.checkpoint(sim, "checkpoint")
-    elif root:
-        out.last_checkpoint = run.last_checkpoint
     if root:
+        out.last_checkpoint = run.last_checkpoint
         run.status.update(status="running", pid=os.getpid(), message="", **_status(sim, run))
     progress = Progress(log, sim, out.total, run.log_interval, run.progress_bar) if root else None
     started = wallclock.perf_counter()
     start_step = sim.step_count
     in_step = False
-    stop = StopRequest(log if root else _Silent())
     try:
-        with stop, progress or _NoContext(), warnings.catch_warnings():
+        with progress or _NoContext(), warnings.catch_warnings():
             warnings.simplefilter("always", RuntimeWarning)
             if root:
                 warnings.showwarning = lambda msg, cat, *a, **k: (
@@ -197,6 +211,10 @@ def _drive(sim: DistributedSimulation, out: _Outputs, fresh: bool) -> Distribute
                 in_step = True
                 sim.step()
                 in_step = False
+                if sim.stop_agreed:
+                    # every rank stops after this step: a signal from here on is noted (one
+                    # obeyed on one rank would leave the others in a collective)
+                    stop.finish("writing the interrupt checkpoint")
                 k = sim.step_count
                 if k % out.series_every == 0:
                     out.series(sim)
@@ -215,6 +233,7 @@ def _drive(sim: DistributedSimulation, out: _Outputs, fresh: bool) -> Distribute
     except _OutputRefused as exc:
         raise SimulationError(str(exc), sim.step_count, sim.time, -1) from None
     except SimulationError as exc:
+        stop.finish("writing the state at the failure and the record of it")
         raise _failed(sim, out, exc) from None
     except KeyboardInterrupt:
         if in_step or not sim.stop_agreed:
@@ -224,7 +243,9 @@ def _drive(sim: DistributedSimulation, out: _Outputs, fresh: bool) -> Distribute
                 log.info(f"aborted during step {sim.step_count + 1}: no checkpoint written; "
                          f"last good state: {out.last_checkpoint}")  # fmt: skip
             sim.comm.Abort(128 + (stop.signum or signal.SIGINT))
+        stop.finish("writing the interrupt checkpoint")
         raise _interrupted(sim, out, stop.signum) from None
+    stop.finish("writing the final outputs")
     # the last step: a row, a frame and a checkpoint even off their schedules (rank 0 knows
     # what its writers wrote last)
     last = (run.timeseries.last_step, run.frames.last_step if run.frames else -1) if root else None
@@ -372,62 +393,123 @@ def run_distributed(
     comm = _comm()
     root = comm.Get_rank() == 0
     output = Path(output)
-    ckpt = None
-    if checkpoint is not None:
-        ckpt = _read_on_all(comm, checkpoint)
-        case = case or ckpt.case()
     lock = runlog = status = None
-    error: Exception | None = None
-    if root:
-        try:
-            check_completeness(case)
-            R.check_output_path(output)
-            if output.is_dir():
-                R.refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
-            R.prepare_output_dir(output, overwrite)
-            lock = R.RunLock(output)
-            lock.acquire()
-            for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
-                (output / stale).unlink(missing_ok=True)
-            for old in list_checkpoints(output / CHECKPOINT_DIR):
-                old.unlink()
-            (output / "case.resolved.yaml").write_text(R.resolved_case_yaml(case))
-            runlog, status = R._open(output, log, append=False, case_name=case_name)
-            R._compile_note(runlog, case)
-        except ConfigError as exc:
-            error = exc
-            if lock is not None:
-                lock.release()
-    _agreed(comm, error)
+    starting = StartingTogether()
     try:
-        try:
-            sim = _build(case, threads, rebalance_threshold, ckpt)
-            # the checks of the serial runner before the first step (engine/runner.py:
-            # run_case, run_from_checkpoint), collective: a refusal on one rank is every rank's
-            warned = _time_step_check(sim) if ckpt is not None else pre_run_checks(sim)
-        except ConfigError as exc:
+        with starting:
+            ckpt = None
+            if checkpoint is not None:
+                ckpt = _read_on_all(comm, checkpoint)
+                case = case or ckpt.case()
+            error: Exception | None = None
             if root:
-                runlog.file_only(f"error: {exc}")
-                status.update(status="failed", message=str(exc), refused_input=True)
-            raise
-        run = None
-        if root:
-            if ckpt is not None:
-                runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
-            for warning in warned:
-                runlog.warn(warning)
-            run = R._make_run(sim, output, runlog, status, False, progress, log_interval,
-                              None, 1)  # fmt: skip
-            run.run_id = status.data["run_id"]
-        if root:
-            _header(runlog, sim, output)
-        else:
-            sim.halo_summary()
-        return _drive(sim, _outputs(sim, run, callback, every), fresh=True)
+                try:
+                    check_completeness(case)
+                    R.check_output_path(output)
+                    if output.is_dir():
+                        R.refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
+                    R.prepare_output_dir(output, overwrite)
+                    lock = R.RunLock(output)
+                    lock.acquire()
+                    for stale in (STATUS_FILE, FAILED_FILE, TIMESERIES_FILE):
+                        (output / stale).unlink(missing_ok=True)
+                    for old in list_checkpoints(output / CHECKPOINT_DIR):
+                        old.unlink()
+                    (output / "case.resolved.yaml").write_text(R.resolved_case_yaml(case))
+                    runlog, status = R._open(output, log, append=False, case_name=case_name)
+                    R._compile_note(runlog, case)
+                except ConfigError as exc:
+                    error = exc
+                    if lock is not None:
+                        lock.release()
+                        lock = None
+            _agreed(comm, error)
+            _together(comm, starting)
+            try:
+                sim = _build(case, threads, rebalance_threshold, ckpt)
+                # the checks of the serial runner before the first step (engine/runner.py:
+                # run_case, run_from_checkpoint), collective: a refusal on one rank is every
+                # rank's
+                warned = _time_step_check(sim) if ckpt is not None else pre_run_checks(sim)
+            except ConfigError as exc:
+                if root:
+                    runlog.file_only(f"error: {exc}")
+                    status.update(status="failed", message=str(exc), refused_input=True)
+                raise
+            run = None
+            if root:
+                if ckpt is not None:
+                    runlog.info(
+                        f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)"
+                    )
+                for warning in warned:
+                    runlog.warn(warning)
+                run = R._make_run(sim, output, runlog, status, False, progress, log_interval,
+                                  None, 1)  # fmt: skip
+                run.run_id = status.data["run_id"]
+                _header(runlog, sim, output)
+            else:
+                sim.halo_summary()
+            _together(comm, starting)
+            out = _outputs(sim, run, callback, every)
+            _first_outputs(sim, out)
+            _together(comm, starting)
+    except KeyboardInterrupt:
+        try:
+            raise _not_started(comm, starting, output, runlog, status) from None
+        finally:
+            _close(runlog, lock)
+    except BaseException:
+        _close(runlog, lock)
+        raise
+    try:
+        return _drive(sim, out, pending=starting.signum)
     finally:
-        if root:
-            runlog.close()
-            lock.release()
+        _close(runlog, lock)
+
+
+def _together(comm: Any, starting: StartingTogether) -> None:
+    """A point of the set-up where the ranks agree on a signal (one allreduce): if one
+    reached any rank, every rank stops here (KeyboardInterrupt, ``starting.agreed``)."""
+    signum = int(comm.allreduce(starting.signum, op=_max_op()))
+    if signum:
+        starting.signum, starting.agreed = signum, True
+        raise KeyboardInterrupt
+
+
+def _not_started(
+    comm: Any,
+    starting: StartingTogether,
+    output: Path,
+    runlog: R.RunLog | None,
+    status: R.Status | None,
+) -> RunInterrupted:
+    """A signal while the ranks were set up (engine/run_signals.py: not_started, written by
+    rank 0): agreed, every rank is here and returns the same RunInterrupted; a second signal
+    on this rank, the others may be waiting in a collective: the job is aborted (rank 0, if
+    it is this rank, writes the record first)."""
+    signum = starting.signum or signal.SIGINT
+    interrupted = None
+    if runlog is not None and status is not None:  # (rank 0, once the directory is prepared)
+        interrupted = not_started(output, runlog, status, signum)
+    if not starting.agreed:
+        if interrupted is None:
+            print(
+                f"interrupted ({signal.Signals(signum).name}) again on MPI rank "
+                f"{comm.Get_rank()} while the run was being set up: aborting every rank",
+                file=sys.stderr,
+                flush=True,
+            )
+        comm.Abort(128 + signum)
+    message = comm.bcast(str(interrupted) if interrupted is not None else None, root=0)
+    return interrupted or RunInterrupted(message, checkpoint=None, exit_code=128 + signum)
+
+
+def _close(runlog: R.RunLog | None, lock: R.RunLock | None) -> None:
+    if runlog is not None:
+        runlog.close()
+    if lock is not None:
+        lock.release()
 
 
 def restart_distributed(
@@ -520,7 +602,7 @@ def restart_distributed(
             if root:
                 runlog.info(f"already at the end time (step {sim.step_count}); nothing to do")
             return sim
-        return _drive(sim, out, fresh=False)
+        return _drive(sim, out)
     finally:
         if root:
             runlog.close()
