@@ -216,3 +216,27 @@ def test_etc_of_a_packing_that_touches_nowhere_names_the_packing(tmp_path: Path)
     res = _cli("etc", case, "--axes", "zz")
     assert res.returncode == 2
     assert "axes = 'zz'; allowed: letters of 'xyz', each once" in res.stderr
+
+
+def test_export_and_plot_of_a_run_that_never_started_say_why(tmp_path: Path) -> None:
+    """export and plot of the record a refused run leaves said 'no checkpoints ...; give
+    --frame N or --checkpoint PATH' and 'is it a thermodem output?' (it is: its status.json
+    holds the refusal)."""
+    glass = _glass(surface_roughness=0.01, microhardness=1.0e9, surface_slope=0.1,
+                   thermal_accommodation=0.9)  # fmt: skip
+    case = _case(tmp_path, "rough", materials=glass,
+                 thermal={"direct_conduction": "resistance_network"})  # fmt: skip
+    out = tmp_path / "out"
+    assert _cli("run", case, "--output", out, "--no-progress").returncode == 2
+    for command in ("export", "plot"):
+        res = _cli(command, out)
+        assert res.returncode == 2, res.stdout + res.stderr
+        assert (
+            f"the run in '{out}' never started (status.json: its input was refused: "
+            "materials.glass.surface_roughness = 0.01 m" in res.stderr
+        )
+        assert (
+            f"after fixing the case (rough) run it again: thermodem run CASE --output {out}"
+            in res.stderr
+        )
+    assert "give --frame N" in _cli("export", tmp_path).stderr  # (not a run record)

@@ -226,9 +226,11 @@ def export_particles(
         if checkpoint is None:
             found = list_checkpoints(directory / "checkpoints")
             if not found:
+                from thermodem.io.run_files import never_ran
+
                 raise ConfigError(
-                    f"no checkpoints in {directory / 'checkpoints'}; give --frame N or "
-                    "--checkpoint PATH"
+                    f"no checkpoints in {directory / 'checkpoints'}"
+                    + (never_ran(directory) or "; give --frame N or --checkpoint PATH")
                 )
             checkpoint = found[-1]
         table = from_checkpoint(Path(checkpoint))

@@ -94,7 +94,12 @@ def plot_directory(
     directory = Path(directory)
     path = directory / TIMESERIES_FILE
     if not path.is_file():
-        raise ConfigError(f"{path} does not exist: is {str(directory)!r} a thermodem output?")
+        from thermodem.io.run_files import never_ran
+
+        why = never_ran(directory) if directory.is_dir() else ""
+        raise ConfigError(
+            f"{path} does not exist" + (why or f": is {str(directory)!r} a thermodem output?")
+        )
     data = read_timeseries(path)
     if "time" not in data or data["time"].size == 0:
         raise ConfigError(f"{path} has no rows yet")

@@ -48,6 +48,25 @@ def refused_run_record(path: Path) -> bool:
     return status.get("refused_input") is True or status.get("not_started") is True
 
 
+def never_ran(path: Path) -> str:
+    """'' or, for the record of a run refused (or stopped) before its first step, what to say
+    instead of 'no checkpoints' / 'no time series': the run's own message and how to run it
+    again (export, plot and info of such a directory)."""
+    if not refused_run_record(path):
+        return ""
+    status = Status.read(path)
+    case = f" ({status['case']})" if status.get("case") else ""
+    why = (
+        f"its input was refused: {status.get('message')}"
+        if status.get("refused_input") is True
+        else "it was stopped while it was being set up"
+    )
+    return (
+        f"; the run in {str(path)!r} never started ({STATUS_FILE}: {why}); after fixing the "
+        f"case{case} run it again: thermodem run CASE --output {path}"
+    )
+
+
 def prepare_output_dir(path: Path, overwrite: bool) -> None:
     """Refuse an existing non-empty directory unless ``overwrite`` (never silently); the
     record of a refused input (:func:`refused_run_record`) counts as empty."""
