@@ -240,3 +240,17 @@ def test_export_and_plot_of_a_run_that_never_started_say_why(tmp_path: Path) -> 
             in res.stderr
         )
     assert "give --frame N" in _cli("export", tmp_path).stderr  # (not a run record)
+
+
+def test_a_heat_capacity_ratio_no_gas_has_is_refused(tmp_path: Path) -> None:
+    """thermal.gas.heat_capacity_ratio: 40 ran (the Smoluchowski parameter read 2γ/(1 + γ));
+    5/3 written as 1.67 still runs."""
+    glass = _glass(thermal_accommodation=0.9)
+    for gamma, status in ((40, 2), (1.67, 0)):
+        thermal = {"indirect_conduction": "vargas_mccarthy2002",
+                   "gas": {"heat_capacity_ratio": gamma}}  # fmt: skip
+        res = _cli("validate", _case(tmp_path, materials=glass, thermal=thermal))
+        assert res.returncode == status, res.stdout + res.stderr
+    assert ("thermal.gas.heat_capacity_ratio: above 5/3, the largest c_p/c_v of a gas") in _cli(
+        "validate", _case(tmp_path, thermal={"gas": {"heat_capacity_ratio": 40}})
+    ).stderr

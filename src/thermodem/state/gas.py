@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 
@@ -28,6 +28,9 @@ BOLTZMANN = 1.380649e-23  # J/K (exact, SI 2019)
 
 #: Air at 300 K, 1 atm: what the mean free path is computed from when the case gives neither
 #: ``mean_free_path`` nor these keys (each missing one takes its air value).
+#: The largest heat capacity ratio accepted: 5/3 of a monatomic ideal gas, as 1.67 (rounded).
+GAMMA_MAX = 1.67
+
 AIR_KINETIC = {"pressure": 101325.0, "temperature": 300.0, "molecular_diameter": 3.66e-10}
 
 
@@ -70,6 +73,19 @@ class GasProperties(StrictModel):
     molar_mass: float = Field(
         default=0.0289647, gt=0, description="M [kg/mol] for the ideal-gas density (air)"
     )
+
+    @field_validator("heat_capacity_ratio")
+    @classmethod
+    def _ideal_gas_ratio(cls, v: float) -> float:
+        # γ = 1 + 2/f for f >= 3 degrees of freedom: 5/3 (monatomic) is the largest; 1.67
+        # (5/3 rounded) is allowed. A larger value is not a gas's (γ = 40 ran silently).
+        if v > GAMMA_MAX:
+            raise ValueError(
+                "above 5/3, the largest c_p/c_v of a gas "
+                "(monatomic 5/3, diatomic 1.4, polyatomic below; the rarefied-gas models read "
+                f"it through 2γ/(1 + γ)); allowed: 1 <= heat_capacity_ratio <= {GAMMA_MAX:g}"
+            )
+        return v
 
     @model_validator(mode="after")
     def _mean_free_path_source(self) -> GasProperties:
