@@ -254,3 +254,35 @@ def test_a_heat_capacity_ratio_no_gas_has_is_refused(tmp_path: Path) -> None:
     assert ("thermal.gas.heat_capacity_ratio: above 5/3, the largest c_p/c_v of a gas") in _cli(
         "validate", _case(tmp_path, thermal={"gas": {"heat_capacity_ratio": 40}})
     ).stderr
+
+
+def test_a_contact_radius_with_another_contact_law_is_refused(tmp_path: Path) -> None:
+    """lu2017 / morris2016_area_time take the normal law and k_n as their own parameters:
+    a normal_stiffness of 5000 N/m beside normal: linear of 1000 N/m, lu2017 on a Hertz law,
+    and morris2016_area_time's default contact_law 'hertz' on a linear law ran silently."""
+    glass = _glass(youngs_modulus_real=6.0e10)
+    linear = {"normal": {"model": "linear", "stiffness": 1000.0}}
+    cases = [
+        (linear, {"model": "lu2017", "normal_stiffness": 5000.0},
+         "thermal.contact_radius.normal_stiffness = 5000 N/m but contact.normal.stiffness = "
+         "1000 N/m: 'lu2017' needs the k_n of the simulation's linear spring"),
+        ({}, {"model": "lu2017", "normal_stiffness": 1000.0},
+         "thermal.contact_radius: 'lu2017' is the correction of a linear spring contact law "
+         "(normal_stiffness k_n), but contact.normal is 'hertz'"),
+        (linear, {"model": "morris2016_area_time"},
+         "thermal.contact_radius.contact_law: 'hertz' (the default) but contact.normal is "
+         "'linear': the collision time t_c of morris2016_area_time would be that of another "
+         "contact law than the one the simulation runs; allowed: contact_law: linear with "
+         "normal_stiffness: 1000 (contact.normal.stiffness)"),
+    ]  # fmt: skip
+    for contact, radius, message in cases:
+        case = _case(tmp_path, materials=glass, contact=contact,
+                     thermal={"contact_radius": radius})  # fmt: skip
+        res = _cli("run", case, "--output", tmp_path / "out", "--no-progress")
+        assert res.returncode == 2, res.stdout + res.stderr
+        assert message in res.stderr
+        assert not (tmp_path / "out" / "timeseries.csv").exists()
+    # the same law and k_n: runs
+    radius = {"model": "morris2016_area_time", "contact_law": "linear", "normal_stiffness": 1e3}
+    case = _case(tmp_path, materials=glass, contact=linear, thermal={"contact_radius": radius})
+    assert _cli("validate", case).returncode == 0

@@ -489,6 +489,60 @@ def on_every_rank(sim: Simulation, check: Any) -> Any:
     return result
 
 
+def check_contact_law_agreement(case: Case) -> None:
+    """Refuse a contact radius correction whose copy of the normal contact law disagrees with
+    ``contact.normal`` (the models cannot read it: they take the law and k_n as their own
+    parameters): lu2017's ``normal_stiffness`` against ``normal: linear``'s ``stiffness`` (or a
+    Hertz law, which has no k_n), morris2016_area_time's ``contact_law`` and
+    ``normal_stiffness``. They ran with the other law's radius or collision time silently."""
+    th = case.thermal
+    if th is None:
+        return
+    radius = th.contact_radius
+    normal = case.contact.normal
+    key = "thermal.contact_radius"
+    if radius.model not in ("lu2017", "morris2016_area_time"):
+        return
+    k_n = getattr(normal.params, "stiffness", None) if normal.model == "linear" else None
+    own = radius.params.normal_stiffness
+    linear_law = radius.model == "lu2017" or radius.params.contact_law == "linear"
+    if radius.model == "morris2016_area_time":
+        law = radius.params.contact_law
+        wants = "linear" if normal.model == "linear" else "hertz"
+        if normal.model in ("linear", "hertz", "hertz_2d") and law != wants:
+            given = "" if "contact_law" in radius.params.model_fields_set else " (the default)"
+            fix = f"contact_law: {wants}" + (
+                f" with normal_stiffness: {k_n:g} (contact.normal.stiffness)"
+                if wants == "linear" and own is None
+                else ""
+            )
+            raise ConfigError(
+                f"{key}.contact_law: {law!r}{given} but contact.normal is {normal.model!r}: "
+                f"the collision time t_c of morris2016_area_time would be that of another "
+                f"contact law than the one the simulation runs; allowed: {fix}"
+            )
+    if not linear_law:
+        return
+    if normal.model in ("hertz", "hertz_2d"):
+        raise ConfigError(
+            f"{key}: {radius.model!r} is the correction of a linear spring contact law "
+            f"(normal_stiffness k_n), but contact.normal is {normal.model!r}, which has no k_n; "
+            "allowed: normal: linear, or a correction of a Hertz law (morris2016_area, "
+            "zhou2010)"
+        )
+    if k_n is not None and own is not None and not math.isclose(own, k_n, rel_tol=1e-9):
+        raise ConfigError(
+            f"{key}.normal_stiffness = {own:g} N/m but contact.normal.stiffness = {k_n:g} N/m: "
+            f"{radius.model!r} needs the k_n of the simulation's linear spring ("
+            + (
+                "its contact radius carries the force k_n δ"
+                if radius.model == "lu2017"
+                else "its collision time is π sqrt(m*/k_n)"
+            )
+            + f"); allowed: normal_stiffness: {k_n:g}"
+        )
+
+
 def pre_run_checks(sim: Simulation) -> list[str]:
     """Every check of a built simulation before the first step of a fresh run: ``thermodem
     validate``, ``thermodem run`` (:func:`thermodem.engine.runner.run_case`) and its MPI
@@ -498,6 +552,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     from thermodem.engine.checks import check_simulation_time_step
 
     case = sim.case
+    check_contact_law_agreement(case)
     check_step_count(sim)
     on_every_rank(sim, check_wall_overlaps)
     check_pour_walls(sim)
