@@ -286,3 +286,33 @@ def test_a_contact_radius_with_another_contact_law_is_refused(tmp_path: Path) ->
     radius = {"model": "morris2016_area_time", "contact_law": "linear", "normal_stiffness": 1e3}
     case = _case(tmp_path, materials=glass, contact=linear, thermal={"contact_radius": radius})
     assert _cli("validate", case).returncode == 0
+
+
+def test_a_restart_runs_the_changed_wall_values_and_refuses_a_moved_wall(tmp_path: Path) -> None:
+    """run CASE --restart CKPT with the wall at 400 K instead of 350 K (or a new wall speed)
+    kept the checkpoint's whole wall row: 350 K, at rest, without a word; a wall moved in
+    the case stayed where the checkpoint had it."""
+    import h5py
+
+    out = tmp_path / "first_out"
+    assert _cli("run", _case(tmp_path, "first"), "--output", out).returncode == 0
+    ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
+    wall = {**CASE["walls"][0], "velocity": [0.0, 0.0, 0.1]}
+    wall["thermal"] = {"kind": "fixed", "temperature": 400.0}
+    hotter = _case(tmp_path, "hotter", walls=[wall])
+    again = tmp_path / "again"
+    res = _cli("run", hotter, "--restart", ckpt, "--output", again, "--end-time", "2e-4")
+    assert res.returncode == 0, res.stdout + res.stderr
+    final = sorted((again / "checkpoints").glob("*.h5"))[-1]
+    with h5py.File(final) as f:
+        row = f["arrays"]["wall_rows"][0]
+    assert row[18] == 400.0 and list(row[6:9]) == [0.0, 0.0, 0.1]
+    assert abs(row[2] - 0.1 * 1.0e-4) < 1e-12  # moved from the checkpoint's place
+    moved = {**CASE["walls"][0], "point": [0.0, 0.0, -0.001]}
+    res = _cli("run", _case(tmp_path, "moved", walls=[moved]), "--restart", ckpt, "--output",
+               tmp_path / "moved_out", "--end-time", "2e-4")  # fmt: skip
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        f"error: walls.0.point.2 differs from the case stored in the checkpoint {ckpt}: a "
+        "wall's place comes from the checkpoint on a restart"
+    ) in res.stderr

@@ -408,6 +408,31 @@ def check_values(state: dict[str, Any]) -> None:
             )
 
 
+def _case_wall_columns(sim: Simulation, fresh: np.ndarray) -> None:
+    """The wall columns the case sets and no step changes (velocity, angular velocity,
+    material, thermal condition, a constant temperature) taken from the case's rows: a
+    restart with a changed case runs its wall temperature, speed or material (the whole
+    stored row kept the checkpoint's: a wall changed from 350 K to 400 K stayed at 350 K).
+    The place of the wall (which moves) stays the checkpoint's; a temperature that is a
+    function of time is set from its function at each step. Unchanged case: the same values,
+    so a restart stays bit-identical."""
+    from thermodem.engine.start_checks import wall_row_owners
+    from thermodem.geometry import wall_layout as WL
+
+    rows = sim.wall_rows
+    if rows.shape != fresh.shape or rows.shape[0] == 0:
+        return
+    owners = wall_row_owners(sim.case)
+    cols = [*range(WL.COL_VELOCITY, WL.COL_VELOCITY + 3), WL.COL_OMEGA, WL.COL_MATERIAL,
+            WL.COL_THERMAL_KIND]  # fmt: skip
+    for w in range(rows.shape[0]):
+        rows[w, cols] = fresh[w, cols]
+        wall = sim.case.walls[owners[w]] if w < len(owners) else None
+        temperature = wall.thermal.temperature if wall is not None else None
+        if isinstance(temperature, int | float):
+            rows[w, WL.COL_TEMPERATURE] = fresh[w, WL.COL_TEMPERATURE]
+
+
 def restore(sim: Simulation, state: dict[str, Any]) -> None:
     """Load ``state`` (from :func:`capture`) into ``sim``, built from the same case."""
     check_state(state)
@@ -454,8 +479,10 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
     sim.ledger_cumulative = {k: float(v) for k, v in s["ledger_cumulative"].items()}
     _load_pairs(sim.pairs, state["pairs"], int(s["pair_count"]), int(s["pair_capacity"]))
     _load_pairs(sim.walls, state["walls"], int(s["wall_pair_count"]), int(s["wall_pair_capacity"]))
+    fresh_rows = sim.wall_rows
     for name in ARRAYS:
         setattr(sim, name, np.array(state["arrays"][name], copy=True))
+    _case_wall_columns(sim, fresh_rows)
     # the pourers hold a reference to this generator: set its state in place
     sim.rng.bit_generator.state = s["rng"]
     for pourer, ps in zip(sim.pourers, s["pourers"], strict=True):

@@ -158,13 +158,23 @@ def read_newest_checkpoint(checkpoints: list[Path]) -> Checkpoint:
         raise ConfigError(f"{exc}; nothing was changed in the run directory{hint}") from None
 
 
-def check_static_insertion(ckpt: Checkpoint, case: Case) -> None:
-    """Refuse a changed case whose static insertion entries (lattice, random, list, file: the
-    particles of t = 0) differ from the checkpoint's: they are not run again on a restart, so
-    the run would continue the checkpoint's particles, not the ones the case describes (the
-    entries' file paths aside: a case moved with its particle file is the same case). Pour
+#: Wall keys a restart takes from the changed case (engine/restart.py: the columns that no
+#: step changes); the others place the wall, which the checkpoint holds (a wall moves).
+WALL_CASE_KEYS = frozenset({"material", "velocity", "angular_velocity", "name", "thermal"})
+
+
+def check_restart_case(ckpt: Checkpoint, case: Case) -> None:
+    """Refuse a changed case that a restart would not run as written: static insertion
+    entries (lattice, random, list, file: the particles of t = 0, not inserted again; a file
+    entry's path aside) or a wall's place (its point, normal, extents, radius...: the
+    checkpoint's wall rows hold where it is) unlike the stored case's. The run would continue
+    the checkpoint's particles and walls, not the ones the case describes. A wall's material,
+    velocity, angular velocity and thermal condition may change (the case's are run). Pour
     entries are compared when the state is loaded."""
     from thermodem.config.dump import case_to_dict
+
+    if case is None:
+        return
 
     def static(entries: Any) -> tuple[list[int], list[Any]]:
         """(index in ``insertion``, entry without its file path) of every static entry."""
@@ -177,13 +187,38 @@ def check_static_insertion(ckpt: Checkpoint, case: Case) -> None:
         ]
         return [k for k, _ in kept], [e for _, e in kept]
 
-    if case is None:
-        return
+    def placed(walls: Any) -> list[Any]:
+        if not isinstance(walls, list):
+            return []
+        return [
+            {k: v for k, v in w.items() if k not in WALL_CASE_KEYS} if isinstance(w, dict) else w
+            for w in walls
+        ]
+
     # both through the schema, so that keys a later version added with their defaults compare
     # equal (the stored case of an older checkpoint lacks them)
-    index, mine = static(case_to_dict(case).get("insertion"))
-    _, theirs = static(case_to_dict(ckpt.case()).get("insertion"))
-    where = first_difference(mine, theirs)
+    mine, theirs = case_to_dict(case), case_to_dict(ckpt.case())
+    particles = ckpt.state.get("particles", {})
+    n = int(particles["radius"].shape[0]) if "radius" in particles else None
+    held = f"the checkpoint's {n} particles" if n is not None else "the checkpoint's particles"
+    allowed = (
+        "nothing was changed. Allowed: the checkpoint's {what} (as in the case.resolved.yaml "
+        "of the run that wrote it), or a new run from t = 0 without --restart"
+    )
+    where = first_difference(placed(mine.get("walls")), placed(theirs.get("walls")))
+    if where is not None:
+        head, _, rest = where.partition(".")
+        where = f"walls.{head}" + (f".{rest}" if rest else "") if head.isdigit() else "walls"
+        raise ConfigError(
+            f"{where} differs from the case stored in the checkpoint {ckpt.path}: a wall's "
+            "place comes from the checkpoint on a restart (a moving wall has moved since "
+            "t = 0), so the run would keep the checkpoint's walls, not the ones this case "
+            "describes (a wall's material, velocity, angular velocity and thermal condition "
+            "may change); " + allowed.format(what="wall places")
+        )
+    index, mine_static = static(mine.get("insertion"))
+    _, theirs_static = static(theirs.get("insertion"))
+    where = first_difference(mine_static, theirs_static)
     if where is None:
         return
     head, _, rest = where.partition(".")
@@ -191,24 +226,18 @@ def check_static_insertion(ckpt: Checkpoint, case: Case) -> None:
         where = f"insertion.{index[int(head)]}" + (f".{rest}" if rest else "")
     else:
         where = "insertion (its static entries: another number of them)"
-    particles = ckpt.state.get("particles", {})
-    n = int(particles["radius"].shape[0]) if "radius" in particles else None
-    held = f"the checkpoint's {n} particles" if n is not None else "the checkpoint's particles"
     raise ConfigError(
         f"{where} differs from the case stored in the checkpoint {ckpt.path}: the particles "
         f"of t = 0 (lattice, random, list, file entries) are not inserted again on a "
         f"restart, so the run would continue {held}, not the ones this case describes; "
-        "nothing was "
-        "changed. Allowed: the checkpoint's static insertion entries (as in the "
-        "case.resolved.yaml of the run that wrote it), or a new run from t = 0 without "
-        "--restart"
+        + allowed.format(what="static insertion entries")
     )
 
 
 def restored_simulation(ckpt: Checkpoint, threads: int | None, case: Case) -> Simulation:
     """A simulation continuing from ``ckpt`` (ConfigError for a state that does not load, or
     a changed case whose t = 0 particles differ from the checkpoint's)."""
-    check_static_insertion(ckpt, case)
+    check_restart_case(ckpt, case)
     try:
         return Simulation.from_checkpoint(ckpt, threads=threads, case=case)
     except ConfigError as exc:
