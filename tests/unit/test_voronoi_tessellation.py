@@ -1,4 +1,4 @@
-"""The tessellation (engine/voronoi.py) on geometries whose cells are known exactly: simple
+"""The tessellation (engine/tessellation.py) on geometries whose cells are known exactly: simple
 cubic (cubes of side 2R, faces (2R)²), FCC (rhombic dodecahedra, faces √2 R²), BCC (truncated
 octahedra, hexagons 3√3 a²/16 and squares a²/8), periodic and clipped by walls (mirror
 particles), and the radical plane of two unequal spheres."""
@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from thermodem.engine.voronoi import Plane, tessellate
+from thermodem.engine.tessellation import Plane, tessellate
 
 R = 1e-3
 #: Relative accuracy of the cells: freud (plain) computes in single precision, pyvoro2

@@ -9,8 +9,8 @@ pair's row of the external pair set)::
     kernel(p, r_i, r_j, dist, r_c, inputs) -> conductance H [W/K] >= 0
 
 ``inputs[INPUT_FACE_AREA]`` is A_n [m²], the area of the Voronoi face the two cells share
-(or of the cell's face on the wall), from the tessellation (``engine/voronoi.py``) or from the
-porosity closure of Zhou et al. (2009). The double pyramid on that face is replaced by the
+(or of the cell's face on the wall), from the tessellation (``engine/tessellation.py``) or from
+the porosity closure of Zhou et al. (2009). The double pyramid on that face is replaced by the
 double tapered cone of the same base area, radius r_ij = √(A_n/π); with the pyramid's volume
 V_ij = A_n d_ij / 3 this is the spec's r_ij = √(3 V_ij/(π d_ij)). ``dist`` is the centre
 distance (a wall: r_j = inf, dist = d_pw the distance from the centre to the wall plane);
