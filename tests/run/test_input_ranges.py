@@ -316,3 +316,38 @@ def test_a_restart_runs_the_changed_wall_values_and_refuses_a_moved_wall(tmp_pat
         f"error: walls.0.point.2 differs from the case stored in the checkpoint {ckpt}: a "
         "wall's place comes from the checkpoint on a restart"
     ) in res.stderr
+
+
+def test_a_restart_that_swaps_a_heat_mechanism_runs_the_new_one(tmp_path: Path) -> None:
+    """A checkpoint of a case with radiation continued with a case with convection instead
+    kept the checkpoint's summed mechanism columns: the convection heat was left out (the
+    temperatures did not move) without a word; an adiabatic wall made fixed at the restart
+    was refused as 'the checkpoint is damaged or belongs to another case'."""
+    import h5py
+
+    rad = {"radiation": {"model": "surroundings", "environment_temperature": 300.0}}
+    glass = _glass(emissivity=0.8)
+    out = tmp_path / "rad"
+    res = _cli("run", _case(tmp_path, "rad", materials=glass, thermal=rad), "--output", out)
+    assert res.returncode == 0, res.stdout + res.stderr
+    ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
+    conv = {"convection": "stagnant", "fluid": {"temperature": 400.0}}
+    again = tmp_path / "conv"
+    res = _cli("run", _case(tmp_path, "conv", materials=glass, thermal=conv), "--restart", ckpt,
+               "--output", again, "--end-time", "2e-4")  # fmt: skip
+    assert res.returncode == 0, res.stdout + res.stderr
+    with h5py.File(ckpt) as f:
+        before = f["particles"]["temperature"][:]
+    with h5py.File(sorted((again / "checkpoints").glob("*.h5"))[-1]) as f:
+        after = f["particles"]["temperature"][:]
+    assert (after - before).min() > 1e-6  # heated by the 400 K gas
+    header = (again / "timeseries.csv").read_text().splitlines()[0]
+    assert "heat_in_convection" in header and "heat_in_radiation" not in header
+    adiabatic = {**CASE["walls"][0], "thermal": {"kind": "adiabatic"}}
+    out = tmp_path / "adiabatic"
+    res = _cli("run", _case(tmp_path, "adiabatic", walls=[adiabatic]), "--output", out)
+    assert res.returncode == 0, res.stdout + res.stderr
+    ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
+    res = _cli("run", _case(tmp_path, "fixed"), "--restart", ckpt, "--output",
+               tmp_path / "fixed_out", "--end-time", "2e-4")  # fmt: skip
+    assert res.returncode == 0, res.stdout + res.stderr

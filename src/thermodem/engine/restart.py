@@ -306,7 +306,13 @@ THERMAL_FROM_CASE: tuple[str, ...] = (
     "has_c_table", "k_t", "k_v", "k_n", "c_t", "c_v", "c_n", "density_by_type",
     "specific_heat_by_type",
 )  # fmt: skip
-THERMAL_LAYOUT: tuple[str, ...] = ("boundary_columns", "scratch", "term_scratch", "euler_partials")
+#: (the second group: the mechanism columns the case's terms write and the explicit update
+#: sums, and the flags they follow from; restored, a restart that swapped radiation for
+#: convection summed the radiation column and left the convection heat out, silently)
+THERMAL_LAYOUT: tuple[str, ...] = (
+    "boundary_columns", "scratch", "term_scratch", "euler_partials", "sum_columns",
+    "euler_columns", "in_use", "fuse_generation", "conducts", "walls_conduct",
+)  # fmt: skip
 #: Thermal arrays computed again before they are read: a state may hold them empty (a
 #: checkpoint gathered from MPI ranks, thermodem.mpi.gather) with ``conductance_ready`` False.
 THERMAL_RECOMPUTED: tuple[str, ...] = (
