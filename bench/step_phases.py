@@ -51,6 +51,7 @@ def _wrap(owner: Any, attr: str, name: str) -> None:
 def instrument() -> None:
     """Wrap the phases of a step (idempotent)."""
     from thermodem.engine import simulation as S
+    from thermodem.engine import simulation_ledger as SL
     from thermodem.engine import thermal as T
     from thermodem.engine import thermal_conditions as TC
     from thermodem.kernels import pair_pass as PP
@@ -60,9 +61,9 @@ def instrument() -> None:
         ("reduce_checks", "checks"),
         ("reset_forces", "force reset"),
         ("final_kick", "final kick"),
-        ("ledger_totals", "ledger sums"),
     ):
         _wrap(S, attr, name)
+    _wrap(SL, "ledger_totals", "ledger sums")
     _wrap(S.Simulation, "rebuild", "neighbour rebuild")
     _wrap(S.Simulation, "step", "step (total)")
 

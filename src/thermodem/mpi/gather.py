@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermodem.engine.restart import THERMAL_RECOMPUTED  # stored empty in a gathered checkpoint
-from thermodem.engine.simulation import LEDGER_DISSIPATION
+from thermodem.engine.simulation_ledger import LEDGER_DISSIPATION
 from thermodem.mpi import exchange as X
 from thermodem.state import heat
 from thermodem.state.particles import Particles
