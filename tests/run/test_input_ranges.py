@@ -351,3 +351,25 @@ def test_a_restart_that_swaps_a_heat_mechanism_runs_the_new_one(tmp_path: Path) 
     res = _cli("run", _case(tmp_path, "fixed"), "--restart", ckpt, "--output",
                tmp_path / "fixed_out", "--end-time", "2e-4")  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_material_values_in_another_unit_are_warned_about(tmp_path: Path) -> None:
+    """specific_heat: 0.8 (kJ/(kg K)), density: 2.5 (g/cm³) and youngs_modulus_real below
+    youngs_modulus (the two swapped) ran without a word (in a bed the first two make the
+    thermal or the mechanical step refused, blaming the step)."""
+    glass = _glass(specific_heat=0.8, density=2.5, youngs_modulus_real=1.0e5)
+    simulation = {"time_step": 1.0e-7, "end_time": 1.0e-6}
+    thermal = {"contact_radius": "zhou2010"}
+    res = _cli("validate", _case(tmp_path, materials=glass, simulation=simulation,
+                                 thermal=thermal))  # fmt: skip
+    assert res.returncode == 0, res.stdout + res.stderr
+    out = res.stdout + res.stderr
+    for message in (
+        "warning: materials.glass.density: 2.5 kg/m³ is below 30 kg/m³, lighter than any "
+        "solid: is it in g/cm³? (2.5 g/cm³ = 2500 kg/m³)",
+        "warning: materials.glass.specific_heat: 0.8 J/(kg K) is below 20 J/(kg K), less than "
+        "any solid near room temperature (lead: 129): is it in kJ/(kg K)?",
+        "warning: materials.glass.youngs_modulus_real: 100000 Pa is below youngs_modulus 1e+07 Pa",
+    ):
+        assert message in out
+    assert "materials.glass" not in _cli("validate", _case(tmp_path)).stdout

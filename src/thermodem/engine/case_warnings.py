@@ -56,6 +56,54 @@ def insertion_warnings(case: Case) -> list[str]:
     return out
 
 
+#: Below these a value is told as one in another unit: a density in g/cm³ (osmium, the
+#: densest element, is 22.6 g/cm³) and a specific heat in kJ/(kg K) (solids near room
+#: temperature: 100 J/(kg K) and more). Warnings: cryogenic or exotic cases can ignore them.
+DENSITY_SUSPECT_BELOW = 30.0
+SPECIFIC_HEAT_SUSPECT_BELOW = 20.0
+
+
+def property_warnings(case: Case) -> list[str]:
+    """Material values that look like another unit (a density in g/cm³, a specific heat in
+    kJ/(kg K), also in a c(T) table), and a ``youngs_modulus_real`` below ``youngs_modulus``
+    (the low-stiffness corrections of the contact radius scale the simulation's softer
+    modulus up to the real one: the two swapped?)."""
+    out = []
+    for name, m in case.materials.items():
+        key = f"materials.{name}"
+        if m.density < DENSITY_SUSPECT_BELOW:
+            out.append(
+                f"{key}.density: {m.density:g} kg/m³ is below {DENSITY_SUSPECT_BELOW:g} kg/m³, "
+                f"lighter than any solid: is it in g/cm³? ({m.density:g} g/cm³ = "
+                f"{1000.0 * m.density:g} kg/m³); a case of such a material can ignore this"
+            )
+        if case.thermal is not None:
+            values = [("specific_heat", m.specific_heat)] if not m.specific_heat_table else []
+            values += [
+                (f"specific_heat_table (row {k})", row[1])
+                for k, row in enumerate(m.specific_heat_table or [])
+            ]
+            low = [(k, v) for k, v in values if v is not None]
+            if low:
+                which, value = min(low, key=lambda kv: kv[1])
+                if value < SPECIFIC_HEAT_SUSPECT_BELOW:
+                    out.append(
+                        f"{key}.{which}: {value:g} J/(kg K) is below "
+                        f"{SPECIFIC_HEAT_SUSPECT_BELOW:g} J/(kg K), less than any solid near "
+                        f"room temperature (lead: 129): is it in kJ/(kg K)? ({value:g} kJ/(kg "
+                        f"K) = {1000.0 * value:g} J/(kg K)); a cryogenic case can ignore this"
+                    )
+        real = m.youngs_modulus_real
+        if real is not None and real < m.youngs_modulus:
+            out.append(
+                f"{key}.youngs_modulus_real: {real:g} Pa is below youngs_modulus "
+                f"{m.youngs_modulus:g} Pa: the real modulus of the low-stiffness corrections "
+                "is the stiffer one (the simulation softens the material to take longer time "
+                "steps); are the two swapped?"
+            )
+    return out
+
+
 def time_table_warnings(case: Case) -> list[str]:
     """Tables of time (a fixed wall's temperature, the fluid's temperature and velocity) whose
     first change (row 1) comes after the end of the run: the first row's value holds for the

@@ -28,6 +28,7 @@ from thermodem.engine.case_warnings import (
     insertion_warnings,
     output_interval_warnings,
     periodic_wall_warnings,
+    property_warnings,
     section_warnings,
     skin_warnings,
     step_interval_warnings,
@@ -559,7 +560,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     check_length_scales(sim)
     notes = check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
     notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
-    notes += time_table_warnings(case)
+    notes += time_table_warnings(case) + property_warnings(case)
     notes += temperature_warnings(sim) + step_interval_warnings(sim)
     return notes + list(on_every_rank(sim, check_simulation_time_step))
 
