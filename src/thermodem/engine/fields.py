@@ -50,6 +50,7 @@ from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import fields as fk
 from thermodem.kernels import heat_terms
 from thermodem.kernels import neighbourhood as nh
+from thermodem.kernels import porosity as pk
 from thermodem.models.thermal import convection as conv
 from thermodem.models.thermal import radiation as rad
 
@@ -192,7 +193,7 @@ class FieldProvider(FluidSources):
             if self.radiation is not None and self.radiation.table.ndim == 2
             else np.zeros(1)
         )
-        self.lattice = fk.unit_ball_points()
+        self.lattice = pk.unit_ball_points()
         self.sums = np.zeros((0, 4))
         # the continuum radiation's neighbours of each particle (kernels/neighbourhood.py):
         # listed from range-set build ``members_builds`` at the positions
@@ -336,13 +337,13 @@ class FieldProvider(FluidSources):
         if self.shell_ratio > 0.0:
             if self.sums.shape[0] != n:
                 self.sums = np.zeros((n, 4))
-            fk.zero_rows(self.sums)
-            fk.shell_pass(p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower,
+            pk.zero_rows(self.sums)
+            pk.shell_pass(p.position, p.radius, ns.i, ns.j, ns.group_start, sim.lower,
                           sim.upper, sim.periodic, self.shell_ratio, self.sums)  # fmt: skip
             width = 4 * max(sim.wall_kind.shape[0], 1)
             if self.scratch.shape[0] < self._chunks() or self.scratch.shape[1] < width:
                 self.scratch = np.zeros((self._chunks(), width))
-            fk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
+            pk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
                               self.shell_ratio, self.lattice, self.sums, self.scratch,
                               fields)  # fmt: skip
 
@@ -425,7 +426,7 @@ class FieldProvider(FluidSources):
         if self._cell_walls.shape != geometry.shape or not np.array_equal(
             self._cell_walls, geometry
         ):
-            fk.cell_fluid_volume(sim.lower, self.cell_edge, self.cell_dims, sim.wall_kind,
+            pk.cell_fluid_volume(sim.lower, self.cell_edge, self.cell_dims, sim.wall_kind,
                                  sim.wall_rows, 4, self.cell_fluid)  # fmt: skip
             self._cell_walls = geometry
             self.cells_valid = False
@@ -437,13 +438,13 @@ class FieldProvider(FluidSources):
         if (
             self.cells_valid
             and fields is self._porosity_for
-            and fk.cell_moves(p.position, sim.lower, self.cell_edge, self.cell_dims,
+            and pk.cell_moves(p.position, sim.lower, self.cell_edge, self.cell_dims,
                               self.cell_of, self._part()) == 0
         ):  # fmt: skip
             return
         self.cells_valid = True
         self._porosity_for = fields
-        fk.cell_porosity(p.position, p.radius, sim.lower, self.cell_edge, self.cell_dims,
+        pk.cell_porosity(p.position, p.radius, sim.lower, self.cell_edge, self.cell_dims,
                          self.cell_fluid, self.cell_solid, self.cell_of, fields)  # fmt: skip
 
     # --------------------------------------------------------------- validity ranges
