@@ -78,9 +78,24 @@ def _threads(requested: int | None) -> int | None:
 
 
 def _guarded(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
-    """Map thermodem's exceptions to messages and exit codes (never a traceback)."""
+    """Map thermodem's exceptions to messages and exit codes (never a traceback); thermodem's
+    own RuntimeWarnings (a section no selected model reads, said while the case is built)
+    as ``warning: ...`` lines, not Python's 'FILE:LINE: RuntimeWarning:' form."""
+    import os
+    import warnings
+
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001, ANN202
+        if issubclass(category, RuntimeWarning) and f"{os.sep}thermodem{os.sep}" in filename:
+            typer.echo(f"warning: {message}", err=True)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
     try:
-        return fn(*args, **kwargs)
+        with warnings.catch_warnings():
+            warnings.showwarning = show
+            return fn(*args, **kwargs)
     except ConfigError as exc:
         _fail(str(exc), EXIT_INPUT)
     except SimulationError as exc:

@@ -373,3 +373,27 @@ def test_material_values_in_another_unit_are_warned_about(tmp_path: Path) -> Non
     ):
         assert message in out
     assert "materials.glass" not in _cli("validate", _case(tmp_path)).stdout
+
+
+def test_thermal_settings_the_case_makes_unused_are_refused_or_told(tmp_path: Path) -> None:
+    """thermal.time_step without frozen_mechanics and max_substeps beside a fixed substeps ran
+    ignored; a fluid section no model reads was said as Python's '.../thermal.py:140:
+    RuntimeWarning: ...' line."""
+    for thermal, message in (
+        ({"time_step": 1.0e-3}, "thermal: time_step = 0.001 s is the step of the heat with "
+         "frozen mechanics, but frozen_mechanics is false"),
+        ({"substeps": 3, "max_substeps": 10}, "thermal: max_substeps = 10 caps substeps: auto, "
+         "but substeps is 3; allowed: substeps: auto, or leave max_substeps out"),
+    ):  # fmt: skip
+        res = _cli("run", _case(tmp_path, thermal=thermal), "--output", tmp_path / "o")
+        assert res.returncode == 2, res.stdout + res.stderr
+        assert message in res.stderr
+    auto = {"substeps": "auto", "max_substeps": 10}
+    assert _cli("validate", _case(tmp_path, thermal=auto)).returncode == 0
+    res = _cli("validate", _case(tmp_path, thermal={"fluid": {"temperature": 300.0}}))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (
+        "warning: thermal.fluid is given but no selected model reads it (thermal.convection = "
+        "'none', thermal.radiation = 'none'): it has no effect"
+    ) in res.stderr
+    assert "RuntimeWarning" not in res.stderr

@@ -417,7 +417,25 @@ class ThermalSettings(StrictModel):
         return v
 
     @model_validator(mode="after")
-    def _frozen(self) -> ThermalSettings:
+    def _frozen(self, info: ValidationInfo) -> ThermalSettings:
+        from thermodem.state.materials import STORED_CASE_KEY
+
+        stored = bool(info.context and info.context.get(STORED_CASE_KEY))
+        ignored = []  # settings that the case's other keys make unused (they ran ignored)
+        if self.time_step is not None and not self.frozen_mechanics:
+            ignored.append(
+                f"time_step = {self.time_step:g} s is the step of the heat with frozen "
+                "mechanics, but frozen_mechanics is false: the heat runs at "
+                "simulation.time_step (× substeps); allowed: frozen_mechanics: true, or leave "
+                "time_step out (substeps: n solves the heat every n mechanical steps)"
+            )
+        if self.max_substeps != 1000 and self.substeps != "auto":
+            ignored.append(
+                f"max_substeps = {self.max_substeps} caps substeps: auto, but substeps is "
+                f"{self.substeps}; allowed: substeps: auto, or leave max_substeps out"
+            )
+        if ignored and not stored:
+            raise ValueError("; ".join(ignored) + " (the value would be ignored)")
         if self.frozen_mechanics and self.time_step is None:
             raise ValueError(
                 "frozen_mechanics needs thermal.time_step [s] (missing): the step of the heat "
