@@ -397,3 +397,17 @@ def test_thermal_settings_the_case_makes_unused_are_refused_or_told(tmp_path: Pa
         "'none', thermal.radiation = 'none'): it has no effect"
     ) in res.stderr
     assert "RuntimeWarning" not in res.stderr
+
+
+def test_a_name_refused_where_a_number_fits_too_says_both(tmp_path: Path) -> None:
+    """cylinder_radius: dai2018 said "Input should be 'kanuparthi2008', ... or 'dai2019'",
+    as if only a name were allowed (a number r̄/R̄ > 0 is too)."""
+    thermal = {"indirect_conduction": {"model": "batchelor_obrien_separated",
+                                       "cylinder_radius": "dai2018"}}  # fmt: skip
+    res = _cli("validate", _case(tmp_path, thermal=thermal))
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "thermal.indirect_conduction.cylinder_radius: should be a number or one of "
+        "'kanuparthi2008', 'yun_evans2010', 'moscardini2018' or 'dai2019' (got 'dai2018'; did "
+        "you mean 'dai2019'?)"
+    ) in res.stderr

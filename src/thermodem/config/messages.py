@@ -441,7 +441,13 @@ def _collapse_unions(errors: list[dict[str, Any]], data: Any) -> list[dict[str, 
         for k, err in content:
             loc = tuple(err["loc"])
             tag = str(loc[k])
-            extra = _or_list(tag, [t for t in tags if t != tag])
+            others = [t for t in tags if t != tag]
+            extra = _or_list(tag, others)
+            if err["type"] == "literal_error" and any(
+                _tag_base(t) in ("float", "int") for t in others
+            ):  # a name refused where a number fits too (cylinder_radius: 2.0 or 'dai2019')
+                err = {**err, "msg": err["msg"].replace("Input should be ", "should be a "
+                                                        "number or one of ", 1)}  # fmt: skip
             out.append({**err, "loc": loc[:k] + loc[k + 1 :], "or_list": extra})
     return out
 
