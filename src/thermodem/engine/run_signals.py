@@ -8,7 +8,9 @@ the checkpoint and ``status.json`` are finished. While it is being set up (the s
 built, the checks, the step-0 outputs), :class:`Starting`: either signal stops at once and
 :func:`not_started` records it so that the same command can be run again; on several MPI
 ranks :class:`StartingTogether`: the signal is noted and every rank stops at the next point
-the ranks agree on (:mod:`thermodem.mpi.runner`).
+the ranks agree on (:mod:`thermodem.mpi.runner`). The same holds while a restart is set up
+(the checkpoint read, the simulation rebuilt and compiled): :func:`restart_not_started` says
+so and leaves the earlier run's record as it was.
 """
 
 from __future__ import annotations
@@ -114,16 +116,68 @@ class StartingTogether(Starting):
         self.signum = signum
 
 
-def not_started(output: Path, log: RunLog, status: Status, signum: int) -> RunInterrupted:
-    """The record of a run stopped by a signal before its first step (:class:`Starting`)."""
+def not_started(
+    output: Path,
+    log: RunLog | None,
+    status: Status | None,
+    signum: int,
+    checkpoint: Path | str | None = None,
+) -> RunInterrupted:
+    """The record of a run stopped by a signal before its first step (:class:`Starting`).
+    ``log`` and ``status`` None: stopped before the output directory was touched (a run from
+    a checkpoint, while the checkpoint was read and the simulation rebuilt); ``checkpoint``:
+    the checkpoint the run starts from (``run --restart``), named as unchanged."""
     signum = signum or signal.SIGINT
     name = signal.Signals(signum).name
-    record_only = only_run_record(output, ignore=LOCK_FILE)
-    again = "the same command" if record_only else "the same command with --overwrite"
+    if status is None:
+        done = f"nothing was computed and {output} was not touched"
+        again = "the same command"
+    else:
+        done = "nothing was computed and no checkpoint written"
+        record_only = only_run_record(output, ignore=LOCK_FILE)
+        again = "the same command" if record_only else "the same command with --overwrite"
+    source = f" (from {checkpoint}, which is unchanged)" if checkpoint is not None else ""
     message = (
-        f"interrupted ({name}) while the run was being set up, before its first step: nothing "
-        f"was computed and no checkpoint written; to start it: {again}"
+        f"interrupted ({name}) while the run was being set up, before its first step: {done}; "
+        f"to start it: {again}{source}"
     )
-    log.info(message)
-    status.update(status="interrupted", message=message, not_started=True)
+    if log is not None:
+        log.info(message)
+    if status is not None:
+        status.update(status="interrupted", message=message, not_started=True)
     return RunInterrupted(message, checkpoint=None, exit_code=128 + signum)
+
+
+def restart_not_started(
+    log: RunLog | None,
+    signum: int,
+    checkpoint: Path | str | None,
+    step: int | None = None,
+    time: float | None = None,
+) -> RunInterrupted:
+    """A restart of a run directory (``thermodem restart OUT``) stopped by a signal before its
+    first step (:class:`Starting`, :class:`StartingTogether`): nothing was computed and the
+    run's checkpoints are as they were, so the same command continues from the same one
+    (``checkpoint``: the newest, at ``step`` and ``time`` once it has been read). The line
+    goes to ``run.log`` (``log``, once it is open); ``status.json`` is not touched: it still
+    records how the earlier run ended (its step, time and last checkpoint), which
+    ``not_started`` would misreport as a run that never started."""
+    signum = signum or signal.SIGINT
+    name = signal.Signals(signum).name
+    if checkpoint is None:
+        source = "its newest checkpoint"
+    else:
+        source = str(checkpoint)
+        if step is not None and time is not None:
+            source += f" (step {step}, t = {time:.6g} s)"
+    message = (
+        f"interrupted ({name}) while the restart was being set up, before its first step: "
+        "nothing was computed, the run's checkpoints are unchanged and nothing of the earlier "
+        f"run is lost (status.json still records it); to continue: the same command, from "
+        f"{source}"
+    )
+    if log is not None:
+        log.info(message)
+    return RunInterrupted(
+        message, checkpoint=str(checkpoint) if checkpoint else None, exit_code=128 + signum
+    )

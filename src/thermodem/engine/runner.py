@@ -71,7 +71,12 @@ from thermodem.engine.run_checks import (  # noqa: F401 (LOCK_FILE, process_star
     timeseries_repair,
 )
 from thermodem.engine.run_info import output_summary  # noqa: F401 (re-exported)
-from thermodem.engine.run_signals import Starting, StopRequest, not_started
+from thermodem.engine.run_signals import (
+    Starting,
+    StopRequest,
+    not_started,
+    restart_not_started,
+)
 from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
     check_completeness,
@@ -83,6 +88,7 @@ from thermodem.engine.validation import (
 )
 from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
 from thermodem.io.checkpoint import (
+    Checkpoint,
     checkpoint_name,
     list_checkpoints,
     read_checkpoint,
@@ -554,7 +560,9 @@ def restart_run(
 
     Everything is checked before the directory is touched: no live process writing it, the
     end time (finite, > 0, not before the checkpoint), the checkpoint (complete, written for
-    this directory), the resources."""
+    this directory), the resources. A signal (SIGINT, SIGTERM) while the restart is set up
+    stops it before its first step (RunInterrupted, 130/143) with the directory's checkpoints
+    and status.json as they were (run_signals.restart_not_started)."""
     output = Path(output)
     if not output.is_dir():
         raise ConfigError(f"{str(output)!r} is not an output directory")
@@ -567,50 +575,66 @@ def restart_run(
         raise ConfigError(f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from")
     refuse_if_busy(output, "restart")
     previous = Status.read(output)
-    ckpt = read_newest_checkpoint(checkpoints)
-    check_checkpoint_belongs(ckpt, output, previous)
-    case = ckpt.case()
-    if end_time is not None:
-        if end_time < ckpt.time:
-            raise ConfigError(
-                f"--end-time: {end_time:g} s is before the time of the newest checkpoint, "
-                f"{ckpt.time:.6g} s ({ckpt.path}); give a later end time"
-            )
-        case.simulation.end_time = float(end_time)
-    sim = restored_simulation(ckpt, threads, case)
-    check_resources(estimate_resources(sim, threads))  # refuses before anything is written
-    series_repair = timeseries_repair(output / TIMESERIES_FILE)
-    for pvd in ("particles.pvd", "walls.pvd"):
-        if (output / pvd).exists():
-            try:
-                PVDWriter.read(output / pvd)
-            except (ValueError, OSError, SyntaxError) as exc:  # ParseError: a SyntaxError
-                raise ConfigError(
-                    f"{output / pvd} cannot be read ({exc}); restart refused, nothing was "
-                    "changed: repair or delete it"
-                ) from None
+    # a signal while the restart is set up (the checkpoint read, the simulation rebuilt and
+    # compiled, the directory opened) stops it before its first step with the checkpoint it
+    # would have continued from; the earlier run's record stays as it was
+    # (run_signals.restart_not_started)
+    starting = Starting()
+    ckpt = None
+    try:
+        with starting:
+            ckpt = read_newest_checkpoint(checkpoints)
+            check_checkpoint_belongs(ckpt, output, previous)
+            case = ckpt.case()
+            if end_time is not None:
+                if end_time < ckpt.time:
+                    raise ConfigError(
+                        f"--end-time: {end_time:g} s is before the time of the newest "
+                        f"checkpoint, {ckpt.time:.6g} s ({ckpt.path}); give a later end time"
+                    )
+                case.simulation.end_time = float(end_time)
+            sim = restored_simulation(ckpt, threads, case)
+            check_resources(estimate_resources(sim, threads))  # refuses before any write
+            series_repair = timeseries_repair(output / TIMESERIES_FILE)
+            for pvd in ("particles.pvd", "walls.pvd"):
+                if (output / pvd).exists():
+                    try:
+                        PVDWriter.read(output / pvd)
+                    except (ValueError, OSError, SyntaxError) as exc:  # ParseError: SyntaxError
+                        raise ConfigError(
+                            f"{output / pvd} cannot be read ({exc}); restart refused, nothing "
+                            "was changed: repair or delete it"
+                        ) from None
+    except KeyboardInterrupt:
+        raise _restart_stopped(None, starting.signum, ckpt, checkpoints) from None
     # nothing above wrote to the directory
     lock = RunLock(output)
     lock.acquire()
     try:
-        if end_time is not None:
-            (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
         runlog, status = _open(output, log, append=True, case_name=previous.get("case"))
         run_id = status.data.setdefault("run_id", ckpt.run_id or uuid.uuid4().hex)
         try:
-            runlog.info(
-                f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) to end "
-                f"time {case.simulation.end_time:g} s"
-            )
-            if series_repair is not None:
-                runlog.warn(series_repair())
+            try:
+                with starting:
+                    runlog.info(
+                        f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) "
+                        f"to end time {case.simulation.end_time:g} s"
+                    )
+                    if series_repair is not None:
+                        runlog.warn(series_repair())
+                    _header(runlog, sim, threads, output)
+                    run = _make_run(
+                        sim, output, runlog, status, True, progress, log_interval, callback, every
+                    )
+                    run.run_id = run_id
+                    run.last_checkpoint = ckpt.path
+            except KeyboardInterrupt:
+                raise _restart_stopped(runlog, starting.signum, ckpt, checkpoints) from None
+            # the set-up is done: the new end time and the end of the failure's record (kept
+            # until here, so that a restart stopped while it was set up changes neither)
+            if end_time is not None:
+                (output / "case.resolved.yaml").write_text(resolved_case_yaml(case))
             (output / FAILED_FILE).unlink(missing_ok=True)
-            _header(runlog, sim, threads, output)
-            run = _make_run(
-                sim, output, runlog, status, True, progress, log_interval, callback, every
-            )
-            run.run_id = run_id
-            run.last_checkpoint = ckpt.path
             if sim.step_count >= run.total:
                 runlog.info(f"already at the end time (step {sim.step_count}); nothing to do")
                 return sim
@@ -619,6 +643,16 @@ def restart_run(
             runlog.close()
     finally:
         lock.release()
+
+
+def _restart_stopped(
+    log: RunLog | None, signum: int, ckpt: Checkpoint | None, checkpoints: list[Path]
+) -> RunInterrupted:
+    """run_signals.restart_not_started with the checkpoint the restart continues from (the
+    newest, read or not yet)."""
+    if ckpt is None:
+        return restart_not_started(log, signum, checkpoints[-1])
+    return restart_not_started(log, signum, ckpt.path, ckpt.step, ckpt.time)
 
 
 def run_from_checkpoint(
@@ -638,15 +672,23 @@ def run_from_checkpoint(
     """A new run in ``output`` starting from the state in ``checkpoint`` (``case``: a changed
     case, e.g. a smaller time step after a failure; default the stored one)."""
     output = Path(output)
-    ckpt = read_checkpoint(checkpoint)
-    case = case or ckpt.case()
-    if not case.simulation.end_time > ckpt.time:
-        raise ConfigError(
-            f"simulation.end_time = {case.simulation.end_time:g} s is not after the time of "
-            f"the checkpoint {ckpt.path}, {ckpt.time:.6g} s (step {ckpt.step}): there is "
-            "nothing to run; give a later end time in the case or with --end-time T"
-        )
-    sim = restored_simulation(ckpt, threads, case)
+    # a signal while the checkpoint is read and the simulation rebuilt (compiled) stops the
+    # run before ``output`` is touched (run_signals.not_started without a record)
+    starting = Starting()
+    try:
+        with starting:
+            ckpt = read_checkpoint(checkpoint)
+            case = case or ckpt.case()
+            if not case.simulation.end_time > ckpt.time:
+                raise ConfigError(
+                    f"simulation.end_time = {case.simulation.end_time:g} s is not after the "
+                    f"time of the checkpoint {ckpt.path}, {ckpt.time:.6g} s (step {ckpt.step}): "
+                    "there is nothing to run; give a later end time in the case or with "
+                    "--end-time T"
+                )
+            sim = restored_simulation(ckpt, threads, case)
+    except KeyboardInterrupt:
+        raise not_started(output, None, None, starting.signum, checkpoint) from None
     check_output_path(output)
     if output.is_dir():
         refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
@@ -660,7 +702,6 @@ def run_from_checkpoint(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         try:
             runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
-            starting = Starting()
             try:
                 with starting:
                     for warning in check_simulation_time_step(sim):
@@ -674,7 +715,7 @@ def run_from_checkpoint(
             except RunInterrupted:
                 raise
             except KeyboardInterrupt:
-                raise not_started(output, runlog, status, starting.signum) from None
+                raise not_started(output, runlog, status, starting.signum, ckpt.path) from None
             return _drive(sim, run, fresh=False)
         finally:
             runlog.close()

@@ -12,13 +12,13 @@ Failures: a :class:`SimulationError` is agreed inside the step (every rank raise
 message, :meth:`DistributedSimulation.agree`), the state at the failure is gathered to
 ``failed.h5`` and the message names the last good checkpoint, on every rank. A signal
 (SIGINT, SIGTERM) on any rank stops every rank after the same step with a checkpoint (the
-stop request travels with the step's reduction); one while the run is being set up is agreed
-at fixed points of the set-up and every rank stops there (engine/run_signals.py:
-StartingTogether, not_started). An output the system refuses on rank 0 (a
-full disk, the run directory removed) is agreed after each write: every rank stops with rank
-0's message (engine/runner.py's ``_unwritable``). Any other exception on one rank cannot be
-agreed (the others wait in a collective): the rank prints it and aborts the MPI job
-(``MPI_Abort``), so no rank hangs (``thermodem.cli``).
+stop request travels with the step's reduction); one while the run (or a restart) is being
+set up is agreed at fixed points of the set-up and every rank stops there
+(engine/run_signals.py: StartingTogether, not_started, restart_not_started). An output the
+system refuses on rank 0 (a full disk, the run directory removed) is agreed after each write:
+every rank stops with rank 0's message (engine/runner.py's ``_unwritable``). Any other
+exception on one rank cannot be agreed (the others wait in a collective): the rank prints it
+and aborts the MPI job (``MPI_Abort``), so no rank hangs (``thermodem.cli``).
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ import time as wallclock
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -37,7 +38,12 @@ from thermodem.config.schema import Case
 from thermodem.engine import runner as R
 from thermodem.engine.checks import check_simulation_time_step
 from thermodem.engine.progress import Progress
-from thermodem.engine.run_signals import StartingTogether, StopRequest, not_started
+from thermodem.engine.run_signals import (
+    StartingTogether,
+    StopRequest,
+    not_started,
+    restart_not_started,
+)
 from thermodem.engine.validation import (
     check_completeness,
     format_duration,
@@ -455,8 +461,11 @@ def run_distributed(
             _first_outputs(sim, out)
             _together(comm, starting)
     except KeyboardInterrupt:
+        record = None
+        if runlog is not None and status is not None:  # (rank 0, once the directory is ready)
+            record = partial(not_started, output, runlog, status, checkpoint=checkpoint)
         try:
-            raise _not_started(comm, starting, output, runlog, status) from None
+            raise _not_started(comm, starting, record) from None
         finally:
             _close(runlog, lock)
     except BaseException:
@@ -480,23 +489,21 @@ def _together(comm: Any, starting: StartingTogether) -> None:
 def _not_started(
     comm: Any,
     starting: StartingTogether,
-    output: Path,
-    runlog: R.RunLog | None,
-    status: R.Status | None,
+    record: Callable[[int], RunInterrupted] | None,
+    what: str = "run",
 ) -> RunInterrupted:
-    """A signal while the ranks were set up (engine/run_signals.py: not_started, written by
-    rank 0): agreed, every rank is here and returns the same RunInterrupted; a second signal
-    on this rank, the others may be waiting in a collective: the job is aborted (rank 0, if
-    it is this rank, writes the record first)."""
+    """A signal while the ranks were set up (engine/run_signals.py: not_started,
+    restart_not_started): ``record`` (rank 0, None on the others or before there is
+    anything to record) writes it and returns the RunInterrupted. Agreed, every rank is here
+    and returns rank 0's message; a second signal on this rank, the others may be waiting in
+    a collective: the job is aborted (rank 0, if it is this rank, writes the record first)."""
     signum = starting.signum or signal.SIGINT
-    interrupted = None
-    if runlog is not None and status is not None:  # (rank 0, once the directory is prepared)
-        interrupted = not_started(output, runlog, status, signum)
+    interrupted = record(signum) if record is not None else None
     if not starting.agreed:
         if interrupted is None:
             print(
                 f"interrupted ({signal.Signals(signum).name}) again on MPI rank "
-                f"{comm.Get_rank()} while the run was being set up: aborting every rank",
+                f"{comm.Get_rank()} while the {what} was being set up: aborting every rank",
                 file=sys.stderr,
                 flush=True,
             )
@@ -523,90 +530,118 @@ def restart_distributed(
     rebalance_threshold: float = REBALANCE_THRESHOLD,
 ) -> DistributedSimulation:
     """``restart_run`` on every rank: continue the run in ``output`` from its newest
-    checkpoint (written by any number of ranks)."""
+    checkpoint (written by any number of ranks). A signal while the ranks are set up is
+    agreed at two points (after the build, before the directory is touched; after it is
+    opened) and every rank stops there with rank 0's message, the checkpoints and status.json
+    as they were (engine/run_signals.py: StartingTogether, restart_not_started)."""
     import math
     import uuid
 
     comm = _comm()
     root = comm.Get_rank() == 0
     output = Path(output)
-    error: Exception | None = None
-    newest = None
-    if root:
-        try:
-            if not output.is_dir():
-                raise ConfigError(f"{str(output)!r} is not an output directory")
-            if end_time is not None and not (math.isfinite(end_time) and end_time > 0.0):
-                raise ConfigError(
-                    f"--end-time: {end_time!r} is not allowed; give a finite end time > 0 [s]"
-                )
-            checkpoints = list_checkpoints(output / CHECKPOINT_DIR)
-            if not checkpoints:
-                raise ConfigError(
-                    f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from"
-                )
-            R.refuse_if_busy(output, "restart")
-            ck = R.read_newest_checkpoint(checkpoints)
-            R.check_checkpoint_belongs(ck, output, R.Status.read(output))
-            if end_time is not None and end_time < ck.time:
-                raise ConfigError(
-                    f"--end-time: {end_time:g} s is before the time of the newest checkpoint, "
-                    f"{ck.time:.6g} s ({ck.path}); give a later end time"
-                )
-            newest = str(ck.path)
-        except ConfigError as exc:
-            error = exc
-    _agreed(comm, error)
-    newest = comm.bcast(newest, root=0)
-    ckpt = _read_on_all(comm, newest)
-    case = ckpt.case()
-    if end_time is not None:
-        case.simulation.end_time = float(end_time)
-    sim = _build(case, threads, rebalance_threshold, ckpt)
     lock = runlog = None
-    run = None
-    error = None
-    if root:
-        try:
-            series_repair = R.timeseries_repair(output / TIMESERIES_FILE)
-            lock = R.RunLock(output)
-            lock.acquire()
+    newest: Checkpoint | None = None  # (rank 0: the checkpoint the restart continues from)
+    starting = StartingTogether()
+    try:
+        with starting:
+            error: Exception | None = None
+            path = None
+            if root:
+                try:
+                    if not output.is_dir():
+                        raise ConfigError(f"{str(output)!r} is not an output directory")
+                    if end_time is not None and not (math.isfinite(end_time) and end_time > 0.0):
+                        raise ConfigError(
+                            f"--end-time: {end_time!r} is not allowed; give a finite end time "
+                            "> 0 [s]"
+                        )
+                    checkpoints = list_checkpoints(output / CHECKPOINT_DIR)
+                    if not checkpoints:
+                        raise ConfigError(
+                            f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from"
+                        )
+                    R.refuse_if_busy(output, "restart")
+                    path = checkpoints[-1]
+                    newest = R.read_newest_checkpoint(checkpoints)
+                    R.check_checkpoint_belongs(newest, output, R.Status.read(output))
+                    if end_time is not None and end_time < newest.time:
+                        raise ConfigError(
+                            f"--end-time: {end_time:g} s is before the time of the newest "
+                            f"checkpoint, {newest.time:.6g} s ({newest.path}); give a later "
+                            "end time"
+                        )
+                except ConfigError as exc:
+                    error = exc
+            _agreed(comm, error)
+            path = comm.bcast(str(newest.path) if root else None, root=0)
+            ckpt = _read_on_all(comm, path)
+            case = ckpt.case()
             if end_time is not None:
-                (output / "case.resolved.yaml").write_text(R.resolved_case_yaml(case))
-            previous = R.Status.read(output)
-            runlog, status = R._open(output, log, append=True, case_name=previous.get("case"))
-            run_id = status.data.setdefault("run_id", ckpt.run_id or uuid.uuid4().hex)
-            runlog.info(
-                f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) to end "
-                f"time {case.simulation.end_time:g} s on {sim.size} MPI ranks"
-            )
-            if series_repair is not None:
-                runlog.warn(series_repair())
-            (output / FAILED_FILE).unlink(missing_ok=True)
-            run = R._make_run(sim, output, runlog, status, True, progress, log_interval, None, 1)
-            run.run_id = run_id
-            run.last_checkpoint = ckpt.path
-        except ConfigError as exc:
-            error = exc
-            if lock is not None:
-                lock.release()
-    _agreed(comm, error)
+                case.simulation.end_time = float(end_time)
+            sim = _build(case, threads, rebalance_threshold, ckpt)
+            _together(comm, starting)  # (nothing written yet)
+            run = None
+            error = None
+            if root:
+                try:
+                    series_repair = R.timeseries_repair(output / TIMESERIES_FILE)
+                    lock = R.RunLock(output)
+                    lock.acquire()
+                    previous = R.Status.read(output)
+                    runlog, status = R._open(output, log, append=True,
+                                             case_name=previous.get("case"))  # fmt: skip
+                    run_id = status.data.setdefault("run_id", ckpt.run_id or uuid.uuid4().hex)
+                    runlog.info(
+                        f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) "
+                        f"to end time {case.simulation.end_time:g} s on {sim.size} MPI ranks"
+                    )
+                    if series_repair is not None:
+                        runlog.warn(series_repair())
+                    run = R._make_run(sim, output, runlog, status, True, progress,
+                                      log_interval, None, 1)  # fmt: skip
+                    run.run_id = run_id
+                    run.last_checkpoint = ckpt.path
+                except ConfigError as exc:
+                    error = exc
+                    _close(runlog, lock)
+                    runlog = lock = None
+            _agreed(comm, error)
+            if root:
+                _header(runlog, sim, output)
+            else:
+                sim.halo_summary()
+            out = _outputs(sim, run)
+            out.last_checkpoint = ckpt.path
+            _together(comm, starting)
+    except KeyboardInterrupt:
+        record = None
+        if root and newest is not None:
+            record = partial(restart_not_started, runlog, checkpoint=newest.path,
+                             step=newest.step, time=newest.time)  # fmt: skip
+        elif root:  # (stopped before the newest checkpoint was read)
+            record = partial(restart_not_started, runlog, checkpoint=path)
+        try:
+            raise _not_started(comm, starting, record, "restart") from None
+        finally:
+            _close(runlog, lock)
+    except BaseException:
+        _close(runlog, lock)
+        raise
     try:
         if root:
-            _header(runlog, sim, output)
-        else:
-            sim.halo_summary()
-        out = _outputs(sim, run)
-        out.last_checkpoint = ckpt.path
+            # the set-up is done: the new end time and the end of the failure's record (kept
+            # until here, so that a restart stopped while it was set up changes neither)
+            if end_time is not None:
+                (output / "case.resolved.yaml").write_text(R.resolved_case_yaml(case))
+            (output / FAILED_FILE).unlink(missing_ok=True)
         if sim.step_count >= out.total:
             if root:
                 runlog.info(f"already at the end time (step {sim.step_count}); nothing to do")
             return sim
-        return _drive(sim, out)
+        return _drive(sim, out, pending=starting.signum)
     finally:
-        if root:
-            runlog.close()
-            lock.release()
+        _close(runlog, lock)
 
 
 def _time_step_check(sim: DistributedSimulation) -> list[str]:
