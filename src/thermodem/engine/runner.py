@@ -356,10 +356,21 @@ def _stepped(sim: Simulation, run: _Run, fresh: bool, stop: StopRequest) -> Simu
     )
     log.info(
         f"done: {steps} steps in {format_duration(elapsed)}, {sim.particles.count} particles at "
-        f"t = {sim.time:.6g} s; final checkpoint {final}; open {run.output / 'particles.pvd'} "
-        "in ParaView"
+        f"t = {sim.time:.6g} s; final checkpoint {final}; {outputs_text(run.output, run.frames)}"
     )
     return sim
+
+
+def outputs_text(output: Path, frames: FrameWriter | None) -> str:
+    """The last line's pointer to the outputs: only files that were written (with
+    ``output.vtu: false`` there is no ``particles.pvd`` to open)."""
+    series = f"time series {output / TIMESERIES_FILE}"
+    if frames is None:
+        return (
+            f"{series}; no VTU frames were written (output.vtu: false): thermodem export "
+            f"{output} gives the particles of a checkpoint as CSV"
+        )
+    return f"{series}; open {output / 'particles.pvd'} in ParaView"
 
 
 def _failed(sim: Simulation, run: _Run, exc: SimulationError) -> SimulationError:

@@ -1,0 +1,76 @@
+"""What a run reports and writes, through the CLI in a subprocess: the warnings said while a
+case is built reach run.log, the last line names only files that were written, export leaves
+out what a run never computed, warnings come with (before) the refusal they explain, and
+implausible model parameters are told."""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+from pathlib import Path
+
+import yaml
+
+EXE = Path(sys.executable).with_name("thermodem")
+
+CASE = {
+    "simulation": {"time_step": 1.0e-5, "end_time": 5.0e-5},
+    "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
+    "materials": {
+        "glass": {
+            "density": 2500,
+            "youngs_modulus": 1.0e7,
+            "poisson_ratio": 0.3,
+            "thermal_conductivity": 1.0,
+            "specific_heat": 800,
+        }
+    },
+    "walls": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "glass"}],
+    "insertion": [
+        {
+            "kind": "list",
+            "material": "glass",
+            "positions": [[0.003, 0.003, 0.003], [0.005, 0.003, 0.003]],
+            "radii": [0.001, 0.001],
+        }
+    ],
+}
+
+
+def _write(tmp_path: Path, name: str = "case.yaml", **sections) -> Path:  # noqa: ANN003
+    data = copy.deepcopy(CASE)
+    for key, value in sections.items():
+        data[key] = value
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def _cli(*args: object) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [str(EXE), *(str(a) for a in args)], capture_output=True, text=True, timeout=600
+    )
+
+
+def _run(case: Path, out: Path) -> subprocess.CompletedProcess:
+    return _cli("run", case, "--output", out, "--no-progress")
+
+
+def test_without_vtu_the_last_line_names_no_pvd(tmp_path: Path) -> None:
+    """output.vtu: false: the last line said 'open OUT/particles.pvd in ParaView', a file that
+    was never written."""
+    out = tmp_path / "out"
+    res = _run(_write(tmp_path, output={"vtu": False}), out)
+    assert res.returncode == 0, res.stdout + res.stderr
+    last = res.stdout.strip().splitlines()[-1]
+    assert "particles.pvd" not in last, last
+    assert "no VTU frames were written (output.vtu: false)" in last
+    assert f"time series {out / 'timeseries.csv'}" in last
+    assert not (out / "particles.pvd").exists()
+    assert "no VTU frames were written" in (out / "run.log").read_text()
+    # with frames: the file it names exists
+    res = _run(_write(tmp_path), tmp_path / "frames")
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert f"open {tmp_path / 'frames' / 'particles.pvd'} in ParaView" in res.stdout
+    assert (tmp_path / "frames" / "particles.pvd").is_file()
