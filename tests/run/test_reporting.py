@@ -74,3 +74,16 @@ def test_without_vtu_the_last_line_names_no_pvd(tmp_path: Path) -> None:
     assert res.returncode == 0, res.stdout + res.stderr
     assert f"open {tmp_path / 'frames' / 'particles.pvd'} in ParaView" in res.stdout
     assert (tmp_path / "frames" / "particles.pvd").is_file()
+
+
+def test_a_warning_said_while_the_case_is_built_reaches_run_log(tmp_path: Path) -> None:
+    """thermal.fluid that no selected model reads is told while the simulation is built (a
+    RuntimeWarning): the CLI printed it on stderr, run.log did not have it."""
+    out = tmp_path / "out"
+    case = _write(tmp_path, thermal={"fluid": {"temperature": 300.0, "velocity": [0, 0, 0.1]}})
+    res = _run(case, out)
+    assert res.returncode == 0, res.stdout + res.stderr
+    text = "warning: thermal.fluid is given but no selected model reads it"
+    assert res.stdout.count(text) == 1, res.stdout
+    assert text not in res.stderr, res.stderr
+    assert (out / "run.log").read_text().count(text) == 1

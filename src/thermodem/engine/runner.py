@@ -48,7 +48,8 @@ import sys
 import time as wallclock
 import uuid
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
@@ -282,6 +283,20 @@ def _unwritable(sim: Simulation, run: _Run, exc: OSError, ranks: int = 1) -> Sim
     )
 
 
+@contextmanager
+def logged_warnings(log: RunLog) -> Iterator[None]:
+    """Warnings raised inside (while the simulation is built: a fluid section no model reads;
+    while it steps: a pour that placed fewer particles) go to the console and ``run.log``
+    through ``log`` as ``warning: ...`` lines (a :class:`RunNotice` as a plain line), not to
+    the CLI's stderr only: a user reading run.log later sees them."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", RuntimeWarning)
+        warnings.showwarning = lambda msg, cat, *a, **k: (
+            log.info if issubclass(cat, RunNotice) else log.warn
+        )(str(msg))
+        yield
+
+
 def _loop(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     # the signal handlers stay until the run's end is on disk: once it is stopping or ending
     # (the interrupt checkpoint, the record of a failure, the final outputs) a signal is
@@ -300,11 +315,7 @@ def _stepped(sim: Simulation, run: _Run, fresh: bool, stop: StopRequest) -> Simu
     started = wallclock.perf_counter()
     start_step = sim.step_count
     try:
-        with progress, warnings.catch_warnings():
-            warnings.simplefilter("always", RuntimeWarning)
-            warnings.showwarning = lambda msg, cat, *a, **k: (
-                log.info if issubclass(cat, RunNotice) else log.warn
-            )(str(msg))
+        with progress, logged_warnings(log):
             while sim.step_count < run.total:
                 if stop.signum:
                     raise KeyboardInterrupt
@@ -528,7 +539,7 @@ def run_case(
         starting = Starting()
         try:
             try:
-                with starting:
+                with starting, logged_warnings(runlog):
                     sim = Simulation(case, threads=threads)
                     for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
                         runlog.warn(warning)
