@@ -97,12 +97,20 @@ def _guarded(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
             warnings.showwarning = show
             return fn(*args, **kwargs)
     except ConfigError as exc:
+        _told(exc)
         _fail(str(exc), EXIT_INPUT)
     except SimulationError as exc:
         _fail(str(exc), EXIT_SIMULATION)
     except RunInterrupted as exc:
         typer.echo(str(exc), err=True)
         raise typer.Exit(exc.exit_code) from None
+
+
+def _told(exc: ConfigError) -> None:
+    """The warnings computed before a refusal, before its error line (a density in g/cm³
+    explains a time step refused for the tiny mass); a run logged them already."""
+    for warning in exc.warnings or ():
+        typer.echo(f"warning: {warning}", err=True)
 
 
 def _guarded_mpi(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
@@ -120,6 +128,7 @@ def _guarded_mpi(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
         return fn(*args, **kwargs)
     except ConfigError as exc:
         if root:
+            _told(exc)
             typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(EXIT_INPUT) from None
     except SimulationError as exc:

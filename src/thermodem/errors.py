@@ -5,7 +5,14 @@ from __future__ import annotations
 
 
 class ConfigError(ValueError):
-    """A case that cannot run; the message names the key path, the value and what is allowed."""
+    """A case that cannot run; the message names the key path, the value and what is allowed.
+
+    ``warnings``: the warnings of the case computed before the refusal (a density in g/cm³
+    that explains a time step refused for the tiny mass it gives), said before the error:
+    the CLI prints them as ``warning: ...`` lines; a run that logs them itself (run.log)
+    empties the list. None when none were gathered."""
+
+    warnings: list[str] | None = None
 
 
 class SimulationError(RuntimeError):

@@ -87,3 +87,23 @@ def test_a_warning_said_while_the_case_is_built_reaches_run_log(tmp_path: Path) 
     assert res.stdout.count(text) == 1, res.stdout
     assert text not in res.stderr, res.stderr
     assert (out / "run.log").read_text().count(text) == 1
+
+
+def test_the_warnings_before_a_refusal_are_told_with_it(tmp_path: Path) -> None:
+    """density: 2.5 (g/cm³) gives a mass 1000 times too small and a time step refused for it;
+    the refusal came alone, without the density warning that explains it."""
+    glass = {**CASE["materials"]["glass"], "density": 2.5}
+    case = _write(tmp_path, materials={"glass": glass})
+    warning = "warning: materials.glass.density: 2.5 kg/m³ is below 30 kg/m³"
+    res = _cli("validate", case)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert res.stderr.count(warning) == 1, res.stderr
+    assert res.stderr.index(warning) < res.stderr.index("error: time step refused")
+    out = tmp_path / "out"
+    res = _run(case, out)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (res.stdout + res.stderr).count(warning) == 1, res.stdout + res.stderr
+    assert "error: time step refused" in res.stderr
+    log = (out / "run.log").read_text()
+    assert log.count(warning) == 1
+    assert log.index(warning) < log.index("error: time step refused")

@@ -86,6 +86,7 @@ from thermodem.engine.validation import (
     format_duration,
     pre_run_checks,
     total_steps,
+    with_warnings,
 )
 from thermodem.errors import ConfigError, RunInterrupted, RunNotice, SimulationError
 from thermodem.io.checkpoint import (
@@ -552,6 +553,11 @@ def run_case(
             except KeyboardInterrupt:
                 raise not_started(output, runlog, status, starting.signum) from None
             except ConfigError as exc:
+                # the warnings that may explain the refusal, before it (a density in g/cm³
+                # before the time step its tiny mass refuses), on the console and in run.log
+                for warning in with_warnings(exc, case).warnings or ():
+                    runlog.warn(warning)
+                exc.warnings = []  # (told: the CLI does not print them again)
                 runlog.file_only(f"error: {exc}")
                 status.update(status="failed", message=str(exc), refused_input=True)
                 raise

@@ -553,16 +553,43 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     from thermodem.engine.checks import check_simulation_time_step
 
     case = sim.case
-    check_contact_law_agreement(case)
-    check_step_count(sim)
-    on_every_rank(sim, check_wall_overlaps)
-    check_pour_walls(sim)
-    check_length_scales(sim)
-    notes = check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
-    notes += section_warnings(case) + check_thermal_selections(sim) + insertion_warnings(case)
-    notes += time_table_warnings(case) + property_warnings(case)
-    notes += temperature_warnings(sim) + step_interval_warnings(sim)
-    return notes + list(on_every_rank(sim, check_simulation_time_step))
+    notes: list[str] = []
+    try:
+        check_contact_law_agreement(case)
+        check_step_count(sim)
+        on_every_rank(sim, check_wall_overlaps)
+        check_pour_walls(sim)
+        check_length_scales(sim)
+        notes += check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
+        notes += section_warnings(case) + check_thermal_selections(sim)
+        notes += insertion_warnings(case) + time_table_warnings(case) + property_warnings(case)
+        notes += temperature_warnings(sim) + step_interval_warnings(sim)
+        return notes + list(on_every_rank(sim, check_simulation_time_step))
+    except ConfigError as exc:
+        with_warnings(exc, case, notes)
+        raise
+
+
+def case_level_warnings(case: Case) -> list[str]:
+    """The warnings of the case alone (no simulation needed): sections, pours, time tables,
+    material values in another unit, implausible model parameters."""
+    return (
+        section_warnings(case)
+        + insertion_warnings(case)
+        + time_table_warnings(case)
+        + property_warnings(case)
+    )
+
+
+def with_warnings(exc: ConfigError, case: Case, told: list[str] | None = None) -> ConfigError:
+    """``exc`` with the warnings that may explain it (``ConfigError.warnings``): those computed
+    before the refusal (``told``) and the case's own (:func:`case_level_warnings`), each once;
+    a density in g/cm³ gives a mass 1000 times too small and a time step refused for it, and
+    the refusal alone does not say why. Kept when ``exc`` has them already."""
+    if exc.warnings is None:
+        told = list(told or [])
+        exc.warnings = told + [w for w in case_level_warnings(case) if w not in told]
+    return exc
 
 
 @dataclass
@@ -579,9 +606,13 @@ def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> V
     from thermodem.engine.simulation import Simulation
 
     case = load_case(path)
-    check_completeness(case)
-    sim = Simulation(case, threads=threads)
-    warnings = pre_run_checks(sim)
+    try:
+        check_completeness(case)
+        sim = Simulation(case, threads=threads)
+        warnings = pre_run_checks(sim)
+    except ConfigError as exc:
+        with_warnings(exc, case)
+        raise
     warnings += output_interval_warnings(case)
     estimate = estimate_resources(sim, threads)
     warnings += check_resources(estimate)
