@@ -138,6 +138,25 @@ def test_zhou2010_scales_the_hertz_radius():
     )
 
 
+def test_zhou2010_at_the_deepest_point_of_an_impact_is_the_spec_formula():
+    """Spec: R_c^cor = (E*/E*_real)^{1/5} R_c^max, R_c^max = (15/16 m* R*² v²/E*)^{1/5}
+    (appendix A). The kernel scales the current Hertz radius; at δ = δ_max = (R_c^max)²/R* it
+    is the spec's value, and it equals R_c^max of the same impact with the real modulus."""
+    _, e_sim, e_real = soft_pair()
+    r_i, r_j, m, v = 1.0e-3, 2.0e-3, 3.0e-6, 0.4
+    r_eff = r_i * r_j / (r_i + r_j)
+    r_max = (15.0 / 16.0 * m * r_eff**2 * v**2 / e_sim) ** 0.2
+    spec = (e_sim / e_real) ** 0.2 * r_max
+    for hertz_from in ("overlap", "force"):
+        p = pack("zhou2010", hertz_from=hertz_from)
+        d_max = r_max**2 / r_eff
+        f_max = 4.0 / 3.0 * e_sim * math.sqrt(r_eff) * d_max**1.5
+        got = radius("zhou2010", p, r_i, r_j, d_max, f_n=f_max)
+        assert got == pytest.approx(spec, rel=1e-13)
+    real = (15.0 / 16.0 * m * r_eff**2 * v**2 / e_real) ** 0.2
+    assert spec == pytest.approx(real, rel=1e-13)
+
+
 def test_lu2017_solves_its_definition_numerically():
     """Same force: k_n δ_sim = (4/3) E*_real sqrt(R*) δ_real^{3/2}, R_c = sqrt(R* δ_real)."""
     _, _, e_real = soft_pair()
