@@ -263,7 +263,8 @@ def export(
     overwrite: bool = typer.Option(False, "--overwrite", help="replace an existing --out file"),
 ) -> None:
     """Particle state as CSV (one row per particle: global id, material, position, velocity,
-    radius, temperature, heat rate), from a frame or a checkpoint."""
+    radius, and for a run with heat temperature and heat rate), from a frame or a
+    checkpoint."""
     from thermodem.io.export import export_particles
 
     where = _guarded(export_particles, directory, frame, checkpoint, out, overwrite)

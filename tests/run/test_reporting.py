@@ -107,3 +107,27 @@ def test_the_warnings_before_a_refusal_are_told_with_it(tmp_path: Path) -> None:
     log = (out / "run.log").read_text()
     assert log.count(warning) == 1
     assert log.index(warning) < log.index("error: time step refused")
+
+
+def test_export_and_plot_of_a_run_without_heat_leave_the_heat_out(tmp_path: Path) -> None:
+    """A run without a thermal section was exported with temperature 293.15 and heat_rate 0,
+    values it never computed."""
+    out = tmp_path / "out"
+    res = _run(_write(tmp_path), out)
+    assert res.returncode == 0, res.stdout + res.stderr
+    for args in (("--frame", "-1"), ()):
+        res = _cli("export", out, *args, "--out", "-")
+        assert res.returncode == 0, res.stdout + res.stderr
+        first, header, row = res.stdout.splitlines()[:3]
+        assert "no thermal section: the run computed no temperature or heat rate" in first
+        assert "temperature [K]" not in first
+        assert header == "global_id,material,x,y,z,vx,vy,vz,radius"
+        assert len(row.split(",")) == 9
+    res = _cli("plot", out)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert sorted(Path(p).name for p in res.stdout.split()) == ["contacts.png", "energies.png"]
+    # with heat: the columns are there
+    heated = tmp_path / "heated"
+    assert _run(_write(tmp_path, thermal={}), heated).returncode == 0
+    res = _cli("export", heated, "--out", "-")
+    assert res.stdout.splitlines()[1].endswith(",radius,temperature,heat_rate")

@@ -2,7 +2,9 @@
 
 One row per particle, sorted by global id, with the columns :data:`COLUMNS`: global id,
 material name, position, velocity, radius, temperature and heat rate (the sum over the
-mechanisms). The state comes from an output frame (``--frame N``, the N-th entry of
+mechanisms). A run without a ``thermal`` section computed no temperature or heat rate (its
+particles keep the initial temperature and 0 W): those columns are left out, and the first
+line says so. The state comes from an output frame (``--frame N``, the N-th entry of
 ``particles.pvd``, counted from 0; negative counts from the end) or from a checkpoint
 (``--checkpoint PATH``; by default the newest checkpoint of the directory). Nothing is
 compiled or simulated: the VTU or HDF5 file is read as it is.
@@ -38,6 +40,10 @@ COLUMNS = (
     "heat_rate",
 )
 UNITS = "positions [m], velocities [m/s], radius [m], temperature [K], heat_rate [W]"
+#: The columns a run without a ``thermal`` section never computes (its particles keep the
+#: initial temperature and a heat rate of 0): left out of the CSV of such a run.
+THERMAL_COLUMNS = ("temperature", "heat_rate")
+NO_HEAT = "no thermal section: the run computed no temperature or heat rate"
 
 
 class ParticleTable:
@@ -63,6 +69,36 @@ class ParticleTable:
         self.heat_rate = np.asarray(heat_rate, float)
         self.source = source
         self.frame_index: int | None = None
+        self.heat = True  # False: a run without heat (no temperature or heat rate columns)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        if self.heat:
+            return COLUMNS
+        return tuple(c for c in COLUMNS if c not in THERMAL_COLUMNS)
+
+
+def _case_has_heat(text: str | None) -> bool:
+    """Whether a resolved case (its YAML text) has a ``thermal`` section; True when it cannot
+    be read (the columns are then written as the file holds them)."""
+    import yaml
+
+    if text is None:
+        return True
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return True
+    return not isinstance(data, dict) or data.get("thermal") is not None
+
+
+def _directory_has_heat(directory: Path) -> bool:
+    """Whether the run in ``directory`` had heat, from its ``case.resolved.yaml``."""
+    try:
+        text = (directory / "case.resolved.yaml").read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return True
+    return _case_has_heat(text)
 
 
 def from_frame(directory: Path, frame: int) -> ParticleTable:
@@ -108,6 +144,7 @@ def from_frame(directory: Path, frame: int) -> ParticleTable:
         f"frame {frame % len(entries)} of {pvd} ({file}), t = {time!r} s",
     )
     table.frame_index = frame % len(entries)  # -1: the last frame's own number
+    table.heat = _directory_has_heat(directory)
     return table
 
 
@@ -119,7 +156,7 @@ def from_checkpoint(path: Path) -> ParticleTable:
     p = ckpt.state["particles"]
     names = list(ckpt.state["scalars"].get("material_names", []))
     material = [names[k] if 0 <= k < len(names) else str(int(k)) for k in p["type_id"]]
-    return ParticleTable(
+    table = ParticleTable(
         p["global_id"],
         material,
         p["position"],
@@ -129,6 +166,8 @@ def from_checkpoint(path: Path) -> ParticleTable:
         p["heat_rate"],
         f"checkpoint {ckpt.path} ({ckpt.kind}), step {ckpt.step}, t = {ckpt.time!r} s",
     )
+    table.heat = _case_has_heat(ckpt.case_yaml)
+    return table
 
 
 def _rows(table: ParticleTable) -> list[list[str]]:
@@ -137,11 +176,11 @@ def _rows(table: ParticleTable) -> list[list[str]]:
     for i in order:
         x, v = table.position[i], table.velocity[i]
         values = (x[0], x[1], x[2], v[0], v[1], v[2], table.radius[i])
-        rows.append(
-            [str(int(table.global_id[i])), table.material[i]]
-            + [repr(float(a)) for a in values]
-            + [repr(float(table.temperature[i])), repr(float(table.heat_rate[i]))]
-        )
+        row = [str(int(table.global_id[i])), table.material[i]]
+        row += [repr(float(a)) for a in values]
+        if table.heat:
+            row += [repr(float(table.temperature[i])), repr(float(table.heat_rate[i]))]
+        rows.append(row)
     return rows
 
 
@@ -152,9 +191,10 @@ def write_csv(
     ``out`` is replaced only with ``overwrite``; ``given``: ``out`` is the user's ``--out``
     (else the default file in the run's directory)."""
     buffer = io.StringIO()
-    buffer.write(f"# thermodem export: {table.source}; {UNITS}\n")
+    units = UNITS if table.heat else f"{UNITS.rsplit(', temperature', 1)[0]}; {NO_HEAT}"
+    buffer.write(f"# thermodem export: {table.source}; {units}\n")
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(COLUMNS)
+    writer.writerow(table.columns)
     writer.writerows(_rows(table))
     if out is None:
         sys.stdout.write(buffer.getvalue())
