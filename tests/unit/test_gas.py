@@ -51,6 +51,18 @@ def test_mean_free_path_from_kinetic_theory_by_hand():
     assert GasProperties(**GAS).prandtl() == pytest.approx(2.8e-5 * 5193.0 / 0.2, rel=1e-14)
 
 
+def test_physical_constants_are_the_specs_to_its_printed_digits():
+    """k_B (Vargas & McCarthy's mean free path) and σ (radiation) are the exact SI values; the
+    spec prints 1.3806e-23 J/K (k_B rounded) and 5.6703e-8 W/(m² K⁴) (σ truncated, or an older
+    value: 1.3e-5 relative below CODATA)."""
+    from thermodem.models.thermal.radiation import STEFAN_BOLTZMANN
+    from thermodem.state.gas import BOLTZMANN
+
+    assert BOLTZMANN == 1.380649e-23 and STEFAN_BOLTZMANN == 5.670374419e-8
+    assert abs(BOLTZMANN - 1.3806e-23) < 0.5e-27  # half a unit of the last printed digit
+    assert 0 < STEFAN_BOLTZMANN / 5.6703e-8 - 1 < 1.5e-5
+
+
 @pytest.mark.parametrize(
     ("gas", "expected"),
     [
