@@ -126,3 +126,22 @@ def test_rolling_laws_by_hand():
     # at the limit (no plastic damping by default): |M| = μ_r R* F_n
     out = rolling.epsd(p, k_n, R_EFF, i_r, 1e-6, *(1e4 * w), *m0, dt)
     assert np.linalg.norm(out[:3]) == pytest.approx(mu_r * R_EFF * 1e-6, rel=1e-13)
+
+
+def test_sustained_sliding_heat_is_the_specs_coulomb_power():
+    """Spec 5, sliding friction: Q_g = χ |μ F_n δ̇_t|. In steady sliding (the spring held at the
+    cap, with or without the tangential dashpot) the energy the kernel books as sliding in a
+    step is μ F_n |v_t| Δt, and nothing as damping."""
+    p = tangential.pack_mindlin(tangential.MindlinParams(), pair())
+    mu = p[tangential.MINDLIN_FRICTION]
+    delta, dt, f_n = 2.0e-6, 1.0e-7, 0.05
+    v = np.array([0.3, 0.0, -0.4])  # |v_t| = 0.5 m/s
+    for gamma_n in (0.0, 0.02):
+        s = np.zeros(3)
+        for _ in range(200):  # from first touch to steady sliding
+            out = _mindlin(p, 4.0e5, gamma_n, delta, f_n, v, s, dt)
+            s = np.array(out[3:6])
+        out = _mindlin(p, 4.0e5, gamma_n, delta, f_n, v, s, dt)
+        assert np.linalg.norm(out[:3]) == pytest.approx(mu * f_n, rel=1e-13)
+        assert out[8] == pytest.approx(mu * f_n * 0.5 * dt, rel=1e-12)
+        assert abs(out[7]) < 1e-12 * out[8]
