@@ -145,3 +145,16 @@ def test_sustained_sliding_heat_is_the_specs_coulomb_power():
         assert np.linalg.norm(out[:3]) == pytest.approx(mu * f_n, rel=1e-13)
         assert out[8] == pytest.approx(mu * f_n * 0.5 * dt, rel=1e-12)
         assert abs(out[7]) < 1e-12 * out[8]
+
+
+def test_linear_dashpot_power_is_richard2008s_formula():
+    """Spec 5 (Richard et al. 2008): Q_g = F_n^vis δ̇_n = 2 μ sqrt(K_n m̄) δ̇_n², μ the damping
+    ratio of the linear law, -ln e / sqrt(π² + ln² e) for the restitution e."""
+    pr = pair()
+    e = 0.5 * (0.7 + 0.5)
+    zeta = -math.log(e) / math.sqrt(math.pi**2 + math.log(e) ** 2)
+    k_n, rate = 3.0e4, 0.7
+    p = normal.pack_linear(normal.LinearParams(stiffness=k_n), pr)
+    f_el, f_d, k, gamma, energy, _, _ = normal.linear_force(p, 1e-6, rate, R_EFF, M_EFF, 0.0)
+    assert (f_el, k) == (k_n * 1e-6, k_n) and energy == pytest.approx(0.5 * k_n * 1e-12)
+    assert f_d * rate == pytest.approx(2 * zeta * math.sqrt(k_n * M_EFF) * rate**2, rel=1e-14)
