@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 
 EXE = Path(sys.executable).with_name("thermodem")
@@ -131,3 +132,75 @@ def test_export_and_plot_of_a_run_without_heat_leave_the_heat_out(tmp_path: Path
     assert _run(_write(tmp_path, thermal={}), heated).returncode == 0
     res = _cli("export", heated, "--out", "-")
     assert res.stdout.splitlines()[1].endswith(",radius,temperature,heat_rate")
+
+
+SURFACE = {"surface_slope": 0.1, "microhardness": 3.0e9, "surface_roughness": 1.0e-6,
+           "thermal_accommodation": 0.9}  # fmt: skip
+NETWORK = {"direct_conduction": "resistance_network"}
+RADIATION = {"radiation": {"model": "surroundings", "environment_temperature": 300.0}}
+GENERATION = {"heat_generation": {"model": "rojek2014", "conversion_fraction": 0.0}}
+
+
+@pytest.mark.parametrize(
+    ("glass", "thermal", "message"),
+    [
+        (
+            {**SURFACE, "surface_slope": 50.0},
+            NETWORK,
+            "warning: materials.glass.surface_slope: 50 is above 2, steeper than any real surface "
+            "(the RMS asperity slope, the tangent of the asperities' angle, is usually 0.05-0.5): "
+            "is it an angle in degrees? (50° is a slope tan 50° = 1.19)",
+        ),
+        (
+            {**SURFACE, "microhardness": 1.0e-3},
+            NETWORK,
+            "warning: materials.glass.microhardness: 0.001 Pa is below 1e+07 Pa, softer than any "
+            "solid (real microhardnesses are 1e8-1e10 Pa, lead about 5e7 Pa): is it in MPa or GPa?",
+        ),
+        (
+            {**SURFACE, "microhardness": 3.0e15},
+            NETWORK,
+            "warning: materials.glass.microhardness: 3e+15 Pa is above 2e+11 Pa, harder than "
+            "diamond",
+        ),
+        (
+            {"emissivity": 0.0},
+            RADIATION,
+            "warning: thermal.radiation = 'surroundings', but every particle material has "
+            "emissivity 0 (materials.glass.emissivity = 0): the radiation model exchanges no heat",
+        ),
+        (
+            {},
+            GENERATION,
+            "warning: thermal.heat_generation = 'rojek2014' with conversion_fraction 0: it turns "
+            "none of the dissipation into heat, so the model does nothing",
+        ),
+    ],
+    ids=["slope", "microhardness_low", "microhardness_high", "emissivity", "generation"],
+)
+def test_implausible_parameters_are_warned_about(
+    tmp_path: Path, glass: dict, thermal: dict, message: str
+) -> None:
+    """Values far outside any real material (a slope of 50, a microhardness of 1e-3 Pa) and
+    selections that do nothing (radiation with every emissivity 0, heat generation with
+    χ = 0) ran without a word."""
+    materials = {"glass": {**CASE["materials"]["glass"], **glass}}
+    res = _cli("validate", _write(tmp_path, materials=materials, thermal=thermal))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert res.stderr.count(message) == 1, res.stderr
+
+
+def test_plausible_parameters_and_a_fluid_at_rest_are_not_warned_about(tmp_path: Path) -> None:
+    """Real values give none of those warnings; a convection model in a fluid at rest is the
+    natural-convection limit (Nu = 2), not a mistake."""
+    materials = {"glass": {**CASE["materials"]["glass"], **SURFACE, "emissivity": 0.9}}
+    thermal = {**NETWORK, **RADIATION, "heat_generation": {"model": "rojek2014"}}
+    res = _cli("validate", _write(tmp_path, materials=materials, thermal=thermal))
+    assert res.returncode == 0, res.stdout + res.stderr
+    for key in ("surface_slope", "microhardness", "emissivity", "conversion_fraction"):
+        assert key not in res.stderr, res.stderr
+    still = {"convection": "ranz_marshall1952",
+             "fluid": {"temperature": 300.0, "velocity": [0.0, 0.0, 0.0]}}  # fmt: skip
+    res = _cli("validate", _write(tmp_path, thermal=still))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "velocity" not in res.stderr, res.stderr

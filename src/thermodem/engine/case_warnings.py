@@ -1,7 +1,9 @@
 """Warnings of a case that runs but may not do what it says, told before its first step by
 ``thermodem validate`` and ``thermodem run`` (:func:`thermodem.engine.validation.pre_run_checks`):
 temperatures that look like °C, output intervals in steps or below the time step, pours that
-pour nothing, a skin of many diameters, a wall closing a periodic axis, ``thermal: null``.
+pour nothing, a skin of many diameters, a wall closing a periodic axis, ``thermal: null``,
+material values in another unit, model parameters far outside any real material and
+selections that do nothing.
 Each names the key, the value and what was probably meant; none refuses the case."""
 
 from __future__ import annotations
@@ -101,6 +103,83 @@ def property_warnings(case: Case) -> list[str]:
                 "is the stiffer one (the simulation softens the material to take longer time "
                 "steps); are the two swapped?"
             )
+    return out
+
+
+#: An RMS asperity slope above this is told: real surfaces have 0.05-0.5 (asperity angles of
+#: 3°-27°); 2 is an angle of 63°. A value in degrees is the usual cause.
+SLOPE_SUSPECT_ABOVE = 2.0
+#: A microhardness outside these [Pa] is told: real ones are 1e8-1e10 Pa (lead about 5e7 Pa,
+#: diamond about 1e11 Pa); a value in MPa or GPa is the usual cause.
+MICROHARDNESS_SUSPECT_BELOW = 1.0e7
+MICROHARDNESS_SUSPECT_ABOVE = 2.0e11
+
+
+def _slope_text(key: str, value: float) -> str:
+    hint = ""
+    if value < 90.0:
+        hint = f": is it an angle in degrees? ({value:g}° is a slope tan {value:g}° = " + (
+            f"{math.tan(math.radians(value)):.3g})"
+        )
+    return (
+        f"{key}: {value:g} is above {SLOPE_SUSPECT_ABOVE:g}, steeper than any real surface (the "
+        "RMS asperity slope, the tangent of the asperities' angle, is usually 0.05-0.5)" + hint
+    )
+
+
+def parameter_warnings(case: Case) -> list[str]:
+    """Parameters far outside any real material (a unit mistake) and selections that do
+    nothing, in a case with heat: a ``surface_slope`` above :data:`SLOPE_SUSPECT_ABOVE` (an
+    angle in degrees?), a ``microhardness`` outside 1e7-2e11 Pa (MPa or GPa?), a radiation
+    model whose particle materials all have emissivity 0 (it exchanges no heat), a heat
+    generation model with ``conversion_fraction: 0`` (it generates none). Warnings: each
+    names the key, the value and the usual range. (A convection model in a fluid at rest is
+    the natural-convection limit, Nu = 2: not told.)"""
+    th = case.thermal
+    if th is None:
+        return []
+    out = []
+    for name, m in case.materials.items():
+        key = f"materials.{name}"
+        if m.surface_slope is not None and m.surface_slope > SLOPE_SUSPECT_ABOVE:
+            out.append(_slope_text(f"{key}.surface_slope", m.surface_slope))
+        hardness = m.microhardness
+        if hardness is not None and hardness < MICROHARDNESS_SUSPECT_BELOW:
+            out.append(
+                f"{key}.microhardness: {hardness:g} Pa is below "
+                f"{MICROHARDNESS_SUSPECT_BELOW:g} Pa, softer than any solid (real "
+                "microhardnesses are 1e8-1e10 Pa, lead about 5e7 Pa): is it in MPa or GPa? "
+                f"({hardness:g} MPa = {hardness * 1e6:g} Pa, {hardness:g} GPa = "
+                f"{hardness * 1e9:g} Pa)"
+            )
+        elif hardness is not None and hardness > MICROHARDNESS_SUSPECT_ABOVE:
+            out.append(
+                f"{key}.microhardness: {hardness:g} Pa is above "
+                f"{MICROHARDNESS_SUSPECT_ABOVE:g} Pa, harder than diamond (about 1e11 Pa; real "
+                "microhardnesses are 1e8-1e10 Pa): is it in another unit?"
+            )
+    for k, o in enumerate(case.interactions):
+        if o.surface_slope is not None and o.surface_slope > SLOPE_SUSPECT_ABOVE:
+            out.append(_slope_text(f"interactions.{k}.surface_slope", o.surface_slope))
+    if th.radiation.model != "none":
+        particles = sorted({e.material for e in case.insertion})
+        values = {n: case.materials[n].emissivity for n in particles if n in case.materials}
+        if values and all(v is not None and v == 0.0 for v in values.values()):
+            keys = ", ".join(f"materials.{n}.emissivity = 0" for n in values)
+            out.append(
+                f"thermal.radiation = {th.radiation.model!r}, but every particle material has "
+                f"emissivity 0 ({keys}): the radiation model exchanges no heat; most solids "
+                "have 0.2-0.95 (polished metals 0.02-0.1): give the emissivity, or radiation: "
+                "none"
+            )
+    generation = th.heat_generation
+    fraction = getattr(generation.params, "conversion_fraction", None)
+    if generation.model != "none" and fraction is not None and fraction == 0.0:
+        out.append(
+            f"thermal.heat_generation = {generation.model!r} with conversion_fraction 0: it "
+            "turns none of the dissipation into heat, so the model does nothing; give the "
+            "fraction χ that becomes heat (usually 0.85-1), or heat_generation: none"
+        )
     return out
 
 

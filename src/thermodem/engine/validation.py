@@ -27,6 +27,7 @@ from pydantic import BaseModel
 from thermodem.engine.case_warnings import (
     insertion_warnings,
     output_interval_warnings,
+    parameter_warnings,
     periodic_wall_warnings,
     property_warnings,
     section_warnings,
@@ -563,6 +564,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
         notes += check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
         notes += section_warnings(case) + check_thermal_selections(sim)
         notes += insertion_warnings(case) + time_table_warnings(case) + property_warnings(case)
+        notes += parameter_warnings(case)
         notes += temperature_warnings(sim) + step_interval_warnings(sim)
         return notes + list(on_every_rank(sim, check_simulation_time_step))
     except ConfigError as exc:
@@ -578,6 +580,7 @@ def case_level_warnings(case: Case) -> list[str]:
         + insertion_warnings(case)
         + time_table_warnings(case)
         + property_warnings(case)
+        + parameter_warnings(case)
     )
 
 
