@@ -117,6 +117,8 @@ DERIVED: tuple[str, ...] = (
     "threads",
     "threads_reason",
     "governor",  # (engine/threads.py: ThreadGovernor, made by set_threads)
+    # the log line of heat that started at this restart (restore; engine/heat_start.py)
+    "heat_start",
 )
 #: Attributes of the thermal engine that are never saved (objects, back references).
 THERMAL_SKIP: tuple[str, ...] = ("sim", "settings", "wall_functions")
@@ -439,8 +441,20 @@ def _case_wall_columns(sim: Simulation, fresh: np.ndarray) -> None:
             rows[w, WL.COL_TEMPERATURE] = fresh[w, WL.COL_TEMPERATURE]
 
 
+#: A checkpoint with heat continued by a case without a ``thermal`` section.
+NO_THERMAL_SECTION = (
+    "thermal: the case has no thermal section, but the checkpoint holds the particles' "
+    "temperatures and heat ledger (its run had one); a restart does not drop them. Allowed: "
+    "keep the thermal section (as in the case.resolved.yaml of the run that wrote it; its "
+    "models, properties and conditions may change), or continue a checkpoint written without "
+    "heat"
+)
+
+
 def restore(sim: Simulation, state: dict[str, Any]) -> None:
-    """Load ``state`` (from :func:`capture`) into ``sim``, built from the same case."""
+    """Load ``state`` (from :func:`capture`) into ``sim``, built from the same case. A state
+    without heat loaded into a case with a ``thermal`` section starts the heat at its time
+    (engine/heat_start.py; the log line in ``sim.heat_start``)."""
     check_state(state)
     s = state["scalars"]
     if list(s["material_names"]) != list(sim.material_names):
@@ -482,6 +496,7 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
         elif value is not None:
             value = float(value)
         setattr(sim, name, value)
+    fresh_ledger = dict(sim.ledger_cumulative)  # (the case's keys, for heat that starts)
     sim.ledger_cumulative = {k: float(v) for k, v in s["ledger_cumulative"].items()}
     _load_pairs(sim.pairs, state["pairs"], int(s["pair_count"]), int(s["pair_capacity"]))
     _load_pairs(sim.walls, state["walls"], int(s["wall_pair_count"]), int(s["wall_pair_capacity"]))
@@ -494,9 +509,11 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
     for pourer, ps in zip(sim.pourers, s["pourers"], strict=True):
         pourer.load_state_dict(dict(ps))
     th = sim.thermal
-    if th is not None:
-        if "thermal" not in state:
-            raise ConfigError("checkpoint has no thermal state but the case has a thermal section")
+    sim.heat_start = None
+    # a state without heat and a case with heat: the heat starts at this restart, below, once
+    # the step is known (engine/heat_start.py)
+    starts_heat = th is not None and "thermal" not in state
+    if th is not None and not starts_heat:
         if hasattr(th, "load_state_dict"):
             th.load_state_dict(state["thermal"])
         else:
@@ -508,8 +525,12 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
             for name, value in state["thermal"]["arrays"].items():
                 setattr(th, name, np.array(value, copy=True))
     elif "thermal" in state:
-        raise ConfigError("checkpoint has thermal state but the case has no thermal section")
+        raise ConfigError(NO_THERMAL_SECTION)
     _adapt_step_length(sim, float(s.get("step_length", step_length(sim))))
+    if starts_heat:
+        from thermodem.engine.heat_start import start_heat
+
+        sim.heat_start = start_heat(sim, fresh_ledger)
 
 
 def step_length(sim: Simulation) -> float:

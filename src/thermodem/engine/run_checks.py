@@ -172,19 +172,27 @@ def check_restart_case(ckpt: Checkpoint, case: Case) -> None:
     velocity, angular velocity and thermal condition may change (the case's are run). Pour
     entries are compared when the state is loaded."""
     from thermodem.config.dump import case_to_dict
+    from thermodem.engine.restart import NO_THERMAL_SECTION
 
     if case is None:
         return
+    with_heat = "thermal" in ckpt.state
+    if with_heat and case.thermal is None:
+        raise ConfigError(f"{NO_THERMAL_SECTION}; checkpoint {ckpt.path}, nothing was changed")
+    # heat that starts at this restart (a checkpoint without heat) takes the temperatures the
+    # static entries give (engine/heat_start.py): they may change
+    ignored = {"path"} if with_heat else {"path", "temperature", "temperatures"}
 
     def static(entries: Any) -> tuple[list[int], list[Any]]:
         """(index in ``insertion``, entry without its file path) of every static entry."""
         if not isinstance(entries, list):
             return [], []
         kept = [
-            (k, {key: v for key, v in e.items() if key != "path"} if isinstance(e, dict) else e)
+            (k, {key: v for key, v in e.items() if key not in ignored} if isinstance(e, dict)
+             else e)
             for k, e in enumerate(entries)
             if not (isinstance(e, dict) and e.get("kind") == "pour")
-        ]
+        ]  # fmt: skip
         return [k for k, _ in kept], [e for _, e in kept]
 
     def placed(walls: Any) -> list[Any]:
@@ -232,6 +240,20 @@ def check_restart_case(ckpt: Checkpoint, case: Case) -> None:
         f"restart, so the run would continue {held}, not the ones this case describes; "
         + allowed.format(what="static insertion entries")
     )
+
+
+def check_restart_start(ckpt: Checkpoint, case: Case) -> None:
+    """The checks of ``run CASE --restart CKPT`` before anything is built or written (serial
+    and MPI alike): an end time after the checkpoint's time, a case whose t = 0 particles,
+    wall places and thermal section fit the checkpoint (:func:`check_restart_case`)."""
+    if not case.simulation.end_time > ckpt.time:
+        raise ConfigError(
+            f"simulation.end_time = {case.simulation.end_time:g} s is not after the "
+            f"time of the checkpoint {ckpt.path}, {ckpt.time:.6g} s (step {ckpt.step}): "
+            "there is nothing to run; give a later end time in the case or with "
+            "--end-time T"
+        )
+    check_restart_case(ckpt, case)
 
 
 def restored_simulation(ckpt: Checkpoint, threads: int | None, case: Case) -> Simulation:

@@ -65,6 +65,7 @@ from thermodem.engine.run_checks import (  # noqa: F401 (LOCK_FILE, process_star
     RunLock,
     check_checkpoint_belongs,
     check_output_path,
+    check_restart_start,
     process_start,
     read_newest_checkpoint,
     refuse_if_busy,
@@ -707,13 +708,7 @@ def run_from_checkpoint(
         with starting:
             ckpt = read_checkpoint(checkpoint)
             case = case or ckpt.case()
-            if not case.simulation.end_time > ckpt.time:
-                raise ConfigError(
-                    f"simulation.end_time = {case.simulation.end_time:g} s is not after the "
-                    f"time of the checkpoint {ckpt.path}, {ckpt.time:.6g} s (step {ckpt.step}): "
-                    "there is nothing to run; give a later end time in the case or with "
-                    "--end-time T"
-                )
+            check_restart_start(ckpt, case)
             sim = restored_simulation(ckpt, threads, case)
     except KeyboardInterrupt:
         raise not_started(output, None, None, starting.signum, checkpoint) from None
@@ -730,6 +725,8 @@ def run_from_checkpoint(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         try:
             runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
+            if getattr(sim, "heat_start", None):  # (engine/heat_start.py)
+                runlog.info(sim.heat_start)
             try:
                 with starting:
                     for warning in check_simulation_time_step(sim):

@@ -361,6 +361,10 @@ def load_distributed(sim: DistributedSimulation, state: dict) -> None:
     if th is not None and th.range_set is not None:
         th.range_set.invalidate()
     sim.rebuild()
+    if th is not None and getattr(sim, "heat_start", None):
+        # heat started at this restart (engine/heat_start.py): U(0) of the owned particles
+        # summed over the ranks, now that they are distributed (before, every rank held all)
+        th.initial_energy = th.thermal_energy()
     sim.set_threads()
 
 

@@ -411,6 +411,8 @@ def run_distributed(
             if root:
                 try:
                     check_completeness(case)
+                    if ckpt is not None:  # (as the serial run --restart, before any write)
+                        R.check_restart_start(ckpt, case)
                     R.check_output_path(output)
                     if output.is_dir():
                         R.refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
@@ -448,6 +450,8 @@ def run_distributed(
                     runlog.info(
                         f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)"
                     )
+                    if getattr(sim, "heat_start", None):  # (engine/heat_start.py)
+                        runlog.info(sim.heat_start)
                 for warning in warned:
                     runlog.warn(warning)
                 run = R._make_run(sim, output, runlog, status, False, progress, log_interval,

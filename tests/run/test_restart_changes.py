@@ -1,0 +1,158 @@
+"""Restarts with a changed case, through the CLI in a subprocess (as a user runs them):
+heat that starts at a restart (a mechanics-only run settled, then ``run CASE --restart CKPT``
+with a ``thermal`` section; engine/heat_start.py), the reverse refused, a run directory whose
+run never started, and the list of the changes a restart applies."""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from thermodem.io.checkpoint import read_checkpoint
+from thermodem.io.run_files import read_timeseries
+
+BIN = Path(sys.executable).parent
+THERMODEM = BIN / "thermodem"
+
+R = 0.001  # [m]
+GLASS = {"density": 2500.0, "youngs_modulus": 1.0e7, "poisson_ratio": 0.3,
+         "restitution": 0.6, "sliding_friction": 0.4, "thermal_conductivity": 50.0,
+         "specific_heat": 800.0}  # fmt: skip
+#: a column of four spheres on the floor of a box, each touching the next (1 % overlap):
+#: two list entries of two spheres each; 20 steps without heat
+SETTLE = {
+    "simulation": {"time_step": 1.0e-5, "end_time": 2.0e-4, "seed": 5},
+    "domain": {"lower": [0, 0, 0], "upper": [0.004, 0.004, 0.01]},
+    "materials": {"glass": GLASS},
+    "walls": [
+        {
+            "kind": "box",
+            "lower": [0, 0, 0],
+            "upper": [0.004, 0.004, 0.01],
+            "open_top": True,
+            "material": "glass",
+        }
+    ],  # fmt: skip
+    "insertion": [
+        {
+            "kind": "list",
+            "material": "glass",
+            "radius": R,
+            "positions": [[0.002, 0.002, 0.99 * R], [0.002, 0.002, 2.97 * R]],
+        },
+        {
+            "kind": "list",
+            "material": "glass",
+            "radius": R,
+            "positions": [[0.002, 0.002, 4.95 * R], [0.002, 0.002, 6.93 * R]],
+        },
+    ],  # fmt: skip
+    "output": {
+        "vtu": False,
+        "timeseries_interval": 5.0e-5,
+        "checkpoint_interval": 1.0e-4,
+        "checkpoint_keep": None,
+    },
+}
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([str(THERMODEM), *args, "--no-progress"], capture_output=True,
+                          text=True, timeout=600)  # fmt: skip
+
+
+def _write(path: Path, case: dict) -> Path:
+    path.write_text(yaml.safe_dump(case))
+    return path
+
+
+def _settled(tmp_path: Path) -> Path:
+    res = _cli("run", str(_write(tmp_path / "settle.yaml", SETTLE)), "-o", str(tmp_path / "s"))
+    assert res.returncode == 0, res.stderr
+    return tmp_path / "s" / "checkpoints" / "checkpoint_000000020.h5"
+
+
+def _particles(path: Path) -> dict[str, np.ndarray]:
+    p = read_checkpoint(path).state["particles"]
+    order = np.argsort(p["global_id"])
+    return {k: np.asarray(v)[order] for k, v in p.items()}
+
+
+def test_heat_starts_at_a_restart_of_a_run_without_heat(tmp_path: Path) -> None:
+    """Settled without heat, continued with a thermal section: the temperatures start as the
+    case assigns them at t = 0 (entry 0 by thermal.initial_temperature, entry 1 by its
+    ``temperatures``, which may be added at the restart), the floor at 350 K heats the column,
+    the heat columns start at zero at the checkpoint's time and Σ m c ΔT equals the heat the
+    floor gave (and the balance error is round-off)."""
+    ckpt = _settled(tmp_path)
+    heat = copy.deepcopy(SETTLE)
+    heat["simulation"]["end_time"] = 6.0e-4
+    heat["insertion"][1]["temperatures"] = [380.0, 420.0]
+    heat["walls"][0]["thermal"] = {"kind": "fixed", "temperature": 350.0}
+    heat["thermal"] = {"initial_temperature": {"kind": "uniform", "value": 300.0}}
+    out = tmp_path / "h"
+    res = _cli("run", str(_write(tmp_path / "heat.yaml", heat)), "--restart", str(ckpt),
+               "-o", str(out))  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    line = "heat starts at t = 0.0002 s (step 20) from the case's initial temperatures"
+    assert line in res.stdout, res.stdout
+    assert line in (out / "run.log").read_text()
+    first = _particles(out / "checkpoints" / "checkpoint_000000020.h5")
+    np.testing.assert_array_equal(first["temperature"], [300.0, 300.0, 380.0, 420.0])
+    # the positions and velocities are the settled run's
+    np.testing.assert_array_equal(first["position"], _particles(ckpt)["position"])
+    last = _particles(out / "checkpoints" / "checkpoint_000000060.h5")
+    rise = last["temperature"] - first["temperature"]
+    assert rise[0] > 1e-3, rise  # the floor (350 K) heats the bottom sphere
+    assert rise[3] < -1e-3, rise  # the top one (420 K) gives heat to the one below
+    series = read_timeseries(out / "timeseries.csv")
+    assert series["step"][0] == 20 and series["step"][-1] == 60
+    assert series["heat_in_wall_direct_conduction"][0] == 0.0
+    assert series["heat_balance_error"][0] == 0.0
+    stored = np.sum(last["mass"] * GLASS["specific_heat"] * rise)
+    floor = series["heat_in_wall_direct_conduction"][-1]
+    assert floor > 0.0
+    assert abs(stored - floor) <= 1e-9 * abs(floor), (stored, floor)
+    assert abs(series["heat_balance_error"][-1]) <= 1e-9 * abs(floor)
+
+
+def test_adiabatic_heat_start_keeps_the_heat_and_the_reverse_is_refused(tmp_path: Path) -> None:
+    """Two temperatures by region (evaluated where the spheres are at the restart), no wall
+    heat: Σ m c T stays what it was to round-off while the temperatures even out. A
+    checkpoint with heat continued by a case without a thermal section is refused, naming
+    the key and what is allowed, before anything is written."""
+    ckpt = _settled(tmp_path)
+    heat = copy.deepcopy(SETTLE)
+    heat["simulation"]["end_time"] = 6.0e-4
+    heat["thermal"] = {"initial_temperature": {
+        "kind": "regions", "default": 300.0,
+        "regions": [[{"lower": [0, 0, 4 * R], "upper": [0.004, 0.004, 0.01]}, 500.0]],
+    }}  # fmt: skip
+    out = tmp_path / "h"
+    res = _cli("run", str(_write(tmp_path / "heat.yaml", heat)), "--restart", str(ckpt),
+               "-o", str(out))  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert "thermal.initial_temperature (regions at the particles' positions now)" in res.stdout
+    first = _particles(out / "checkpoints" / "checkpoint_000000020.h5")
+    np.testing.assert_array_equal(first["temperature"], [300.0, 300.0, 500.0, 500.0])
+    last = _particles(out / "checkpoints" / "checkpoint_000000060.h5")
+    assert last["temperature"][1] > 300.001 and last["temperature"][2] < 499.999
+    c = GLASS["specific_heat"]
+    before = np.sum(first["mass"] * c * first["temperature"])
+    after = np.sum(last["mass"] * c * last["temperature"])
+    assert abs(after - before) <= 1e-13 * before, (before, after)
+    # the reverse: the heated run's checkpoint, the mechanics-only case
+    back = tmp_path / "back"
+    res = _cli("run", str(tmp_path / "settle.yaml"), "--restart",
+               str(out / "checkpoints" / "checkpoint_000000060.h5"), "--end-time", "0.001",
+               "-o", str(back))  # fmt: skip
+    assert res.returncode == 2, res.stderr
+    assert "thermal: the case has no thermal section, but the checkpoint holds the " in res.stderr
+    assert "keep the thermal section" in res.stderr
+    assert "Traceback" not in res.stderr
+    assert not back.exists()
