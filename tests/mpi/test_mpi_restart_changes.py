@@ -60,3 +60,19 @@ def test_heat_starts_at_a_restart_on_2_ranks_as_serially(tmp_path: Path) -> None
         assert f"{key} differs from the case stored in the checkpoint" in res.stderr
         assert res.stderr.count("error:") == 1, res.stderr  # (rank 0 only)
         assert not out.exists()
+
+
+@needs_mpi
+def test_restart_of_a_run_that_never_started_on_2_ranks(tmp_path: Path) -> None:
+    """``mpiexec -n 2 thermodem restart DIR`` of a refused run: rank 0 says it never started,
+    with the refusal and the mpiexec command to run it again."""
+    bad = copy.deepcopy(SETTLE)
+    bad["simulation"]["time_step"] = 1.0e-3
+    out = tmp_path / "out"
+    res = _run(["run", str(_write(tmp_path / "bad.yaml", bad)), "-o", str(out), "--no-progress"])
+    assert res.returncode == 2, res.stderr
+    res = _run(["restart", str(out), "--no-progress"], 2)
+    assert res.returncode == 2, res.stderr
+    assert "never started (status.json: its input was refused: simulation.end_time" in res.stderr
+    assert f"run it again: mpiexec -n 2 thermodem run CASE --output {out}" in res.stderr
+    assert res.stderr.count("error:") == 1, res.stderr

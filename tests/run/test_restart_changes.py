@@ -156,3 +156,24 @@ def test_adiabatic_heat_start_keeps_the_heat_and_the_reverse_is_refused(tmp_path
     assert "keep the thermal section" in res.stderr
     assert "Traceback" not in res.stderr
     assert not back.exists()
+
+
+def test_restart_of_a_run_that_never_started_says_so(tmp_path: Path) -> None:
+    """``thermodem restart DIR`` of a run refused before its first step: the message says the
+    run never started, with the refusal from its status.json and the command to run it again
+    (before: 'no checkpoints in DIR/checkpoints; nothing to restart from')."""
+    bad = copy.deepcopy(SETTLE)
+    bad["simulation"]["time_step"] = 1.0e-3  # no step before the end time: refused
+    out = tmp_path / "out"
+    res = _cli("run", str(_write(tmp_path / "bad.yaml", bad)), "-o", str(out))
+    assert res.returncode == 2 and "gives no step" in res.stderr, res.stderr
+    res = _cli("restart", str(out))
+    assert res.returncode == 2, res.stderr
+    assert f"cannot restart '{out}': no checkpoints in {out / 'checkpoints'}; the run in " in (
+        res.stderr
+    )
+    assert "never started (status.json: its input was refused: simulation.end_time" in res.stderr
+    assert f"after fixing the case (bad) run it again: thermodem run CASE --output {out}" in (
+        res.stderr
+    )
+    assert "Traceback" not in res.stderr

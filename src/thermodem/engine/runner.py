@@ -109,6 +109,7 @@ from thermodem.io.run_files import (  # noqa: F401 (re-exported)
     TimeseriesWriter,
     _atomic_write_text,
     _cell,
+    no_checkpoint_to_restart,
     only_run_record,
     prepare_output_dir,
     read_timeseries,
@@ -601,7 +602,7 @@ def restart_run(
         )
     checkpoints = list_checkpoints(output / CHECKPOINT_DIR)
     if not checkpoints:
-        raise ConfigError(f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from")
+        raise ConfigError(no_checkpoint_to_restart(output))
     refuse_if_busy(output, "restart")
     previous = Status.read(output)
     # a signal while the restart is set up (the checkpoint read, the simulation rebuilt and

@@ -48,10 +48,11 @@ def refused_run_record(path: Path) -> bool:
     return status.get("refused_input") is True or status.get("not_started") is True
 
 
-def never_ran(path: Path) -> str:
+def never_ran(path: Path, ranks: int = 1) -> str:
     """'' or, for the record of a run refused (or stopped) before its first step, what to say
     instead of 'no checkpoints' / 'no time series': the run's own message and how to run it
-    again (export, plot and info of such a directory)."""
+    again (export, plot, info and restart of such a directory; ``ranks``: the MPI ranks of
+    the command that asks, for the command it suggests)."""
     if not refused_run_record(path):
         return ""
     status = Status.read(path)
@@ -61,10 +62,21 @@ def never_ran(path: Path) -> str:
         if status.get("refused_input") is True
         else "it was stopped while it was being set up"
     )
+    launch = f"mpiexec -n {ranks} thermodem" if ranks > 1 else "thermodem"
     return (
         f"; the run in {str(path)!r} never started ({STATUS_FILE}: {why}); after fixing the "
-        f"case{case} run it again: thermodem run CASE --output {path}"
+        f"case{case} run it again: {launch} run CASE --output {path}"
     )
+
+
+def no_checkpoint_to_restart(path: Path, ranks: int = 1) -> str:
+    """The message of ``thermodem restart DIR`` for a directory without checkpoints: the run
+    that never started (:func:`never_ran`: its refusal from status.json and the command to run
+    it again), or nothing to restart from."""
+    why = never_ran(path, ranks)
+    if why:
+        return f"cannot restart {str(path)!r}: no checkpoints in {path / CHECKPOINT_DIR}{why}"
+    return f"no checkpoints in {path / CHECKPOINT_DIR}; nothing to restart from"
 
 
 def prepare_output_dir(path: Path, overwrite: bool) -> None:

@@ -562,9 +562,7 @@ def restart_distributed(
                         )
                     checkpoints = list_checkpoints(output / CHECKPOINT_DIR)
                     if not checkpoints:
-                        raise ConfigError(
-                            f"no checkpoints in {output / CHECKPOINT_DIR}; nothing to restart from"
-                        )
+                        raise ConfigError(R.no_checkpoint_to_restart(output, comm.Get_size()))
                     R.refuse_if_busy(output, "restart")
                     path = checkpoints[-1]
                     newest = R.read_newest_checkpoint(checkpoints)
