@@ -303,7 +303,10 @@ def test_packing_core_rule_and_validity_limits() -> None:
 
 
 def test_closure_face_area() -> None:
-    # Zhou et al. (2009): r_ij = √(A_n/π) = 0.560 R (1 - ε)^(-1/3)
+    # Zhou et al. (2009): A_n = 0.985 R² (1 - ε)^(-2/3), r_ij = √(A_n/π) = 0.560 R (1 - ε)^(-1/3)
+    for radius, eps in ((1e-3, 0.26), (2.5e-4, 0.4), (3e-3, 0.6)):
+        expected = 0.985 * radius**2 / (1.0 - eps) ** (2.0 / 3.0)
+        assert v.closure_face_area(radius, eps) == pytest.approx(expected, rel=1e-14)
     for eps in (0.26, 0.4, 0.6):
         a_n = v.closure_face_area(1e-3, eps)
         assert math.sqrt(a_n / math.pi) == pytest.approx(0.560e-3 * (1 - eps) ** (-1 / 3), rel=1e-3)
