@@ -102,6 +102,9 @@ def test_heat_starts_at_a_restart_of_a_run_without_heat(tmp_path: Path) -> None:
     line = "heat starts at t = 0.0002 s (step 20) from the case's initial temperatures"
     assert line in res.stdout, res.stdout
     assert line in (out / "run.log").read_text()
+    for change in ("thermal (none) -> (a section)", "walls.0.thermal.kind adiabatic -> fixed",
+                   "insertion.1.temperatures (none) -> [380.0, 420.0]"):  # fmt: skip
+        assert f"changed from the checkpoint's case: {change}\n" in res.stdout, res.stdout
     first = _particles(out / "checkpoints" / "checkpoint_000000020.h5")
     np.testing.assert_array_equal(first["temperature"], [300.0, 300.0, 380.0, 420.0])
     # the positions and velocities are the settled run's
@@ -177,3 +180,52 @@ def test_restart_of_a_run_that_never_started_says_so(tmp_path: Path) -> None:
         res.stderr
     )
     assert "Traceback" not in res.stderr
+
+
+def test_changes_a_restart_applies_are_listed(tmp_path: Path) -> None:
+    """``run CASE --restart CKPT`` lists every key CASE changes against the checkpoint's
+    stored case, old -> new, in stdout and run.log (before, they were applied silently); at
+    most 20 lines, then 'and N more'."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.run_checks import restart_changes
+
+    ckpt = _settled(tmp_path)
+    changed = copy.deepcopy(SETTLE)
+    changed["simulation"]["end_time"] = 4.0e-4
+    changed["simulation"]["time_step"] = 5.0e-6
+    changed["materials"]["glass"]["restitution"] = 0.5
+    changed["walls"][0]["velocity"] = [0.0, 0.0, 0.01]
+    out = tmp_path / "c"
+    res = _cli("run", str(_write(tmp_path / "changed.yaml", changed)), "--restart", str(ckpt),
+               "-o", str(out))  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    log = (out / "run.log").read_text()
+    lines = [
+        "changed from the checkpoint's case: simulation.time_step 1e-05 -> 5e-06",
+        "changed from the checkpoint's case: simulation.end_time 0.0002 -> 0.0004",
+        "changed from the checkpoint's case: materials.glass.restitution 0.6 -> 0.5",
+        "changed from the checkpoint's case: walls.0.velocity [0.0, 0.0, 0.0] -> [0.0, 0.0, 0.01]",
+    ]
+    for line in lines:
+        assert line in res.stdout, res.stdout
+        assert line in log
+    assert res.stdout.count("changed from the checkpoint's case:") == 4, res.stdout
+    # the same case: nothing listed
+    res = _cli("run", str(tmp_path / "settle.yaml"), "--restart", str(ckpt), "--end-time",
+               "0.0003", "-o", str(tmp_path / "same"))  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.count("changed from the checkpoint's case:") == 1  # (--end-time)
+    # more than 20 changes: 20 lines and the count of the others
+    many = copy.deepcopy(changed)
+    many["simulation"]["gravity"] = [0.1, 0.2, -9.0]
+    many["materials"]["glass"].update(density=2400.0, youngs_modulus=2.0e7, poisson_ratio=0.25,
+                                      sliding_friction=0.3, thermal_conductivity=2.0,
+                                      specific_heat=700.0, rolling_friction=0.1)  # fmt: skip
+    many["domain"]["upper"] = [0.004, 0.004, 0.02]
+    many["domain"]["lower"] = [-0.001, 0.0, 0.0]
+    many["simulation"].update(seed=7, max_overlap_ratio=0.3)
+    many["output"] = {"vtu": True, "interval": 1e-4, "timeseries_interval": 1e-5,
+                      "checkpoint_interval": 2e-4, "checkpoint_keep": 3}  # fmt: skip
+    shown = restart_changes(read_checkpoint(ckpt), case_from_dict(many))
+    assert len(shown) == 21, shown  # (21 changes: 20 lines)
+    assert shown[-1] == "changed from the checkpoint's case: and 1 more", shown

@@ -306,6 +306,66 @@ def first_difference(a: Any, b: Any, path: str = "") -> str | None:
     return None if a == b else (path.rstrip(".") or "(the whole case)")
 
 
+def all_differences(a: Any, b: Any, path: str = "") -> list[tuple[str, Any, Any]]:
+    """Every difference between two plain-data trees: (key path, value in ``a``, value in
+    ``b``), a key present on one side only with ``None`` on the other, a list of scalars (a
+    vector) or lists of other lengths as one difference of the whole list
+    (:func:`first_difference` finds the first only)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out: list[tuple[str, Any, Any]] = []
+        for key in list(a) + [k for k in b if k not in a]:
+            out += all_differences(a.get(key), b.get(key), f"{path}{key}.")
+        return out
+    if (
+        isinstance(a, list)
+        and isinstance(b, list)
+        and len(a) == len(b)
+        and any(isinstance(v, dict | list) for v in a + b)  # (not a vector)
+    ):
+        out = []
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            out += all_differences(x, y, f"{path}{k}.")
+        return out
+    return [] if a == b else [(path.rstrip(".") or "(the whole case)", a, b)]
+
+
+#: Lines of the changes a restart lists before "and N more".
+CHANGES_SHOWN = 20
+
+
+def _shown(value: Any) -> str:
+    if value is None:
+        return "(none)"
+    if isinstance(value, dict):
+        return "(a section)"
+    text = str(value)
+    if isinstance(value, list) and len(text) > 60:
+        return f"(a list of {len(value)})"
+    return text
+
+
+def restart_changes(ckpt: Checkpoint, case: Case) -> list[str]:
+    """The lines that list what ``case`` changes against the case stored in ``ckpt`` (``run
+    CASE --restart CKPT``: these are applied; the ones a restart cannot apply were refused
+    by :func:`check_restart_case`), one per key with the old and new value, at most
+    :data:`CHANGES_SHOWN` and then 'and N more'. A file entry's path is left out (its
+    particles come from the checkpoint); the end time and the output settings are listed."""
+    from thermodem.config.dump import case_to_dict
+
+    changes = [
+        (key, old, new)
+        for key, old, new in all_differences(case_to_dict(ckpt.case()), case_to_dict(case))
+        if not (key.startswith("insertion.") and key.endswith(".path"))
+    ]
+    lines = [
+        f"changed from the checkpoint's case: {key} {_shown(old)} -> {_shown(new)}"
+        for key, old, new in changes[:CHANGES_SHOWN]
+    ]
+    if len(changes) > CHANGES_SHOWN:
+        lines.append(f"changed from the checkpoint's case: and {len(changes) - CHANGES_SHOWN} more")
+    return lines
+
+
 def check_checkpoint_belongs(ckpt: Checkpoint, output: Path, status: dict[str, Any]) -> None:
     """Refuse a checkpoint that was not written for ``output``: another run_id than the
     directory's ``status.json``, or a stored case that differs from ``case.resolved.yaml``

@@ -69,6 +69,7 @@ from thermodem.engine.run_checks import (  # noqa: F401 (LOCK_FILE, process_star
     process_start,
     read_newest_checkpoint,
     refuse_if_busy,
+    restart_changes,
     restored_simulation,
     timeseries_repair,
 )
@@ -710,6 +711,7 @@ def run_from_checkpoint(
             ckpt = read_checkpoint(checkpoint)
             case = case or ckpt.case()
             check_restart_start(ckpt, case)
+            changes = restart_changes(ckpt, case)
             sim = restored_simulation(ckpt, threads, case)
     except KeyboardInterrupt:
         raise not_started(output, None, None, starting.signum, checkpoint) from None
@@ -726,6 +728,8 @@ def run_from_checkpoint(
         runlog, status = _open(output, log, append=False, case_name=case_name)
         try:
             runlog.info(f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)")
+            for line in changes:
+                runlog.info(line)
             if getattr(sim, "heat_start", None):  # (engine/heat_start.py)
                 runlog.info(sim.heat_start)
             try:

@@ -450,6 +450,8 @@ def run_distributed(
                     runlog.info(
                         f"starting from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s)"
                     )
+                    for line in R.restart_changes(ckpt, case):
+                        runlog.info(line)
                     if getattr(sim, "heat_start", None):  # (engine/heat_start.py)
                         runlog.info(sim.heat_start)
                 for warning in warned:
