@@ -193,9 +193,8 @@ def run(
     threads = _threads(threads)
     ranks = _mpi_ranks()
 
-    def go() -> None:
-        if case is None and restart is None:
-            raise ConfigError("give a case file, or --restart CHECKPOINT")
+    def prepared() -> object:
+        """The case (None: the checkpoint's) with --end-time/--steps applied."""
         loaded = load_case(case) if case is not None else None
         if end_time is not None or steps is not None:
             if loaded is None:
@@ -203,6 +202,25 @@ def run(
 
                 loaded = read_checkpoint(restart).case()
             _shorten(loaded, end_time, steps, restart)
+        return loaded
+
+    def go() -> None:
+        if case is None and restart is None:
+            raise ConfigError("give a case file, or --restart CHECKPOINT")
+        if ranks > 1:
+            loaded = prepared()
+        else:
+            # a signal while the case (or the checkpoint of --end-time/--steps) is read, before
+            # the runner handles them: the runner's not-started message, nothing touched
+            # (before: Ctrl-C exited 130 and SIGTERM killed the process without a word)
+            from thermodem.engine.run_signals import Starting, not_started
+
+            starting = Starting()
+            try:
+                with starting:
+                    loaded = prepared()
+            except KeyboardInterrupt:
+                raise not_started(output, None, None, starting.signum, restart) from None
         name = case.stem if case is not None else None
         options = dict(progress=progress, log_interval=log_interval, case_name=name)
         if ranks > 1:

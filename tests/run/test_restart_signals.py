@@ -137,3 +137,59 @@ def test_a_signal_while_a_run_from_a_checkpoint_is_set_up(tmp_path: Path, finish
     again = CliRunner().invoke(app, args)
     assert again.exit_code == 0, again.output
     assert json.loads((new / "status.json").read_text())["status"] == "finished"
+
+
+# the CLI with the signal sent while cli.py reads the case or the checkpoint (for --end-time),
+# before the runner's own handlers are in place
+EARLY = """
+import os
+import signal
+import sys
+
+import thermodem.config.load as load
+import thermodem.io.checkpoint as checkpoint
+from thermodem.cli import app
+
+signum = getattr(signal, sys.argv[1])
+module = {"load_case": load, "read_checkpoint": checkpoint}[sys.argv[2]]
+original = getattr(module, sys.argv[2])
+
+
+def slow(*args, **kwargs):
+    os.kill(os.getpid(), signum)
+    return original(*args, **kwargs)
+
+
+setattr(module, sys.argv[2], slow)
+app(sys.argv[3:])
+"""
+
+
+@pytest.mark.parametrize(
+    ("signum", "where"),
+    [(signal.SIGINT, "load_case"), (signal.SIGTERM, "read_checkpoint")],
+    ids=["SIGINT-case-read", "SIGTERM-checkpoint-read"],
+)
+def test_a_signal_while_the_cli_reads_the_case(
+    tmp_path: Path, finished: Path, signum: int, where: str
+) -> None:
+    """``run CASE --restart CKPT --end-time T`` stopped while cli.py reads the case or the
+    checkpoint: the runner's not-started message, exit 130 (143), NEWDIR not created (before:
+    Ctrl-C exited 130 and SIGTERM killed the process without a word)."""
+    ckpt = finished / "checkpoints" / "checkpoint_000000050.h5"
+    new = tmp_path / "new"
+    script = tmp_path / "early.py"
+    script.write_text(EARLY)
+    args = ["run", str(tmp_path / "case.yaml"), "--restart", str(ckpt), "--end-time", "0.001",
+            "-o", str(new), "--no-progress"]  # fmt: skip
+    name = signal.Signals(signum).name
+    res = subprocess.run([sys.executable, str(script), name, where, *args],
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    text = res.stdout + res.stderr
+    assert res.returncode == 128 + signum, text
+    assert (
+        f"interrupted ({name}) while the run was being set up, before its first step: nothing "
+        f"was computed and {new} was not touched; to start it: the same command (from {ckpt}, "
+        "which is unchanged)" in res.stderr
+    ), text
+    assert "Traceback" not in text and not new.exists()
