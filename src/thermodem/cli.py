@@ -345,12 +345,18 @@ def _announce_compile(case: Path) -> None:
 @app.command()
 def etc(
     case: Path = typer.Argument(..., help="case file (YAML): the packing and its thermal models"),
-    axes: str = typer.Option("xyz", "--axes", help="axes to measure along, letters of 'xyz'"),
+    axes: str | None = typer.Option(
+        None, "--axes", help="axes to measure along, letters of 'xyz' [default: xyz; 2D: xy]"
+    ),
     layer: list[float] = typer.Option(
         None, "--layer", help="boundary-layer thickness [m] (repeat; default 1 and 2 diameters)"
     ),
-    temperature: float = typer.Option(300.0, "--temperature", help="cold-layer temperature [K]"),
-    difference: float = typer.Option(1.0, "--difference", help="hot minus cold [K]"),
+    temperature: float | None = typer.Option(
+        None, "--temperature", help="cold-layer temperature [K] [default: 300.0]"
+    ),
+    difference: float | None = typer.Option(
+        None, "--difference", help="hot minus cold [K] [default: 1.0]"
+    ),
     periodic: bool = typer.Option(
         False,
         "--periodic",
@@ -376,23 +382,42 @@ def etc(
     def go() -> list:
         import math
 
-        if not (math.isfinite(temperature) and temperature > 0.0):
-            raise ConfigError(f"--temperature {temperature!r}: must be a finite temperature > 0 K")
-        if not (math.isfinite(difference) and difference != 0.0):
-            raise ConfigError(f"--difference {difference!r}: must be finite and not 0 [K]")
-        if not temperature + difference > 0.0:
+        def measured_axes(loaded) -> str:  # noqa: ANN001
+            # (2D: the axes of the plane; a 2D user who gives no --axes measures x and y)
+            return axes if axes is not None else "xy" if loaded.simulation.planar else "xyz"
+
+        if periodic:
+            given = [f"--layer {s!r}" for s in layer or ()] + [
+                f"{name} {value!r}"
+                for name, value in (("--temperature", temperature), ("--difference", difference))
+                if value is not None
+            ]
+            if given:
+                raise ConfigError(
+                    f"{', '.join(given)}: not used with --periodic (an imposed mean gradient "
+                    "across the period: no boundary layers, no layer temperatures); give "
+                    "either --periodic or the boundary-layer options"
+                )
+            loaded = load_case(case)
+            return effective_conductivity_of_case(loaded, measured_axes(loaded), periodic=True)
+        temperature_ = 300.0 if temperature is None else temperature
+        difference_ = 1.0 if difference is None else difference
+        if not (math.isfinite(temperature_) and temperature_ > 0.0):
+            raise ConfigError(f"--temperature {temperature_!r}: must be a finite temperature > 0 K")
+        if not (math.isfinite(difference_) and difference_ != 0.0):
+            raise ConfigError(f"--difference {difference_!r}: must be finite and not 0 [K]")
+        if not temperature_ + difference_ > 0.0:
             raise ConfigError(
-                f"--difference {difference!r}: the hot layer would be at "
-                f"{temperature + difference:g} K; temperatures must stay > 0 K"
+                f"--difference {difference_!r}: the hot layer would be at "
+                f"{temperature_ + difference_:g} K; temperatures must stay > 0 K"
             )
         for s in layer or ():
             if not (math.isfinite(s) and s > 0.0):
                 raise ConfigError(f"--layer {s!r}: must be a finite thickness > 0 [m]")
-        if periodic:
-            return effective_conductivity_of_case(load_case(case), axes, periodic=True)
+        loaded = load_case(case)
         return effective_conductivity_of_case(
-            load_case(case), axes, layers=tuple(layer) if layer else None,
-            base_temperature=temperature, difference=difference,
+            loaded, measured_axes(loaded), layers=tuple(layer) if layer else None,
+            base_temperature=temperature_, difference=difference_,
         )  # fmt: skip
 
     results = _guarded(go)

@@ -411,3 +411,38 @@ def test_a_name_refused_where_a_number_fits_too_says_both(tmp_path: Path) -> Non
         "'kanuparthi2008', 'yun_evans2010', 'moscardini2018' or 'dai2019' (got 'dai2018'; did "
         "you mean 'dai2019'?)"
     ) in res.stderr
+
+
+def test_etc_of_a_2d_case_measures_the_plane_and_refuses_ignored_options(tmp_path: Path) -> None:
+    """``thermodem etc`` of a 2D case without --axes was refused for the default 'xyz' (an
+    axis the user never gave); --periodic with --layer/--temperature/--difference ignored
+    them without a word; a bed whose interior (between the layers and their margins) was one
+    column of particles ended in a ZeroDivisionError traceback."""
+    s = 0.00158
+    case = {
+        "simulation": {"dimension": 2, "thickness": 0.001, "time_step": 1.0e-6, "end_time": 1e-5},
+        "domain": {"lower": [0, 0], "upper": [0.02, 0.02]},
+        "materials": _glass(),
+        "insertion": [
+            {
+                "kind": "list",
+                "material": "glass",
+                "radius": 0.0008,
+                "positions": [[0.001 + i * s, 0.001 + j * s] for i in range(9) for j in range(9)],
+            }
+        ],
+        "thermal": {"direct_conduction": "rojek2014", "contact_radius": "geometric"},
+    }
+    path = tmp_path / "disc.yaml"
+    path.write_text(yaml.safe_dump(case))
+    res = _cli("etc", path, "--json")
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert [r["axis"] for r in json.loads(res.stdout)] == ["x", "y"]
+    res = _cli("etc", path, "--axes", "x", "--layer", "0.0048")  # one column in between
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert "too thin for boundary layers of 0.0048 m" in res.stderr
+    res = _cli("etc", path, "--axes", "z")
+    assert res.returncode == 2 and "axes = 'z'; allowed: letters of 'xy'" in res.stderr
+    res = _cli("etc", path, "--periodic", "--layer", "0.001", "--temperature", "350")
+    assert res.returncode == 2
+    assert "--layer 0.001, --temperature 350.0: not used with --periodic" in res.stderr

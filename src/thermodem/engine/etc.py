@@ -115,8 +115,7 @@ def effective_conductivity(
     bad = [a for a in axes if a not in allowed]
     if bad or not axes or len(set(axes)) < len(axes):
         raise ConfigError(
-            f"effective conductivity: axes = {axes!r}; allowed: letters of {allowed!r}, "
-            "each once"
+            f"effective conductivity: axes = {axes!r}; allowed: letters of {allowed!r}, each once"
         )
     p = sim.particles
     if p.count == 0:
@@ -153,11 +152,15 @@ def effective_conductivity(
             hot = x - low < s
             cold = high - x < s
             interior = ~hot & ~cold & (x - low >= s + diameter) & (high - x >= s + diameter)
-            if not hot.any() or not cold.any() or interior.sum() < 3:
+            # (the interior slope needs its particles at two coordinates at least: a lattice
+            # column alone between the margins gave a ZeroDivisionError)
+            spread = np.ptp(x[interior]) if interior.any() else 0.0
+            if not hot.any() or not cold.any() or interior.sum() < 3 or not spread > 0.0:
                 raise ConfigError(
                     f"effective conductivity along {name}: the bed ({high - low:.4g} m) is too "
                     f"thin for boundary layers of {s:.4g} m plus one diameter of margin on each "
-                    "side (need particles in both layers and at least 3 in between)"
+                    "side (need particles in both layers and at least 3 in between, at two "
+                    f"{name} coordinates at least)"
                 )
             p.temperature[:] = base_temperature + 0.5 * difference
             p.temperature[hot] = base_temperature + difference
@@ -217,10 +220,11 @@ def periodic_gradient(
     from thermodem.engine.implicit import laplacian, pair_lists
 
     _check_case(sim)
-    bad = [a for a in axes if a not in AXES]
+    allowed = "xy" if getattr(sim, "planar", False) else "xyz"  # 2D: in the plane
+    bad = [a for a in axes if a not in allowed]
     if bad or not axes or len(set(axes)) < len(axes):
         raise ConfigError(
-            f"effective conductivity: axes = {axes!r}; allowed: letters of 'xyz', each once"
+            f"effective conductivity: axes = {axes!r}; allowed: letters of {allowed!r}, each once"
         )
     p = sim.particles
     if p.count == 0:
