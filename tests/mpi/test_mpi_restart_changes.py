@@ -39,6 +39,9 @@ def test_heat_starts_at_a_restart_on_2_ranks_as_serially(tmp_path: Path) -> None
         assert res.returncode == 0, res.stderr
         assert "heat starts at t = 0.0002 s (step 20)" in res.stdout, res.stdout
         assert "changed from the checkpoint's case: thermal (none) -> (a section)" in res.stdout
+        # output.vtu: false: the last line names no particles.pvd (none was written)
+        assert "no VTU frames were written (output.vtu: false)" in res.stdout, res.stdout
+        assert "particles.pvd" not in res.stdout
     first = _particles(tmp_path / "h2" / "checkpoints" / "checkpoint_000000020.h5")
     np.testing.assert_array_equal(first["temperature"], [300.0, 300.0, 400.0, 400.0])
     serial = _particles(tmp_path / "h1" / "checkpoints" / "checkpoint_000000060.h5")

@@ -272,7 +272,7 @@ def _stepped(sim: DistributedSimulation, out: _Outputs, stop: StopRequest) -> Di
         log.info(
             f"done: {steps} steps in {format_duration(elapsed)} on {sim.size} MPI ranks, "
             f"{sim.global_count} particles at t = {sim.time:.6g} s; final checkpoint {final}; "
-            f"open {run.output / 'particles.pvd'} in ParaView"
+            f"{R.outputs_text(run.output, run.frames)}"
         )
     return sim
 
