@@ -90,6 +90,29 @@ def test_a_warning_said_while_the_case_is_built_reaches_run_log(tmp_path: Path) 
     assert (out / "run.log").read_text().count(text) == 1
 
 
+def test_a_warning_said_while_a_restart_is_built_reaches_run_log(tmp_path: Path) -> None:
+    """thermodem restart DIR and run CASE --restart CKPT build the simulation before they open
+    run.log: the warnings said then went to stderr only."""
+    out = tmp_path / "out"
+    case = _write(tmp_path, thermal={"fluid": {"temperature": 300.0, "velocity": [0, 0, 0.1]}})
+    assert _run(case, out).returncode == 0
+    text = "warning: thermal.fluid is given but no selected model reads it"
+    final = sorted((out / "checkpoints").glob("*.h5"))[-1]
+    again = tmp_path / "again"
+    for args, log in (
+        (
+            ("run", case, "--restart", final, "-o", again, "--end-time", 1.0e-4, "--no-progress"),
+            again / "run.log",
+        ),
+        (("restart", out, "--end-time", 1.0e-4, "--no-progress"), out / "run.log"),
+    ):
+        res = _cli(*args)
+        assert res.returncode == 0, res.stdout + res.stderr
+        assert res.stdout.count(text) == 1, res.stdout
+        assert text not in res.stderr, res.stderr
+        assert log.read_text().count(text) == (2 if log.parent == out else 1)
+
+
 def test_the_warnings_before_a_refusal_are_told_with_it(tmp_path: Path) -> None:
     """density: 2.5 (g/cm³) gives a mass 1000 times too small and a time step refused for it;
     the refusal came alone, without the density warning that explains it."""

@@ -301,6 +301,36 @@ def logged_warnings(log: RunLog) -> Iterator[None]:
         yield
 
 
+@contextmanager
+def recorded_warnings() -> Iterator[list[warnings.WarningMessage]]:
+    """Warnings raised inside kept, not shown: a restart builds its simulation before it
+    touches the output directory (no run.log yet); :func:`say_warnings` says them once the
+    log is open, or a refusal carries them (:func:`refusal_with`)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuntimeWarning)
+        yield caught
+
+
+def say_warnings(log: RunLog, caught: list[warnings.WarningMessage]) -> None:
+    """The recorded warnings through ``log`` as :func:`logged_warnings` says them; others
+    (not thermodem's) as Python would have shown them."""
+    for w in caught:
+        if issubclass(w.category, RunNotice):
+            log.info(str(w.message))
+        elif issubclass(w.category, RuntimeWarning):
+            log.warn(str(w.message))
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+
+
+def refusal_with(exc: ConfigError, caught: list[warnings.WarningMessage]) -> ConfigError:
+    """``exc`` carrying the RuntimeWarnings recorded before it (the CLI says them before the
+    error: they may explain it)."""
+    if exc.warnings is None:
+        exc.warnings = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    return exc
+
+
 def _loop(sim: Simulation, run: _Run, fresh: bool) -> Simulation:
     # the signal handlers stay until the run's end is on disk: once it is stopping or ending
     # (the interrupt checkpoint, the record of a failure, the final outputs) a signal is
@@ -613,7 +643,7 @@ def restart_run(
     starting = Starting()
     ckpt = None
     try:
-        with starting:
+        with starting, recorded_warnings() as built:
             ckpt = read_newest_checkpoint(checkpoints)
             check_checkpoint_belongs(ckpt, output, previous)
             case = ckpt.case()
@@ -638,6 +668,9 @@ def restart_run(
                         ) from None
     except KeyboardInterrupt:
         raise _restart_stopped(None, starting.signum, ckpt, checkpoints) from None
+    except ConfigError as exc:
+        refusal_with(exc, built)
+        raise
     # nothing above wrote to the directory
     lock = RunLock(output)
     lock.acquire()
@@ -653,6 +686,7 @@ def restart_run(
                     )
                     if series_repair is not None:
                         runlog.warn(series_repair())
+                    say_warnings(runlog, built)
                     _header(runlog, sim, threads, output)
                     run = _make_run(
                         sim, output, runlog, status, True, progress, log_interval, callback, every
@@ -707,7 +741,7 @@ def run_from_checkpoint(
     # run before ``output`` is touched (run_signals.not_started without a record)
     starting = Starting()
     try:
-        with starting:
+        with starting, recorded_warnings() as built:
             ckpt = read_checkpoint(checkpoint)
             case = case or ckpt.case()
             check_restart_start(ckpt, case)
@@ -715,6 +749,9 @@ def run_from_checkpoint(
             sim = restored_simulation(ckpt, threads, case)
     except KeyboardInterrupt:
         raise not_started(output, None, None, starting.signum, checkpoint) from None
+    except ConfigError as exc:
+        refusal_with(exc, built)
+        raise
     check_output_path(output)
     if output.is_dir():
         refuse_if_busy(output, "--overwrite" if overwrite else "a new run")
@@ -732,6 +769,7 @@ def run_from_checkpoint(
                 runlog.info(line)
             if getattr(sim, "heat_start", None):  # (engine/heat_start.py)
                 runlog.info(sim.heat_start)
+            say_warnings(runlog, built)
             try:
                 with starting:
                     for warning in check_simulation_time_step(sim):
