@@ -446,3 +446,17 @@ def test_etc_of_a_2d_case_measures_the_plane_and_refuses_ignored_options(tmp_pat
     res = _cli("etc", path, "--periodic", "--layer", "0.001", "--temperature", "350")
     assert res.returncode == 2
     assert "--layer 0.001, --temperature 350.0: not used with --periodic" in res.stderr
+
+
+def test_a_tessellation_that_nothing_reads_is_told(tmp_path: Path) -> None:
+    """thermal.tessellation without a Voronoi model (the model switched, its settings kept)
+    ran without a word, like the fluid and porosity sections before they were warned about."""
+    path = _case(tmp_path, thermal={"tessellation": {"method": "radical", "every_steps": 5}})
+    res = _cli("validate", path)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "warning: thermal.tessellation is given but nothing tessellates" in res.stderr
+    assert "thermal.indirect_conduction = 'none'" in res.stderr
+    res = _cli("validate", _case(tmp_path, "voronoi", thermal={
+        "indirect_conduction": "voronoi_a", "tessellation": {"every_steps": 5}}))  # fmt: skip
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "nothing tessellates" not in res.stderr

@@ -279,6 +279,16 @@ class ImplicitSettings(StrictModel):
     )
 
 
+#: Implicit settings read by one scheme only (thermal.implicit.KEY -> thermal.scheme).
+SCHEME_SETTINGS = {
+    "startup_steps": "crank_nicolson",
+    "error_tolerance": "tr_bdf2",
+    "initial_step": "tr_bdf2",
+    "krylov_tolerance": "exponential",
+    "krylov_dimension": "exponential",
+}
+
+
 class ThermalSettings(StrictModel):
     """Heat transfer between particles (explicit Euler, spec section 1.2)."""
 
@@ -434,6 +444,36 @@ class ThermalSettings(StrictModel):
                 f"max_substeps = {self.max_substeps} caps substeps: auto, but substeps is "
                 f"{self.substeps}; allowed: substeps: auto, or leave max_substeps out"
             )
+        # the settings of one implicit scheme given with another (a scheme switched, its
+        # settings kept); tolerance, max_iterations, preconditioner and the Picard settings
+        # are read by several schemes and by etc's steady solve
+        defaults = ImplicitSettings()
+        for key, owner in SCHEME_SETTINGS.items():
+            value = getattr(self.implicit, key)
+            if self.scheme != owner and value != getattr(defaults, key):
+                ignored.append(
+                    f"implicit.{key} = {value!r} is read by scheme {owner!r} only, but scheme "
+                    f"is {self.scheme!r}; allowed: scheme: {owner}, or leave implicit.{key} out"
+                )
+        generation = getattr(self.heat_generation, "model", "none")
+        if self.frozen_mechanics and generation != "none":
+            ignored.append(
+                f"heat_generation = {generation!r} turns the dissipation of moving contacts "
+                "into heat, but frozen_mechanics is true: nothing moves, so no heat would be "
+                "generated; allowed: heat_generation: none, or frozen_mechanics: false"
+            )
+        from thermodem.models.thermal.radiation import WallRadiation
+
+        walls = getattr(self.radiation, "params", None)
+        if isinstance(walls, WallRadiation) and not walls.walls:
+            for key in ("wall_view_factor", "wall_range"):
+                value = getattr(walls, key)
+                if value != WallRadiation.model_fields[key].default:
+                    ignored.append(
+                        f"radiation.{key} = {value:g} sets the radiation with the walls in "
+                        f"view, but radiation.walls is false; allowed: walls: true, or leave "
+                        f"{key} out"
+                    )
         if ignored and not stored:
             raise ValueError("; ".join(ignored) + " (the value would be ignored)")
         if self.frozen_mechanics and self.time_step is None:

@@ -162,6 +162,20 @@ class FieldProvider(FluidSources):
             float(self.porosity.radius_ratio) if isinstance(self.porosity, ShellPorosity) else 0.0
         )
         self.external_porosity: PorosityProvider | None = None
+        tessellated = isinstance(self.porosity, VoronoiPorosity) or any(
+            t.target == "external" and getattr(t.params, "geometry", "") == "tessellation"
+            for t in terms
+        )
+        if settings.tessellation is not None and not tessellated:
+            # (as the fluid and porosity above: a Voronoi model switched off, its settings kept)
+            warnings.warn(
+                "thermal.tessellation is given but nothing tessellates (thermal."
+                f"indirect_conduction = {settings.indirect_conduction.model!r}; the Voronoi "
+                "models voronoi_a / voronoi_b with geometry: tessellation and porosity: {kind: "
+                "voronoi} read it): it has no effect",
+                RuntimeWarning,
+                stacklevel=2,
+            )
         if isinstance(self.porosity, VoronoiPorosity):
             factory = POROSITY_PROVIDERS.get("voronoi")
             if factory is None:
