@@ -30,6 +30,8 @@ BOLTZMANN = 1.380649e-23  # J/K (exact, SI 2019)
 #: ``mean_free_path`` nor these keys (each missing one takes its air value).
 #: The largest heat capacity ratio accepted: 5/3 of a monatomic ideal gas, as 1.67 (rounded).
 GAMMA_MAX = 1.67
+#: Largest molar mass of a gas [kg/mol] (UF6 is 0.352; a value in g/mol is ~1000 times more).
+MOLAR_MASS_MAX = 1.0
 
 AIR_KINETIC = {"pressure": 101325.0, "temperature": 300.0, "molecular_diameter": 3.66e-10}
 
@@ -73,6 +75,19 @@ class GasProperties(StrictModel):
     molar_mass: float = Field(
         default=0.0289647, gt=0, description="M [kg/mol] for the ideal-gas density (air)"
     )
+
+    @field_validator("molar_mass")
+    @classmethod
+    def _kilograms_per_mole(cls, v: float) -> float:
+        # (28.97, air in g/mol, ran with a density 1000 times too large)
+        if v > MOLAR_MASS_MAX:
+            raise ValueError(
+                f"{v:g} kg/mol is heavier than any gas (uranium hexafluoride, among the "
+                f"heaviest, 0.352 kg/mol); the unit is kg/mol: is it a value in g/mol? "
+                f"({v:g} g/mol = {v / 1000:g} kg/mol); allowed: 0 < molar_mass <= "
+                f"{MOLAR_MASS_MAX:g}"
+            )
+        return v
 
     @field_validator("heat_capacity_ratio")
     @classmethod
