@@ -21,6 +21,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "validation.md"
+KRATOS = ROOT / "docs" / "validation-kratos.md"  # hand-written, copied in
 FIGURES = ROOT / "docs" / "figures"
 
 
@@ -163,6 +164,8 @@ def main() -> None:
         "band of the two correlations over k_p/k_f = 10…10⁴, within ZBS's own ±25 % only up to "
         "~2000 (docs/effective-conductivity.md). The Beaulieu set-up departs from the "
         "experiment in its packing (examples/beaulieu_heated_bed/README.md).",
+        "",
+        *KRATOS.read_text().rstrip("\n").splitlines(),
         "",
         "## Every verification test",
         "",
