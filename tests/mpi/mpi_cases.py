@@ -70,3 +70,53 @@ def bed_case(
             case["walls"][0]["thermal"] = {"kind": "fixed", "temperature": 420.0}
         case["thermal"] = thermal
     return case
+
+
+COLUMN_SIDE = 6e-3  # [m] floor of the column
+COLUMN_HEIGHT = 12e-3  # [m] 6 layers of 3 x 3 spheres, touching
+
+
+def column_case(thermal: dict[str, Any] | None, *, steps: int = 140,
+                time_step: float = 5e-6) -> dict[str, Any]:  # fmt: skip
+    """54 spheres (3 x 3 x 6, R = 1 mm, touching) between a hot floor (400 K) and a cold lid
+    (300 K) pressing down at 5 cm/s, side walls adiabatic; the thermal section ``thermal``
+    on top of Batchelor & O'Brien simple and a linear initial temperature (None: no heat,
+    no wall temperatures). c = 2 J/(kg K), so that the heat changes temperatures by tens of
+    kelvin in a hundred steps. On 2 ranks the bisection cuts it across z (27 + 27)."""
+    w, h = COLUMN_SIDE, COLUMN_HEIGHT
+    material = {"density": 2500.0, "youngs_modulus": 1e7, "poisson_ratio": 0.3,
+                "restitution": 0.5, "sliding_friction": 0.5, "rolling_friction": 0.05,
+                "thermal_conductivity": 50.0, "specific_heat": 2.0}  # fmt: skip
+    hot = {"kind": "fixed", "temperature": 400.0}
+    cold = {"kind": "fixed", "temperature": 300.0}
+    walls = [
+        {"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "glass",
+         "thermal": hot},
+        {"kind": "plane", "point": [0, 0, 0], "normal": [1, 0, 0], "material": "glass"},
+        {"kind": "plane", "point": [w, 0, 0], "normal": [-1, 0, 0], "material": "glass"},
+        {"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "glass"},
+        {"kind": "plane", "point": [0, w, 0], "normal": [0, -1, 0], "material": "glass"},
+        {"kind": "plane", "point": [0, 0, h - 2e-5], "normal": [0, 0, -1], "material": "glass",
+         "velocity": [0, 0, -0.05], "thermal": cold},
+    ]  # fmt: skip
+    case: dict[str, Any] = {
+        "simulation": {"time_step": time_step, "end_time": steps * time_step, "seed": 3},
+        "domain": {"lower": [0, 0, 0], "upper": [w, w, 2 * h]},
+        "materials": {"glass": material},
+        "contact": {"normal": "hertz", "tangential": "mindlin", "rolling": "epsd"},
+        "walls": walls,
+        "insertion": [{"kind": "lattice", "material": "glass",
+                       "distribution": {"kind": "mono", "radius": 1e-3},
+                       "lower": [0, 0, 0], "upper": [w, w, h], "count": [3, 3, 6]}],
+        "output": {"vtu": False},
+    }  # fmt: skip
+    if thermal is None:
+        for wall in walls:
+            wall.pop("thermal", None)
+        return case
+    case["thermal"] = {
+        "direct_conduction": "batchelor_obrien_simple",
+        "initial_temperature": {"kind": "expression", "expression": "300 + 5000 * z"},
+        **thermal,
+    }
+    return case

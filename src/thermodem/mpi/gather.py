@@ -345,10 +345,24 @@ def load_distributed(sim: DistributedSimulation, state: dict) -> None:
     """Load a restart state (serial layout) on every rank; the rebuild distributes it."""
     from thermodem.engine.restart import restore
 
-    restore(sim, state)
+    # every rank holds the whole restored set until the rebuild below, so all of it is owned
+    # meanwhile: the heat computed before the rebuild (here, and by engine/heat_start.py in
+    # restore) sees every particle (with the empty start's owned count, 0, the range set was
+    # built empty and its heat left out of the first thermal step)
     sim._distributed = False
+    restore(sim, state)
     sim._needs_rebuild = True
     sim.decomposition = None
+    th = sim.thermal
+    if th is not None and not th.fresh and th.next_step <= sim.step_count:
+        # a thermal step at the first step without the rates of a contact pass (a state
+        # between two thermal steps renumbered by another time step, engine/restart.py:
+        # _adapt_step_length): compute them now, on the whole set with the restored lists, as
+        # the serial step does; they travel with the particles. After the rebuild every pair
+        # is unset until the next contact pass, and the heat-only passes do not evaluate the
+        # mirror list: the thermal step found no contact and added no contact heat.
+        th.compute_rates(sim.time)
+        th.fresh = True
     if sim.rank != 0:  # the ledgers are sums over the ranks: rank 0 holds the stored totals
         for key in sim.ledger_cumulative:
             sim.ledger_cumulative[key] = 0.0
@@ -357,7 +371,6 @@ def load_distributed(sim: DistributedSimulation, state: dict) -> None:
         if sim.thermal is not None:
             for key in sim.thermal.cumulative:
                 sim.thermal.cumulative[key] = 0.0
-    th = sim.thermal
     if th is not None and th.range_set is not None:
         th.range_set.invalidate()
     sim.rebuild()

@@ -1,0 +1,164 @@
+"""The heat of a 2-rank run against the serial run on every thermal path MPI supports
+(docs/mpi.md), in one ``mpiexec`` launch: explicit Euler with the heat every step (fused with
+the contact pass), every 3rd step, ``substeps: auto``, the range set (rong_horio1999) with
+fixed-temperature particles, a heat flux and a volumetric source, and three restarts whose
+first thermal step is not fused with a contact pass.
+
+Before the fix (mpi/gather.py: load_distributed) the restarts went wrong on 2 ranks:
+
+- a checkpoint between two thermal steps continued with another time step (the steps are
+  renumbered, engine/restart.py: _adapt_step_length, so a thermal step falls on the first
+  step): its rates came from the heat-only passes after the distributing rebuild, which
+  leaves every pair unset until the next contact pass; that thermal step added no contact
+  heat (limit inf, ``substeps: auto`` kept the old count): temperatures 4e-4 (substeps 3)
+  and 1e-2 (auto) relative off;
+- heat that starts at a restart (engine/heat_start.py) computed its first rates while the
+  rank owned none of the particles (the owned count of the empty start): the range set was
+  built empty and its heat left out of the first thermal step (2e-4 relative off).
+
+The 54-sphere column of mpi_cases.column_case, 140 steps (restarts: 70 serial steps, then
+100 more). The runs agree to the bit today; the test allows 1e-12 relative in temperatures
+(the pair sums of a particle may be added in another order on several ranks: round-off,
+~1e-16), far below what a pair's heat missing for one step gives (> 1e-6), and 1e-9 of its
+scale in each heat column of the report.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from mpi_cases import column_case  # noqa: E402
+from test_mpi import BIN, MPIEXEC, _env, needs_mpi  # noqa: E402
+
+DT = 5e-6
+RANGE = {"indirect_conduction": "rong_horio1999", "gas": {"thermal_conductivity": 0.026}}
+W, H = 6e-3, 12e-3
+CONDITIONS = {
+    "fixed_temperature": [{"temperature": 450.0, "select": {"region": {
+        "lower": [0, 0, 0], "upper": [W, W, 1.5e-3]}}}],
+    "heat_flux": [{"flux": 2e4, "select": {"region": {
+        "lower": [0, 0, 8e-3], "upper": [W, W, H]}}}],
+    "volumetric_source": [{"power_density": 1e7, "select": {"region": {
+        "lower": [0, 0, 4e-3], "upper": [W, W, 8e-3]}}}],
+}  # fmt: skip
+
+#: name -> (thermal section, thermal section of the run that wrote the checkpoint at step 70
+#: or "fresh" for a run from t = 0, time step after the restart)
+CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
+    "substeps_1": ({"substeps": 1}, "fresh", DT),
+    "substeps_3": ({"substeps": 3}, "fresh", DT),
+    "substeps_auto": ({"substeps": "auto"}, "fresh", DT),
+    "range_fixed_flux_source": ({**RANGE, "substeps": 2, **CONDITIONS}, "fresh", DT),
+    # restarts whose first thermal step is not fused with a contact pass
+    "substeps_3_restart_half_time_step": ({"substeps": 3}, {"substeps": 3}, DT / 2),
+    "substeps_auto_restart_half_time_step": ({"substeps": "auto"}, {"substeps": "auto"}, DT / 2),
+    "range_heat_starts_at_restart": (
+        {**RANGE, "direct_conduction": "none", "substeps": 2}, None, DT),
+}  # fmt: skip
+
+SCRIPT = """
+import json, sys
+import numpy as np
+from thermodem.config.load import case_from_dict
+from thermodem.mpi import make_simulation
+from thermodem.mpi.gather import gathered_view
+from thermodem.mpi.simulation import DistributedSimulation
+
+for job in json.load(open(sys.argv[1])):
+    case = case_from_dict(job["case"])
+    if job["checkpoint"]:
+        sim = DistributedSimulation.from_checkpoint(job["checkpoint"], case=case)
+    else:
+        sim = make_simulation(case)
+    sim.run(steps=job["steps"])
+    report = sim.report()
+    view = gathered_view(sim)
+    if view is not None:
+        p = view.particles
+        order = np.argsort(p.global_id)
+        np.savez(job["out"], temperature=p.temperature[order], report=json.dumps(report))
+"""
+
+
+def _jobs(tmp: Path) -> list[dict[str, Any]]:
+    """The cases, checkpoints (written serially at step 70) and step counts of every
+    configuration."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+    from thermodem.io.checkpoint import write_checkpoint
+
+    jobs = []
+    for name, (thermal, before, dt) in CONFIGURATIONS.items():
+        checkpoint = None
+        steps = 140
+        if before != "fresh":
+            first = Simulation(case_from_dict(column_case(before)), threads=1)
+            first.run(steps=70)
+            checkpoint = str(write_checkpoint(first, tmp / f"{name}.h5"))
+            steps = int(round(70 * DT / dt)) + 100
+        case = column_case(thermal, steps=steps, time_step=dt)
+        jobs.append({"name": name, "case": case, "checkpoint": checkpoint,
+                     "steps": 100 if checkpoint else steps,
+                     "out": str(tmp / f"{name}.npz")})  # fmt: skip
+    return jobs
+
+
+def _serial(job: dict[str, Any]) -> tuple[np.ndarray, dict[str, float]]:
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+
+    case = case_from_dict(job["case"])
+    if job["checkpoint"]:
+        sim = Simulation.from_checkpoint(job["checkpoint"], threads=1, case=case)
+    else:
+        sim = Simulation(case, threads=1)
+    sim.run(steps=job["steps"])
+    p = sim.particles
+    return p.temperature[np.argsort(p.global_id)], sim.report()
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """Every configuration serially (in this process) and on 2 ranks (one launch)."""
+    tmp = tmp_path_factory.mktemp("thermal_paths")
+    jobs = _jobs(tmp)
+    (tmp / "jobs.json").write_text(json.dumps(jobs))
+    (tmp / "run.py").write_text(SCRIPT)
+    cmd = ["timeout", "600", str(MPIEXEC), "-n", "2", str(BIN / "python"), str(tmp / "run.py"),
+           str(tmp / "jobs.json")]  # fmt: skip
+    res = subprocess.run(cmd, capture_output=True, text=True, env=_env(2), timeout=900)
+    assert res.returncode == 0, res.stderr[-4000:]
+    return {job["name"]: (job, _serial(job)) for job in jobs}
+
+
+def _heat_columns(report: dict[str, float]) -> list[str]:
+    return [k for k in report if k.startswith(("heat_", "temperature_", "fixed_", "thermal_",
+                                                "inserted_heat", "range_pair"))]  # fmt: skip
+
+
+@needs_mpi
+@pytest.mark.parametrize("name", list(CONFIGURATIONS))
+def test_heat_on_2_ranks_matches_serial(runs: dict[str, Any], name: str) -> None:
+    job, (temperature, report) = runs[name]
+    got = np.load(job["out"])
+    parallel = json.loads(str(got["report"]))
+    start = 300.0 + 5000.0 * np.linspace(1e-3, H - 1e-3, 6)  # (the layers at t = 0)
+    assert np.abs(temperature - np.repeat(start, 9)).max() > 1.0, "the heat changed nothing"
+    rel = np.abs(got["temperature"] / temperature - 1.0).max()
+    assert rel <= 1e-12, f"temperatures differ by {rel:.3g} relative"
+    columns = _heat_columns(report)
+    assert columns == _heat_columns(parallel)
+    for key in columns:
+        scale = abs(report["thermal_energy"] if key == "heat_balance_error" else report[key])
+        diff = abs(parallel[key] - report[key])
+        assert diff <= 1e-9 * scale or diff == 0.0, f"{key}: {parallel[key]!r} / {report[key]!r}"
+    assert abs(parallel["heat_balance_error"]) <= 1e-12 * parallel["thermal_energy"]
