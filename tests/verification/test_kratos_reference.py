@@ -21,7 +21,8 @@ the same equations (docs/validation.md, "Kratos ThermalDEM regression cases"):
   the compression. The same motion and heat: ρ/1.1, c × 1.1 (m c unchanged) and α √1.1.
 * Kratos-only, not emulated: the heat is solved every 5th step (Δt_heat = 5 Δt), E(T), ν(T)
   tables and thermal expansion of the radius. Their effect, OFFSET below, was measured with an
-  independent re-derivation of the Kratos algorithm along the line of centres that
+  independent re-derivation of the Kratos algorithm along the line of centres
+  (tools/kratos_colliding_spheres.py, which prints them) that
   reproduces these reference temperatures to 1e-6 of the change (T - T0); switched off one by
   one (Δ T1 in Dir_01): every-5th-step heat +0.187 K, GlobalDamping +0.154 K (emulated here),
   E(T)/ν(T) +0.009 K, expansion +0.007 K.
