@@ -21,7 +21,7 @@ from scipy import integrate
 
 from thermodem.config.load import case_from_dict, load_case
 from thermodem.engine.simulation import Simulation
-from thermodem.errors import SimulationError
+from thermodem.errors import ConfigError, SimulationError
 from thermodem.kernels import fields as fk
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grids"
@@ -137,10 +137,19 @@ def test_fluid_temperature_table_and_expressions(tmp_path: Path) -> None:
     p = sim.particles.position
     u = np.column_stack([1 + 100 * p[:, 0], np.full(2, 0.5 * t), -p[:, 2] * 10])
     assert np.allclose(f[fk.F_RELATIVE_SPEED], np.linalg.norm(u, axis=1), rtol=1e-14)
-    # an expression of position; one that turns negative stops the run, naming the particle
-    fluid = {"temperature": "300 + 1e5 * x - 1e7 * x * t"}
-    case = _case(_write(tmp_path / "p.txt", pos), {"convection": "stagnant", "fluid": fluid})
-    sim = Simulation(case_from_dict(case))
+    # an expression of position; one that turns negative in the domain before the end time is
+    # refused when the case is read; met during a run (a restart with a later end time) it
+    # stops the run, naming the particle
+    text = "300 + 1e5 * x - 1e7 * x * t"
+    case = _case(
+        _write(tmp_path / "p.txt", pos), {"convection": "stagnant", "fluid": {"temperature": text}}
+    )
+    with pytest.raises(ConfigError, match=r"thermal.fluid.temperature: expression .* gives -700"):
+        case_from_dict(case)
+    case["thermal"]["fluid"]["temperature"] = 300.0
+    case = case_from_dict(case)
+    case.thermal.fluid.temperature = text  # (past the case's checks)
+    sim = Simulation(case)
     tf = _gid(sim, sim.thermal.fields[fk.F_FLUID_TEMPERATURE])
     assert tf == pytest.approx(300 + 1e5 * pos[:, 0], rel=1e-14)
     with pytest.raises(SimulationError, match=r"gives -100.0 K at particle 1 .*t = 0.02 s"):
@@ -167,7 +176,6 @@ thermal:
     assert case.thermal.fluid.temperature.file == str(tmp_path / "flow.vti")
     Simulation(case)
     (tmp_path / "flow.vti").unlink()
-    from thermodem.errors import ConfigError
 
     with pytest.raises(ConfigError, match=r"thermal.fluid.temperature.file: .*does not exist"):
         Simulation(load_case(tmp_path / "case.yaml"))

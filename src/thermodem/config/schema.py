@@ -324,6 +324,26 @@ def _fmt(values: list[float]) -> str:
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 
 
+def fluid_probe_samples(case: Any) -> list[tuple[Any, Any, Any, Any]]:
+    """Sample points (t, x, y, z) at which a fluid expression of t, x, y, z is evaluated before
+    the run: 2001 times from 0 to end_time at the 27 points of a 3 × 3 × 3 grid spanning the
+    domain, and the 21 × 21 × 21 grid at 11 times (2D: the plane z = 0)."""
+    import numpy as np
+
+    def grid(n: int) -> list[Any]:
+        axes = [np.linspace(lo, hi, n) for lo, hi in zip(case.domain.lower, case.domain.upper,
+                                                         strict=True)]  # fmt: skip
+        if case.simulation.planar:
+            axes[2] = np.zeros(1)
+        return [a.ravel()[None, :] for a in np.meshgrid(*axes, indexing="ij")]
+
+    end = case.simulation.end_time
+    return [
+        (np.linspace(0.0, end, 2001)[:, None], *grid(3)),
+        (np.linspace(0.0, end, 11)[:, None], *grid(21)),
+    ]
+
+
 class ExternalForce(StrictModel):
     """A constant force and torque on every selected particle, applied at every step
     (docs/case-file.md, ``external_force``).
@@ -550,7 +570,8 @@ class Case(StrictModel):
     def _probe_temperature_expressions(self, th: ThermalSettings) -> None:
         """Temperature expressions evaluated before the run: the initial temperature on a
         21 × 21 × 21 grid spanning the domain, each wall temperature at 2001 times from 0 to
-        end_time; every value must be finite and > 0 K."""
+        end_time, the fluid's temperature and velocity expressions at the points of
+        :func:`fluid_probe_samples`; every value must be finite and a temperature > 0 K."""
         import numpy as np
 
         from thermodem.engine.expressions import probe_expression
@@ -579,6 +600,23 @@ class Case(StrictModel):
                     raise ValueError(
                         f"walls.{k}.thermal.temperature: {exc} (a wall temperature [K] from "
                         "t = 0 to simulation.end_time)"
+                    ) from None
+        fluid = th.fluid
+        for name, positive in (("temperature", True), ("velocity", False)):
+            source = getattr(fluid, name) if fluid is not None else None
+            if source is None or source.kind != "expression":
+                continue
+            for c, text in enumerate(source.expression):
+                key = f"thermal.fluid.{name}" + (f".{c}" if len(source.expression) > 1 else "")
+                try:
+                    for samples in fluid_probe_samples(self):
+                        probe_expression(text, ("t", "x", "y", "z"), samples,
+                                         0.0 if positive else None)  # fmt: skip
+                except ValueError as exc:
+                    what = "a fluid temperature [K]" if positive else "a fluid velocity [m/s]"
+                    raise ValueError(
+                        f"{key}: {exc} ({what} at every point of the domain from t = 0 to "
+                        "simulation.end_time)"
                     ) from None
 
     def _check_voronoi_reuse(self, th: ThermalSettings) -> None:

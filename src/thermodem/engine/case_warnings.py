@@ -394,6 +394,14 @@ def temperature_warnings(sim: Simulation) -> list[str]:
             add(f"thermal.fluid.temperature (row {i})", fluid.table[i][1])
         elif fluid is not None and fluid.kind == "grid":
             add(*_grid_minimum(sim, fluid))
+        elif fluid is not None and fluid.kind == "expression":
+            from thermodem.config.schema import fluid_probe_samples
+
+            names = ("t", "x", "y", "z")
+            low = min(_expression_minimum(fluid.expression[0], names, samples)
+                      for samples in fluid_probe_samples(case))  # fmt: skip
+            add("thermal.fluid.temperature (its smallest value in the domain until the end "
+                "time)", low)  # fmt: skip
         for family in ("radiation",):
             params = getattr(th, family).params
             add(f"thermal.{family}.environment_temperature",
