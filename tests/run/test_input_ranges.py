@@ -460,3 +460,60 @@ def test_a_tessellation_that_nothing_reads_is_told(tmp_path: Path) -> None:
         "indirect_conduction": "voronoi_a", "tessellation": {"every_steps": 5}}))  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
     assert "nothing tessellates" not in res.stderr
+
+
+def test_2d_region_selections_ignore_z(tmp_path: Path) -> None:
+    """A 2D case's boxes copied from a 3D case whose z range misses the plane z = 0: the
+    external source heated nothing and the initial-temperature regions took nobody (their z
+    was tested as in 3D, docs/two-dimensional.md says z is ignored); the fixed temperature
+    held only by a classification on x, y. Now every selection ignores z in 2D."""
+    import h5py
+
+    away = [0.01, 0.02]  # the z range of every box: misses z = 0
+
+    def box(x0: float, x1: float) -> dict:
+        return {"lower": [x0, 0, away[0]], "upper": [x1, 0.01, away[1]]}
+
+    case = {
+        "simulation": {
+            "dimension": 2,
+            "thickness": 0.001,
+            "time_step": 1.0e-6,
+            "end_time": 2.0e-5,
+            "gravity": [0, 0],
+        },  # fmt: skip
+        "domain": {"lower": [0, 0], "upper": [0.01, 0.01]},
+        "materials": _glass(),
+        "insertion": [
+            {
+                "kind": "list",
+                "material": "glass",
+                "radius": 0.0008,
+                "positions": [[0.002 * (i + 1), 0.002] for i in range(4)],
+            }
+        ],  # fmt: skip
+        "external_force": [{"select": {"region": box(0, 0.0045)}, "force": [1.0e-3, 0, 0]}],
+        "thermal": {
+            "direct_conduction": "rojek2014",
+            "contact_radius": "geometric",
+            "initial_temperature": {
+                "kind": "regions",
+                "regions": [[box(0, 0.003), 350]],
+                "default": 300,
+            },  # fmt: skip
+            "fixed_temperature": [{"select": {"region": box(0.0075, 0.01)}, "temperature": 400}],
+            "external_source": [{"power": 1.0, "region": box(0.0035, 0.0065)}],
+        },
+    }
+    path = tmp_path / "disc.yaml"
+    path.write_text(yaml.safe_dump(case))
+    res = _cli("run", path, "--output", tmp_path / "out")
+    assert res.returncode == 0, res.stdout + res.stderr
+    ckpt = sorted((tmp_path / "out" / "checkpoints").glob("*.h5"))[-1]
+    with h5py.File(ckpt) as f:
+        order = f["particles/global_id"][...].argsort()
+        temperature = f["particles/temperature"][...][order]
+        force = f["particles/external_force"][...][order]
+    assert temperature[0] == 350.0 and temperature[3] == 400.0
+    assert temperature[1] > 300.0 and temperature[2] > 300.0  # the source's share
+    assert force[:, 0].tolist() == [1.0e-3, 1.0e-3, 0.0, 0.0]

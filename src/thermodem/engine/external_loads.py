@@ -20,16 +20,22 @@ from thermodem.errors import ConfigError
 from thermodem.state.particles import Particles
 
 
-def selected(entry_select, particles: Particles, material_index: dict[str, int]) -> np.ndarray:  # noqa: ANN001
+def selected(
+    entry_select,  # noqa: ANN001
+    particles: Particles,
+    material_index: dict[str, int],
+    planar: bool = False,
+) -> np.ndarray:
     """Mask of the particles a :class:`~thermodem.config.thermal.Selection` takes (all of its
-    criteria: material, box region on the current positions, global ids)."""
+    criteria: material, box region on the current positions (2D, ``planar``: z ignored),
+    global ids)."""
+    from thermodem.engine.thermal_conditions import in_box
+
     mask = np.ones(particles.count, bool)
     if entry_select.material is not None:
         mask &= particles.type_id == material_index[entry_select.material]
     if entry_select.region is not None:
-        lo = np.asarray(entry_select.region.lower)
-        hi = np.asarray(entry_select.region.upper)
-        mask &= np.all((particles.position >= lo) & (particles.position <= hi), axis=1)
+        mask &= in_box(particles.position, entry_select.region, planar)
     if entry_select.ids is not None:
         mask &= np.isin(particles.global_id, np.asarray(entry_select.ids, np.int64))
     return mask
@@ -43,7 +49,7 @@ def assign(case: Case, particles: Particles, material_index: dict[str, int]) -> 
     particles.external_force[:] = 0.0
     particles.external_torque[:] = 0.0
     for entry in case.external_force:
-        mask = selected(entry.select, particles, material_index)
+        mask = selected(entry.select, particles, material_index, case.simulation.planar)
         particles.external_force[mask] += np.asarray(entry.force, float)
         particles.external_torque[mask] += np.asarray(entry.torque, float)
 
@@ -54,7 +60,7 @@ def check_selected(case: Case, particles: Particles, material_index: dict[str, i
     if any(e.kind == "pour" for e in case.insertion):
         return
     for k, entry in enumerate(case.external_force):
-        if not selected(entry.select, particles, material_index).any():
+        if not selected(entry.select, particles, material_index, case.simulation.planar).any():
             sel = entry.select.model_dump(exclude_none=True)
             raise ConfigError(
                 f"external_force.{k}.select: selects no particle ({sel}); the selection is "

@@ -59,10 +59,21 @@ def wall_temperature_function(spec: Any) -> Any:
     return lambda t: float(expr(t))
 
 
-def in_box(position: np.ndarray, box: Any) -> np.ndarray:
-    """Mask of positions inside an axis-aligned box (bounds included)."""
-    lo = np.asarray(box.lower)
-    hi = np.asarray(box.upper)
+def box_bounds(box: Any, planar: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) of a selection box as float arrays; in a 2D case (``planar``) the z
+    extent is ignored (-inf .. inf): the particles live in the plane z = 0, and a box copied
+    from a 3D case whose z range misses 0 still selects in the plane (docs/two-dimensional.md).
+    """
+    lo = np.array(box.lower, np.float64)
+    hi = np.array(box.upper, np.float64)
+    if planar:
+        lo[2], hi[2] = -np.inf, np.inf
+    return lo, hi
+
+
+def in_box(position: np.ndarray, box: Any, planar: bool = False) -> np.ndarray:
+    """Mask of positions inside an axis-aligned box (bounds included; 2D: z ignored)."""
+    lo, hi = box_bounds(box, planar)
     return np.all((position >= lo) & (position <= hi), axis=1)
 
 
@@ -93,8 +104,7 @@ class ThermalConditions:
         self.boxes = np.zeros((len(entries), 6))
         for e, sel in enumerate(self.selections):
             if sel.region is not None:
-                self.boxes[e, :3] = sel.region.lower
-                self.boxes[e, 3:] = sel.region.upper
+                self.boxes[e, :3], self.boxes[e, 3:] = box_bounds(sel.region, sim.planar)
         self.static_mask = np.zeros((0, len(entries)), np.bool_)
         self.static_valid = False
         self.fixed = np.zeros(0, np.bool_)
@@ -241,10 +251,11 @@ class ThermalConditions:
         if self._part.shape[0] < rows:
             self._part = np.zeros(rows)
         for e in active:
-            lower = np.asarray(e.region.lower, np.float64)
-            upper = np.asarray(e.region.upper, np.float64)
+            lower, upper = box_bounds(e.region, self.sim.planar)
             axis = np.asarray(e.axis, np.float64) / np.linalg.norm(e.axis)
-            centre = 0.5 * (lower + upper)
+            centre = 0.5 * (np.asarray(e.region.lower) + np.asarray(e.region.upper))
+            if self.sim.planar:
+                centre[2] = 0.0  # (the plane of the discs)
             gaussian = e.profile == "gaussian"
             total = external_weights(
                 p.position, p.radius, lower, upper, gaussian, centre, axis,
@@ -283,7 +294,7 @@ class ThermalConditions:
         if rule.kind == "regions":
             out = np.full(n, rule.default)
             for box, temp in rule.regions:
-                out[in_box(position, box)] = temp
+                out[in_box(position, box, self.sim.planar)] = temp
             return out
         fn = compile_expression(rule.expression, ("x", "y", "z"))
         return np.broadcast_to(fn(position[:, 0], position[:, 1], position[:, 2]), (n,)).copy()

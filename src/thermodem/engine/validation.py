@@ -431,7 +431,7 @@ def check_thermal_selections(sim: Simulation) -> list[str]:
                         f"the global ids 0 ... {count - 1} (in insertion order) and none is "
                         "poured later"
                     )
-            taken = selected(sel, p, sim.material_index)[: sim.owned_count]
+            taken = selected(sel, p, sim.material_index, sim.planar)[: sim.owned_count]
             if sim.sum_over_ranks(float(np.count_nonzero(taken))) > 0.0:
                 continue
             if sel.region is None and not pours:
