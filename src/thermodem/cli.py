@@ -188,7 +188,8 @@ def run(
     """Run a case: VTU/PVD frames, timeseries.csv, checkpoints, run.log, status.json.
     Under ``mpiexec -n P`` (P > 1) the case runs on P ranks (docs/mpi.md)."""
     from thermodem.config.load import load_case
-    from thermodem.engine.runner import run_case, run_from_checkpoint
+    from thermodem.engine.restarted_runs import run_from_checkpoint
+    from thermodem.engine.runner import run_case
 
     threads = _threads(threads)
     ranks = _mpi_ranks()
@@ -303,7 +304,7 @@ def restart(
 ) -> None:
     """Continue a run from the newest checkpoint in DIRECTORY (appending to its outputs); under
     ``mpiexec -n P`` on P ranks, whatever number of ranks wrote it."""
-    from thermodem.engine.runner import restart_run
+    from thermodem.engine.restarted_runs import restart_run
 
     if _mpi_ranks() > 1:
         from thermodem.mpi.runner import restart_distributed

@@ -1,4 +1,4 @@
-"""A signal while a restart is being set up (engine/runner.py: restart_run,
+"""A signal while a restart is being set up (engine/restarted_runs.py: restart_run,
 run_from_checkpoint; engine/run_signals.py: restart_not_started, not_started): a message
 that the restart stopped before its first step and which checkpoint the next one continues
 from, exit code 130 (143), the run directory's checkpoints, status.json and
@@ -47,7 +47,7 @@ import os
 import signal
 import sys
 
-import thermodem.engine.runner as runner
+import thermodem.engine.restarted_runs as runner  # (the restarts set up there)
 from thermodem.cli import app
 
 signum = getattr(signal, sys.argv[1])

@@ -15,13 +15,8 @@ from typer.testing import CliRunner
 
 from thermodem.cli import app
 from thermodem.config.load import case_from_dict
-from thermodem.engine.runner import (
-    TimeseriesWriter,
-    read_timeseries,
-    restart_run,
-    run_case,
-    run_from_checkpoint,
-)
+from thermodem.engine.restarted_runs import restart_run, run_from_checkpoint
+from thermodem.engine.runner import TimeseriesWriter, read_timeseries, run_case
 from thermodem.errors import RunInterrupted
 from thermodem.io.checkpoint import list_checkpoints, read_checkpoint
 from thermodem.io.vtk import PVDWriter
