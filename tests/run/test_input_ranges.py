@@ -517,3 +517,40 @@ def test_2d_region_selections_ignore_z(tmp_path: Path) -> None:
     assert temperature[0] == 350.0 and temperature[3] == 400.0
     assert temperature[1] > 300.0 and temperature[2] > 300.0  # the source's share
     assert force[:, 0].tolist() == [1.0e-3, 1.0e-3, 0.0, 0.0]
+
+
+def test_a_heat_generation_mechanism_the_contact_laws_cannot_produce_is_told(
+    tmp_path: Path,
+) -> None:
+    """rolling_friction with rolling: none, plastic_deformation with an elastic normal law
+    (rojek2014's sliding friction without a tangential law...) gave zero heat without a word."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.case_warnings import generation_mechanism_warnings
+
+    listed = ["rolling_friction", "plastic_deformation", "normal_damping"]
+    generation = {"model": "mechanical_dissipation", "mechanisms": listed}
+    path = _case(tmp_path, thermal={"heat_generation": generation})
+    res = _cli("validate", path)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (
+        "warning: thermal.heat_generation.mechanisms: 'rolling_friction' gives zero heat with "
+        "these contact laws: contact.rolling is 'none'"
+    ) in res.stderr
+    assert (
+        "'plastic_deformation' gives zero heat with these contact laws: contact.normal is "
+        "'hertz', an elastic law"
+    ) in res.stderr
+    assert "'normal_damping' gives zero" not in res.stderr
+
+    def told(contact: dict, generation: dict | str) -> list[str]:
+        data = json.loads(json.dumps(CASE))
+        data["contact"] = contact
+        data["thermal"] = {"heat_generation": generation}
+        return generation_mechanism_warnings(case_from_dict(data))
+
+    (text,) = told({"tangential": "none"}, "rojek2014")
+    assert text.startswith("thermal.heat_generation = 'rojek2014': 'sliding_friction' gives zero")
+    walton_braun = {"model": "walton_braun", "loading_stiffness": 1e4}
+    (text,) = told({"normal": walton_braun, "rolling": "epsd"}, generation)
+    assert "'normal_damping' gives zero heat" in text  # plastic_deformation is produced
+    assert told({"rolling": "none"}, "mechanical_dissipation") == []  # the default list

@@ -180,6 +180,68 @@ def parameter_warnings(case: Case) -> list[str]:
             "turns none of the dissipation into heat, so the model does nothing; give the "
             "fraction χ that becomes heat (usually 0.85-1), or heat_generation: none"
         )
+    return out + generation_mechanism_warnings(case)
+
+
+def _mechanism_zero_reason(mechanism: str, case: Case) -> str | None:
+    """Why the contact laws of ``case`` produce none of ``mechanism``'s dissipation, or None
+    (docs/models/heat_generation-mechanical_dissipation.md)."""
+    laws = case.contact
+    normal, tangential, rolling = laws.normal.model, laws.tangential.model, laws.rolling.model
+    if mechanism == "sliding_friction" and tangential == "none":
+        return "contact.tangential is 'none': no tangential force, so no friction work"
+    if mechanism == "rolling_friction" and rolling == "none":
+        return "contact.rolling is 'none': no rolling torque, so no rolling dissipation"
+    if mechanism == "normal_damping" and normal == "walton_braun":
+        return (
+            "contact.normal is 'walton_braun', which has no dashpot (its loss is "
+            "plastic_deformation)"
+        )
+    if mechanism == "tangential_damping" and tangential == "none":
+        return "contact.tangential is 'none': no tangential dashpot"
+    if mechanism == "tangential_damping" and normal == "walton_braun":
+        return (
+            "the tangential dashpot takes the normal law's damping, and contact.normal "
+            "'walton_braun' has none"
+        )
+    if mechanism == "plastic_deformation" and normal != "walton_braun":
+        return (
+            f"contact.normal is {normal!r}, an elastic law: only the elasto-plastic "
+            "'walton_braun' deforms plastically"
+        )
+    return None
+
+
+def generation_mechanism_warnings(case: Case) -> list[str]:
+    """A heat generation mechanism the case names (``mechanical_dissipation``'s listed
+    ``mechanisms``, ``rojek2014``'s sliding friction, ``richard2008``'s normal damping) that
+    the contact laws cannot produce: it gives zero heat. A warning each, naming the mechanism,
+    the contact law and why. ``mechanical_dissipation``'s default list (all five) is not told
+    about."""
+    th = case.thermal
+    if th is None:
+        return []
+    generation = th.heat_generation
+    key = f"thermal.heat_generation = {generation.model!r}"
+    if generation.model == "mechanical_dissipation":
+        if "mechanisms" not in generation.params.model_fields_set:
+            return []
+        listed = list(generation.params.mechanisms)
+        key = "thermal.heat_generation.mechanisms"
+    elif generation.model == "rojek2014":
+        listed = ["sliding_friction"]
+    elif generation.model == "richard2008":
+        listed = ["normal_damping"]
+    else:
+        return []
+    out = []
+    for mechanism in listed:
+        reason = _mechanism_zero_reason(mechanism, case)
+        if reason is not None:
+            out.append(
+                f"{key}: {mechanism!r} gives zero heat with these contact laws: {reason}; "
+                "remove it, or choose a contact law that dissipates that way"
+            )
     return out
 
 
