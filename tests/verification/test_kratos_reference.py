@@ -95,6 +95,61 @@ CASES = {
         (0.48981477, 0.24338194),
         3.5e-4,  # measured 1.7e-4
     ),
+    # indirect conduction alone (direct_conduction none); Kratos' surrounding_layer
+    "ConductionIndir_01": (
+        {
+            "direct_conduction": "none",
+            "indirect_conduction": {
+                "model": "rong_horio1999",
+                "layer_thickness_ratio": 0.4,  # fluid_layer_thickness
+                "min_separation": 2.75e-8,  # min_conduction_distance
+            },
+            **GAS,
+        },
+        (331.4101119617594, 382.15246624572103),
+        (0.07362021, -0.10707425),
+        1e-3,  # measured 4.4e-4
+    ),
+    # voronoi_method porosity, global_porosity 0.5: Kratos r_ij = 0.56 R (1 - ε)^(-1/3),
+    # thermodem A_n = 0.985 R² (1 - ε)^(-2/3), r_ij 1.1e-4 smaller (in the OFFSET)
+    "ConductionIndir_02": (
+        {
+            "direct_conduction": "none",
+            "indirect_conduction": {"model": "voronoi_a", "geometry": "porosity"},
+            "porosity": {"kind": "global", "value": 0.5},
+            **GAS,
+        },
+        (309.6055055629605, 394.46941470365215),
+        (0.09514583, -0.05920588),
+        2e-4,  # measured 0.8e-4
+    ),
+    "ConductionIndir_03": (
+        {
+            "direct_conduction": "none",
+            "indirect_conduction": {
+                "model": "voronoi_b",
+                "geometry": "porosity",
+                "core_radius_ratio": 0.5,  # isothermal_core_radius
+            },
+            "porosity": {"kind": "global", "value": 0.5},
+            **GAS,
+        },
+        (308.68103418523435, 394.9595923718053),
+        (0.07008443, -0.04616115),
+        1.5e-4,  # measured 0.63e-4
+    ),
+    # Kratos' vargas_mccarthy is the gas-only form without the rarefaction length M: a mean
+    # free path of 1e-30 m makes thermodem's M vanish
+    "ConductionIndir_04": (
+        {
+            "direct_conduction": "none",
+            "indirect_conduction": "vargas_mccarthy2002",
+            "gas": {"thermal_conductivity": 10.0, "mean_free_path": 1e-30},
+        },
+        (314.68557304168144, 391.742377188302),
+        (0.12174023, -0.08723922),
+        6e-4,  # measured 2.9e-4
+    ),
 }
 
 
@@ -119,6 +174,7 @@ def kratos_case(thermal: dict) -> dict:
             "restitution": e,
             "sliding_friction": 0.4,  # DYNAMIC_FRICTION (the slip speed makes the decay moot)
             "rolling_friction": 0.01,
+            "thermal_accommodation": 1.0,  # (read by vargas_mccarthy2002's M, 0 here)
             "thermal_conductivity_table": k,
             "specific_heat_table": [[t, v * factor] for t, v in c],
         }
