@@ -155,6 +155,48 @@ def _mpi_ranks() -> int:
     return world_size()
 
 
+def _one_rank(fn):  # noqa: ANN001, ANN202
+    """A command that does not run a case (validate, etc, export, plot, info, models) under
+    ``mpiexec -n P`` (P > 1): rank 0 runs it alone and sends its exit code to the other
+    ranks, which exit with it without running anything (one output, one file written, no
+    race on ``export -o FILE``); docs/mpi.md. Without MPI: the command itself."""
+    import functools
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+        if _mpi_ranks() <= 1:
+            return fn(*args, **kwargs)
+        import time
+
+        from mpi4py import MPI
+
+        comm = MPI.COMM_WORLD
+        tag = 7301
+        if comm.Get_rank() != 0:
+            request = comm.irecv(source=0, tag=tag)
+            while True:  # (a sleeping wait: no core spinning while rank 0 works)
+                done, code = request.test()
+                if done:
+                    raise typer.Exit(int(code))
+                time.sleep(0.02)
+        code = EXIT_SIMULATION
+        try:
+            result = fn(*args, **kwargs)
+            code = EXIT_OK
+            return result
+        except typer.Exit as exc:
+            code = exc.exit_code
+            raise
+        except SystemExit as exc:
+            code = exc.code if isinstance(exc.code, int) else EXIT_SIMULATION
+            raise
+        finally:
+            for rank in range(1, comm.Get_size()):
+                comm.send(code, dest=rank, tag=tag)
+
+    return wrapper
+
+
 _REBALANCE = typer.Option(
     0.1,
     "--rebalance",
@@ -268,6 +310,7 @@ def _shorten(case, end_time: float | None, steps: int | None, restart: Path | No
 
 
 @app.command()
+@_one_rank
 def export(
     directory: Path = typer.Argument(..., help="output directory of a run"),
     frame: int | None = typer.Option(
@@ -344,6 +387,7 @@ def _announce_compile(case: Path) -> None:
 
 
 @app.command()
+@_one_rank
 def etc(
     case: Path = typer.Argument(..., help="case file (YAML): the packing and its thermal models"),
     axes: str | None = typer.Option(
@@ -443,6 +487,7 @@ def etc(
 
 
 @app.command()
+@_one_rank
 def validate(
     case: Path = typer.Argument(..., help="case file (YAML)"),
     threads: int | None = _THREADS,
@@ -465,6 +510,7 @@ def validate(
 
 
 @app.command()
+@_one_rank
 def info(directory: Path = typer.Argument(..., help="output directory")) -> None:
     """Summarise an output directory: status, time reached, frames, checkpoints, last row."""
     from thermodem.engine.runner import output_summary
@@ -474,6 +520,7 @@ def info(directory: Path = typer.Argument(..., help="output directory")) -> None
 
 
 @app.command()
+@_one_rank
 def plot(
     directory: Path = typer.Argument(..., help="output directory"),
     out: Path | None = typer.Option(None, "--out", help="where the PNGs go (default DIR/plots)"),
@@ -531,6 +578,7 @@ def _conducts_across_gaps(spec) -> bool:  # noqa: ANN001
 
 
 @app.command()
+@_one_rank
 def models(
     family: str | None = typer.Argument(None, help="only this family (e.g. normal)"),
 ) -> None:

@@ -456,3 +456,27 @@ def test_an_output_refused_stops_every_rank_with_one_message(tmp_path: Path) -> 
     assert "No space left on device" in res.stderr
     assert f"continue with: mpiexec -n 2 thermodem restart {out}" in res.stderr, res.stderr
     assert json.loads((out / "status.json").read_text())["status"] == "failed"
+
+
+@needs_mpi
+def test_commands_that_run_no_case_run_on_rank_0_only(tmp_path: Path) -> None:
+    """validate, info, export (and etc, plot, models) under mpiexec -n 2 ran on every rank:
+    every line twice, and export -o FILE raced (one rank failed with 'file exists', exit 2).
+    Rank 0 runs them alone, the other ranks exit with its code."""
+    case = bed_case(DATA / "mpi_bed_box.txt", heat=None, end_time=2 * DT)
+    path = _write_case(tmp_path / "c.yaml", case)
+    out = tmp_path / "o"
+    assert _run(["run", str(path), "-o", str(out), "--no-progress"]).returncode == 0
+    res = _run(["validate", str(path)], 2, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.count(": valid (schema") == 1, res.stdout
+    res = _run(["info", str(out)], 2, timeout=120)
+    assert res.returncode == 0 and res.stdout.count("status: finished") == 1, res.stdout
+    res = _run(["export", str(out), "-o", str(tmp_path / "p.csv")], 2, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.count("p.csv") == 1 and (tmp_path / "p.csv").exists()
+    res = _run(["export", str(out), "-o", str(tmp_path / "p.csv")], 2, timeout=120)
+    assert res.returncode == 2 and res.stderr.count("error:") == 1, res.stderr  # (it exists)
+    case["simulation"]["end_time"] = 0.0
+    res = _run(["validate", str(_write_case(tmp_path / "bad.yaml", case))], 2, timeout=120)
+    assert res.returncode == 2 and res.stderr.count("error:") == 1, res.stderr
