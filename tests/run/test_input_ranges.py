@@ -554,3 +554,17 @@ def test_a_heat_generation_mechanism_the_contact_laws_cannot_produce_is_told(
     (text,) = told({"normal": walton_braun, "rolling": "epsd"}, generation)
     assert "'normal_damping' gives zero heat" in text  # plastic_deformation is produced
     assert told({"rolling": "none"}, "mechanical_dissipation") == []  # the default list
+
+
+def test_a_porosity_cell_larger_than_the_domain_is_told(tmp_path: Path) -> None:
+    """porosity: {kind: cell, cell_size: 0.5} in a 1 cm domain ran with one cell (the
+    domain's mean porosity for every particle) without a word. (A shell or a sphere of
+    radiative influence larger than the domain is refused: the broken-case corpus.)"""
+    thermal = {"convection": "gunn1978", "fluid": {"temperature": 300.0},
+               "porosity": {"kind": "cell", "cell_size": 0.5}}  # fmt: skip
+    res = _cli("validate", _case(tmp_path, thermal=thermal))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (
+        "warning: thermal.porosity.cell_size: 0.5 m is larger than the domain (edges 0.01, "
+        "0.01, 0.01 m)"
+    ) in res.stderr

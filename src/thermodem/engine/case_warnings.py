@@ -180,6 +180,20 @@ def parameter_warnings(case: Case) -> list[str]:
             "turns none of the dissipation into heat, so the model does nothing; give the "
             "fraction χ that becomes heat (usually 0.85-1), or heat_generation: none"
         )
+    porosity = th.porosity
+    size = getattr(porosity, "cell_size", None) if porosity is not None else None
+    if porosity is not None and porosity.kind == "cell" and size is not None:
+        axes = 2 if case.simulation.planar else 3
+        edges = [hi - lo for lo, hi in zip(case.domain.lower, case.domain.upper, strict=True)]
+        edges = edges[:axes]
+        if size > max(edges):
+            out.append(
+                f"thermal.porosity.cell_size: {size:g} m is larger than the domain (edges "
+                f"{', '.join(f'{e:g}' for e in edges)} m): the cells, rounded to tile the "
+                "domain, are one cell, the whole domain, so every particle gets the domain's "
+                "mean porosity (a global porosity, not a local one); give a cell edge of a few "
+                "particle diameters (the default: three), or porosity: {kind: global, value: ...}"
+            )
     return out + generation_mechanism_warnings(case)
 
 

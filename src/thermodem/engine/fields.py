@@ -202,6 +202,13 @@ class FieldProvider(FluidSources):
             if self.radiation_ratio > 0.0 or self.shell_ratio > 0.0
             else None
         )
+        if self.neighbourhood is not None:
+            # before the run: the largest particles the insertions can bring (pours too)
+            bounds = [
+                getattr(getattr(e, "distribution", None), "max_radius_bound", None)
+                for e in sim.case.insertion
+            ]
+            self.check_neighbourhood_range(max([float(b) for b in bounds if b] + [0.0]))
         self.emissivity = (
             np.ascontiguousarray(self.radiation.table[:, 0], np.float64)
             if self.radiation is not None and self.radiation.table.ndim == 2
@@ -269,11 +276,16 @@ class FieldProvider(FluidSources):
             self.neighbourhood.invalidate()
 
     def update(self, time: float, fields: np.ndarray) -> None:
-        """Fill the columns the terms need for the current state at ``time``."""
+        """Fill the columns the terms need for the current state at ``time``, for the
+        particles this process owns (all of them; on several MPI ranks the first
+        ``owned_count``, not the ghosts: ``fields`` has a column per owned particle)."""
         sim = self.sim
         p = sim.particles
-        if p.count == 0 or not self.active:
+        if not self.active or (p.count == 0 and getattr(sim, "comm", None) is None):
+            # (on several MPI ranks a rank without particles still takes part in the
+            # agreements of the warnings and failures below: they are collective)
             return
+        n = sim.owned_count
         if fields is not self._constants_for:  # a new array: its constant columns
             for col, value in self._constant_columns().items():
                 fk.fill_column(fields, col, value)
@@ -281,7 +293,7 @@ class FieldProvider(FluidSources):
         if self.needs_temperature:
             self._temperature(time, fields)
         for col, nodes, values, at_particle in self._property_tables:
-            fk.table_column(fields, col, nodes, values, at_particle, p.temperature)
+            fk.table_column(fields, col, nodes, values, at_particle, p.temperature[:n])
         if self._property_tables:
             fk.prandtl_columns(fields)
         if self.needs_velocity:
@@ -293,7 +305,7 @@ class FieldProvider(FluidSources):
         elif self.external_porosity is not None:
             self.external_porosity.update(sim, fields)
         if self.walls is not None:
-            fk.wall_view(p.position, p.radius, sim.wall_kind, sim.wall_rows,
+            fk.wall_view(p.position[:n], p.radius[:n], sim.wall_kind, sim.wall_rows,
                          float(self.walls.wall_range), float(self.walls.wall_view_factor),
                          fields)  # fmt: skip
         if self.ranges and len(self.warned) < len(self.ranges):
@@ -314,9 +326,36 @@ class FieldProvider(FluidSources):
         return self.part
 
     # ----------------------------------------------------------------- neighbourhood
+    def check_neighbourhood_range(self, r_max: float) -> None:
+        """A sphere of influence (continuum radiation) or a porosity shell of ``radius_ratio``
+        × ``r_max`` larger than the domain's smallest extent averages over the whole domain,
+        not a neighbourhood: a ConfigError naming the key, the value, the sphere's radius and
+        the domain (as the conduction ranges, engine/thermal_terms.py: check_ranges)."""
+        sim = self.sim
+        length = (sim.upper - sim.lower)[: 2 if sim.planar else 3]
+        extent = float(np.min(length))
+        if not r_max > 0.0:
+            return
+        spheres = [("thermal.porosity.radius_ratio", self.shell_ratio, "the porosity shell")]
+        if self.radiation is not None:
+            spheres.append(
+                ("thermal.radiation.radius_ratio", self.radiation_ratio,
+                 f"the sphere of radiative influence of {self.radiation.choice.model!r}")
+            )  # fmt: skip
+        for key, ratio, what in spheres:
+            if ratio > 0.0 and ratio * r_max > extent:
+                raise ConfigError(
+                    f"{key} = {ratio!r}: {what} around a particle of radius {r_max:.6g} m has "
+                    f"the radius {ratio * r_max:.6g} m, more than the domain's smallest extent "
+                    f"{extent:.6g} m (domain edges {', '.join(f'{v:.6g}' for v in length)} m): "
+                    "it would average over the whole domain, not a neighbourhood; allowed: "
+                    f"radius_ratio below {extent / r_max:.6g} (or a larger domain)"
+                )
+
     def _neighbourhood_gap(self) -> float:
         r = self.sim.particles.radius
         r_max, r_min = float(r.max()), float(r.min())
+        self.check_neighbourhood_range(r_max)  # (particle files and lists: once inserted)
         gap = 0.0
         if self.radiation_ratio > 0.0:
             gap = max(gap, self.radiation_ratio * r_max - 2.0 * r_min)
@@ -472,40 +511,49 @@ class FieldProvider(FluidSources):
 
     def _numbers(self, fields: np.ndarray, nusselt: bool) -> None:
         p = self.sim.particles
-        if self.numbers_buffer.shape[0] != p.count:
-            self.numbers_buffer = np.zeros((p.count, len(conv.NUMBER_NAMES)))
+        n = fields.shape[1]  # (the owned particles)
+        if self.numbers_buffer.shape[0] != n:
+            self.numbers_buffer = np.zeros((n, len(conv.NUMBER_NAMES)))
         term = self.convection
         gravity = float(np.linalg.norm(self.sim.gravity))
-        conv.convection_numbers(fields, p.radius, p.temperature, p.type_id, term.model_id,
+        conv.convection_numbers(fields, p.radius[:n], p.temperature[:n], p.type_id[:n],
+                                term.model_id,
                                 term.table, gravity, self.beta_mode, self.beta, nusselt,
                                 self.numbers_buffer)  # fmt: skip
 
     def _check_ranges(self, time: float, fields: np.ndarray) -> None:
+        """Warn once per quantity of the first particle outside the correlation's range (on
+        several MPI ranks: of the lowest rank that has one, said by rank 0 only, and every
+        rank marks the quantity warned, so that the ranks check the same quantities)."""
+        sim = self.sim
         self._numbers(fields, False)
-        p = self.sim.particles
+        p = sim.particles
         model = self.convection.choice.model
         for name, lo, hi in self.ranges:
             if name in self.warned:
                 continue
             col = conv.NUMBER_NAMES.index(name)
             k = conv.first_outside(self.numbers_buffer, col, lo, hi)
-            if k < 0:
+            message = None
+            if k >= 0:
+                value = float(self.numbers_buffer[k, col])
+                others = ", ".join(
+                    f"{n} = {self.numbers_buffer[k, conv.NUMBER_NAMES.index(n)]:.4g}"
+                    for n in ("Re", "Pr", "porosity")
+                    if n != name
+                )
+                message = (
+                    f"thermal.convection = {model!r}: {name} = {value:.4g} of particle "
+                    f"{int(p.global_id[k])} at step {sim.step_count} (t = {time:.6g} s) is "
+                    f"outside the correlation's range {lo:g}–{hi:g} ({others}); the correlation "
+                    "is extrapolated (reported once per quantity)"
+                )
+            message = sim.agree_message(message)
+            if message is None:
                 continue
             self.warned.append(name)
-            value = float(self.numbers_buffer[k, col])
-            others = ", ".join(
-                f"{n} = {self.numbers_buffer[k, conv.NUMBER_NAMES.index(n)]:.4g}"
-                for n in ("Re", "Pr", "porosity")
-                if n != name
-            )
-            warnings.warn(
-                f"thermal.convection = {model!r}: {name} = {value:.4g} of particle "
-                f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s) is "
-                f"outside the correlation's range {lo:g}–{hi:g} ({others}); the correlation is "
-                "extrapolated (reported once per quantity)",
-                RuntimeWarning,
-                stacklevel=3,
-            )
+            if sim.says_warnings:
+                warnings.warn(message, RuntimeWarning, stacklevel=3)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self) -> dict[str, Any]:
