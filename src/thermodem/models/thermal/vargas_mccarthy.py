@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 from numba import njit
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from thermodem.config.base import StrictModel
 from thermodem.models.registry import register
@@ -165,6 +165,21 @@ class VargasMcCarthy2002Params(StrictModel):
         allow_inf_nan=False,
         description="k_l [W/(m K)] of the bridge liquid; required when filling_angle > 0",
     )
+
+    @field_validator("filling_angle", mode="before")
+    @classmethod
+    def _radians(cls, v: object) -> object:
+        """An angle of π/2 or more is refused here with its unit: 30 is an angle in degrees
+        (the Field bound alone said 'less than 1.5707963267948966')."""
+        if isinstance(v, int | float) and not isinstance(v, bool) and v >= 0.5 * math.pi:
+            if 2.0 <= v < 90.0:  # (from 2 on no radian angle near: degrees)
+                hint = f"; {v:g} looks like degrees: {math.radians(v):.4g} rad"
+            else:
+                hint = ""
+            raise ValueError(
+                f"must be less than π/2 = {0.5 * math.pi:.6g} (radians{hint}), got {v!r}"
+            )
+        return v
 
     @model_validator(mode="after")
     def _liquid_given(self) -> VargasMcCarthy2002Params:
