@@ -80,14 +80,20 @@ def _threads(requested: int | None) -> int | None:
 def _guarded(fn, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
     """Map thermodem's exceptions to messages and exit codes (never a traceback); thermodem's
     own RuntimeWarnings (a section no selected model reads, said while the case is built)
-    as ``warning: ...`` lines, not Python's 'FILE:LINE: RuntimeWarning:' form."""
+    as ``warning: ...`` lines, not Python's 'FILE:LINE: RuntimeWarning:' form; a
+    :class:`~thermodem.errors.RunNotice` (information: the statistics of a tessellation) as a
+    plain line, as a run logs it."""
     import os
     import warnings
+
+    from thermodem.errors import RunNotice
 
     shown = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001, ANN202
-        if issubclass(category, RuntimeWarning) and f"{os.sep}thermodem{os.sep}" in filename:
+        if issubclass(category, RunNotice):
+            typer.echo(str(message), err=True)
+        elif issubclass(category, RuntimeWarning) and f"{os.sep}thermodem{os.sep}" in filename:
             typer.echo(f"warning: {message}", err=True)
         else:
             shown(message, category, filename, lineno, file, line)

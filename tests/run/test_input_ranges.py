@@ -460,6 +460,9 @@ def test_a_tessellation_that_nothing_reads_is_told(tmp_path: Path) -> None:
         "indirect_conduction": "voronoi_a", "tessellation": {"every_steps": 5}}))  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
     assert "nothing tessellates" not in res.stderr
+    # the tessellation's statistics are information, not a warning (they were
+    # 'warning: tessellation 1 (plain) ...')
+    assert "\ntessellation 1 (" in "\n" + res.stderr and "warning: tessellation" not in res.stderr
 
 
 def test_2d_region_selections_ignore_z(tmp_path: Path) -> None:
