@@ -182,9 +182,21 @@ def test_plain_run_does_not_import_mpi4py(tmp_path: Path) -> None:
          "insertion.1.kind"),
         (lambda c: c["thermal"].update(frozen_mechanics=True, time_step=1e-3),
          "thermal.frozen_mechanics"),
-        (lambda c: c["thermal"].update(convection="ranz_marshall1952",
-                                       fluid={"temperature": 300.0}),
-         "thermal.convection"),
+        # per-particle terms that need the neighbours (the others run under MPI)
+        (lambda c: c["thermal"].update(convection="gunn1978", fluid={"temperature": 300.0},
+                                       porosity={"kind": "cell"}),
+         "thermal.porosity.kind = 'cell'"),
+        (lambda c: c["thermal"].update(radiation={"model": "surroundings",
+                                                  "environment_temperature": 800.0,
+                                                  "exposure": "fraction"},
+                                       porosity={"kind": "shell", "radius_ratio": 3.0}),
+         "thermal.porosity.kind = 'shell'"),
+        (lambda c: c["thermal"].update(radiation={"model": "zhou2009"},
+                                       fluid={"temperature": 300.0}, porosity=0.4),
+         "thermal.radiation = 'zhou2009'"),
+        (lambda c: c["thermal"].update(radiation={"model": "krause2017",
+                                                  "environment_temperature": 300.0}),
+         "thermal.radiation = 'krause2017'"),
         (lambda c: c["thermal"].update(indirect_conduction="vargas_mccarthy2002"),
          "thermal.indirect_conduction"),
         (lambda c: c["output"].update(vtu=True, contacts=True), "output.contacts"),
@@ -201,6 +213,10 @@ def test_refused_under_mpi(change, key: str) -> None:  # noqa: ANN001
     with pytest.raises(ConfigError, match="MPI does not support it yet") as info:
         check_case(case_from_dict(case))
     assert key in str(info.value)
+    if "porosity" in key:  # (what runs instead)
+        assert "porosity: {kind: global, value: ...} runs under MPI" in str(info.value)
+    if "radiation" in key:
+        assert "radiation 'surroundings', with its walls, runs under MPI" in str(info.value)
 
 
 def test_two_dimensional_case_refused_under_mpi() -> None:

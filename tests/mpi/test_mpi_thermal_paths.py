@@ -2,7 +2,11 @@
 (docs/mpi.md), in one ``mpiexec`` launch: explicit Euler with the heat every step (fused with
 the contact pass), every 3rd step, ``substeps: auto``, the range set (rong_horio1999) with
 fixed-temperature particles, a heat flux and a volumetric source, and three restarts whose
-first thermal step is not fused with a contact pass.
+first thermal step is not fused with a contact pass; the per-particle terms (convection with
+a uniform / expression / grid / table fluid and a global porosity, radiation to the
+surroundings and the walls in view), with a serial checkpoint continued
+on 2 ranks and a 2-rank checkpoint continued serially. The convection's validity-range
+warnings are said once (by rank 0), and the quantities warned travel in checkpoints.
 
 Before the fix (mpi/gather.py: load_distributed) the restarts went wrong on 2 ranks:
 
@@ -51,6 +55,32 @@ CONDITIONS = {
         "lower": [0, 0, 4e-3], "upper": [W, W, 8e-3]}}}],
 }  # fmt: skip
 
+#: per-particle terms (the column's material gets an emissivity of 0.9 when radiation is on;
+#: GRID: a fluid temperature on a grid file written by the test); Re of ranz_marshall1952
+#: below 1 and Pr of the gas below whitaker1972's 0.71 are warned at the first evaluation
+CONVECTION = {
+    "convection": "ranz_marshall1952",
+    "fluid": {"temperature": 500.0, "velocity": [0.0, 0.0, 0.002]},
+    "radiation": {"model": "surroundings", "environment_temperature": 800.0, "walls": True},
+}
+GUNN = {
+    "convection": "gunn1978",
+    "fluid": {"temperature": "400 + 20000 * z", "velocity": ["0", "0", "0.5 + 20 * z"]},
+    "porosity": {"kind": "global", "value": 0.4},
+    "radiation": {
+        "model": "surroundings",
+        "environment_temperature": 700.0,
+        "exposure": "threshold",
+        "threshold": 0.3,
+    },
+}
+GRID = {
+    "convection": "whitaker1972",
+    "fluid": {
+        "temperature": {"file": "GRID", "field": "T"},
+        "velocity": [[0.0, 0, 0, 0.3], [1e-3, 0, 0, 1.5]],
+    },
+}
 #: name -> (thermal section, thermal section of the run that wrote the checkpoint at step 70
 #: or "fresh" for a run from t = 0, time step after the restart)
 CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
@@ -63,24 +93,46 @@ CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
     "substeps_auto_restart_half_time_step": ({"substeps": "auto"}, {"substeps": "auto"}, DT / 2),
     "range_heat_starts_at_restart": (
         {**RANGE, "direct_conduction": "none", "substeps": 2}, None, DT),
+    # per-particle terms
+    "convection_radiation_walls": (CONVECTION, "fresh", DT),
+    "gunn_expression_global_porosity": ({**GUNN, "substeps": 2}, "fresh", DT),
+    "whitaker_grid_table": (GRID, "fresh", DT),
+    "convection_restart_half_time_step": (
+        {**CONVECTION, "substeps": 3}, {**CONVECTION, "substeps": 3}, DT / 2),
 }  # fmt: skip
+#: configurations whose 2-rank run also writes a checkpoint at step 70, continued serially
+CONTINUED_SERIALLY = ("gunn_expression_global_porosity", "whitaker_grid_table")
 
 SCRIPT = """
-import json, sys
+import json, sys, warnings
 import numpy as np
 from thermodem.config.load import case_from_dict
+from thermodem.io.checkpoint import write_checkpoint
 from thermodem.mpi import make_simulation
 from thermodem.mpi.gather import gathered_view
 from thermodem.mpi.simulation import DistributedSimulation
 
 for job in json.load(open(sys.argv[1])):
-    case = case_from_dict(job["case"])
-    if job["checkpoint"]:
-        sim = DistributedSimulation.from_checkpoint(job["checkpoint"], case=case)
-    else:
-        sim = make_simulation(case)
-    sim.run(steps=job["steps"])
-    report = sim.report()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuntimeWarning)
+        case = case_from_dict(job["case"])
+        if job["checkpoint"]:
+            sim = DistributedSimulation.from_checkpoint(job["checkpoint"], case=case)
+        else:
+            sim = make_simulation(case)
+        if job["write"]:  # a checkpoint of this run at step 70 (rank 0 writes it)
+            sim.run(steps=70)
+            state = sim.state_dict()
+            if sim.rank == 0:
+                write_checkpoint(sim, job["write"], state=state)
+            sim.run(steps=job["steps"] - 70)
+        else:
+            sim.run(steps=job["steps"])
+        report = sim.report()
+    said = [str(w.message) for w in caught]
+    warned = list(sim.thermal.field_provider.warned) if sim.thermal else []
+    with open(f"{job['out']}.rank{sim.rank}.json", "w") as f:
+        json.dump({"said": said, "warned": warned}, f)
     view = gathered_view(sim)
     if view is not None:
         p = view.particles
@@ -96,34 +148,73 @@ def _jobs(tmp: Path) -> list[dict[str, Any]]:
     from thermodem.engine.simulation import Simulation
     from thermodem.io.checkpoint import write_checkpoint
 
+    grid = tmp / "fluid.npz"  # T from 350 K at z = 0 to 550 K at the domain's top
+    np.savez(
+        grid,
+        x=np.linspace(0, W, 4),
+        y=np.linspace(0, W, 4),
+        z=np.linspace(0, 2 * H, 7),
+        T=350.0 + 200.0 * np.linspace(0, 1, 7)[None, None, :] * np.ones((4, 4, 1)),
+    )
     jobs = []
     for name, (thermal, before, dt) in CONFIGURATIONS.items():
         checkpoint = None
         steps = 140
         if before != "fresh":
-            first = Simulation(case_from_dict(column_case(before)), threads=1)
+            first = Simulation(case_from_dict(_case(before)), threads=1)
             first.run(steps=70)
             checkpoint = str(write_checkpoint(first, tmp / f"{name}.h5"))
             steps = int(round(70 * DT / dt)) + 100
-        case = column_case(thermal, steps=steps, time_step=dt)
+        case = json.loads(
+            json.dumps(_case(thermal, steps=steps, time_step=dt)).replace(
+                '"GRID"', json.dumps(str(grid))
+            )
+        )
+        write = str(tmp / f"{name}_2_ranks.h5") if name in CONTINUED_SERIALLY else None
         jobs.append({"name": name, "case": case, "checkpoint": checkpoint,
-                     "steps": 100 if checkpoint else steps,
+                     "steps": 100 if checkpoint else steps, "write": write,
                      "out": str(tmp / f"{name}.npz")})  # fmt: skip
     return jobs
 
 
-def _serial(job: dict[str, Any]) -> tuple[np.ndarray, dict[str, float]]:
+def _case(thermal: dict[str, Any] | None, **kw: Any) -> dict[str, Any]:
+    case = column_case(thermal, **kw)
+    if thermal is not None and "radiation" in thermal:
+        case["materials"]["glass"]["emissivity"] = 0.9
+    return case
+
+
+def _serial(job: dict[str, Any]) -> dict[str, Any]:
+    """The serial run of ``job``: its final temperatures (by global id), report, warnings
+    said and quantities warned; with ``continued``, the 2-rank run's checkpoint at step 70
+    continued serially (its temperatures and quantities warned)."""
+    import warnings
+
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
     case = case_from_dict(job["case"])
-    if job["checkpoint"]:
-        sim = Simulation.from_checkpoint(job["checkpoint"], threads=1, case=case)
-    else:
-        sim = Simulation(case, threads=1)
-    sim.run(steps=job["steps"])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuntimeWarning)
+        if job["checkpoint"]:
+            sim = Simulation.from_checkpoint(job["checkpoint"], threads=1, case=case)
+        else:
+            sim = Simulation(case, threads=1)
+        sim.run(steps=job["steps"])
     p = sim.particles
-    return p.temperature[np.argsort(p.global_id)], sim.report()
+    out = {"temperature": p.temperature[np.argsort(p.global_id)], "report": sim.report(),
+           "said": [str(w.message) for w in caught],
+           "warned": list(sim.thermal.field_provider.warned)}  # fmt: skip
+    if job["write"]:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RuntimeWarning)
+            again = Simulation.from_checkpoint(job["write"], threads=1, case=case)
+            assert list(again.thermal.field_provider.warned) == out["warned"]
+            again.run(steps=job["steps"] - 70)
+        q = again.particles
+        out["continued"] = q.temperature[np.argsort(q.global_id)]
+        out["continued_said"] = [str(w.message) for w in caught]
+    return out
 
 
 @pytest.fixture(scope="module")
@@ -145,10 +236,17 @@ def _heat_columns(report: dict[str, float]) -> list[str]:
                                                 "inserted_heat", "range_pair"))]  # fmt: skip
 
 
+def _agreed(said: list[str]) -> list[str]:
+    """The warnings every rank agrees on (said once by rank 0): the convection's validity
+    ranges and the fluid grid's outside count."""
+    return [w for w in said if w.startswith(("thermal.convection", "thermal.fluid."))]
+
+
 @needs_mpi
 @pytest.mark.parametrize("name", list(CONFIGURATIONS))
 def test_heat_on_2_ranks_matches_serial(runs: dict[str, Any], name: str) -> None:
-    job, (temperature, report) = runs[name]
+    job, serial = runs[name]
+    temperature, report = serial["temperature"], serial["report"]
     got = np.load(job["out"])
     parallel = json.loads(str(got["report"]))
     start = 300.0 + 5000.0 * np.linspace(1e-3, H - 1e-3, 6)  # (the layers at t = 0)
@@ -162,3 +260,14 @@ def test_heat_on_2_ranks_matches_serial(runs: dict[str, Any], name: str) -> None
         diff = abs(parallel[key] - report[key])
         assert diff <= 1e-9 * scale or diff == 0.0, f"{key}: {parallel[key]!r} / {report[key]!r}"
     assert abs(parallel["heat_balance_error"]) <= 1e-12 * parallel["thermal_energy"]
+    # validity-range warnings: said once (rank 0), the same quantities warned on every rank
+    ranks = [json.loads(Path(f"{job['out']}.rank{r}.json").read_text()) for r in (0, 1)]
+    assert len(_agreed(ranks[0]["said"])) == len(_agreed(serial["said"]))
+    assert _agreed(ranks[1]["said"]) == []
+    assert ranks[0]["warned"] == ranks[1]["warned"] == serial["warned"]
+    if name in ("convection_radiation_walls", "whitaker_grid_table"):
+        assert len(_agreed(serial["said"])) == 1, serial["said"]  # (Re, resp. Pr, at step 0)
+    if job["write"]:  # the 2-rank checkpoint at step 70 continued serially
+        rel = np.abs(serial["continued"] / temperature - 1.0).max()
+        assert rel <= 1e-12, f"continued serially: temperatures differ by {rel:.3g} relative"
+        assert _agreed(serial["continued_said"]) == []  # (warned before the checkpoint)

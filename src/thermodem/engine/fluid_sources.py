@@ -108,8 +108,15 @@ class FluidSources:
 
     # ---------------------------------------------------------------------- update
     def _outside_warning(self, key: str, file: str, count: int, axes: Any, time: float) -> None:
-        if count and key not in self.warned:
+        """Once: the particles outside the grid (on several MPI ranks summed over the ranks,
+        said by rank 0)."""
+        if key in self.warned:
+            return
+        count = int(self.sim.sum_over_ranks(float(count)))  # (collective)
+        if count:
             self.warned.append(key)
+            if not self.sim.says_warnings:
+                return
             extent = ", ".join(
                 f"{a} {ax[0]:.6g}..{ax[-1]:.6g}" for a, ax in zip("xyz", axes, strict=True)
             )
@@ -123,6 +130,7 @@ class FluidSources:
 
     def _temperature(self, time: float, fields: np.ndarray) -> None:
         p = self.sim.particles
+        n = fields.shape[1]  # (the owned particles)
         source = self._sources["temperature"]
         kind = source[0]
         if kind == "uniform":
@@ -132,14 +140,13 @@ class FluidSources:
             fk.fill_column(fields, fk.F_FLUID_TEMPERATURE,
                            float(np.interp(time, table[:, 0], table[:, 1])))  # fmt: skip
         elif kind == "expression":
-            pos = p.position
-            values = np.broadcast_to(
-                source[1][0](time, pos[:, 0], pos[:, 1], pos[:, 2]), (p.count,)
-            )
+            pos = p.position[:n]
+            values = np.broadcast_to(source[1][0](time, pos[:, 0], pos[:, 1], pos[:, 2]), (n,))
             bad = ~(np.isfinite(values) & (values > 0))
+            error = None
             if bad.any():
                 k = int(np.argmax(bad))
-                raise SimulationError(
+                error = SimulationError(
                     f"thermal.fluid.temperature: the expression {source[2][0]!r} gives "
                     f"{float(values[k])!r} K at particle {int(p.global_id[k])} (x, y, z = "
                     f"{tuple(float(v) for v in pos[k])}) at step {self.sim.step_count} "
@@ -148,15 +155,17 @@ class FluidSources:
                     time,
                     int(p.global_id[k]),
                 )
+            self.sim.agree_failure(error)  # (collective on several MPI ranks)
             fields[fk.F_FLUID_TEMPERATURE, :] = values
         else:
             _, axes, values, file = source
-            outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values, fields,
-                                     fk.F_FLUID_TEMPERATURE, self._part())  # fmt: skip
+            outside = fk.grid_sample(p.position[:n], axes[0], axes[1], axes[2], values,
+                                     fields, fk.F_FLUID_TEMPERATURE, self._part())  # fmt: skip
             self._outside_warning("thermal.fluid.temperature", file, outside, axes, time)
 
     def _velocity(self, time: float, fields: np.ndarray) -> None:
         p = self.sim.particles
+        n = fields.shape[1]  # (the owned particles)
         source = self._sources["velocity"]
         kind = source[0]
         uniform = kind in ("uniform", "table")
@@ -167,17 +176,18 @@ class FluidSources:
             for a in range(3):
                 self.velocity_buffer[a, 0] = np.interp(time, table[:, 0], table[:, 1 + a])
         else:
-            if self.velocity_buffer.shape[1] != p.count:
-                self.velocity_buffer = np.zeros((3, p.count))
+            if self.velocity_buffer.shape[1] != n:
+                self.velocity_buffer = np.zeros((3, n))
             if kind == "expression":
-                pos = p.position
+                pos = p.position[:n]
                 for a in range(3):
                     self.velocity_buffer[a, :] = source[1][a](time, pos[:, 0], pos[:, 1],
                                                               pos[:, 2])  # fmt: skip
                 bad = ~np.isfinite(self.velocity_buffer).all(axis=0)
+                error = None
                 if bad.any():
                     k = int(np.argmax(bad))
-                    raise SimulationError(
+                    error = SimulationError(
                         f"thermal.fluid.velocity: the expressions {list(source[2])} give "
                         f"{self.velocity_buffer[:, k].tolist()} m/s at particle "
                         f"{int(p.global_id[k])} at step {self.sim.step_count} (t = {time:.6g} s)",
@@ -185,12 +195,13 @@ class FluidSources:
                         time,
                         int(p.global_id[k]),
                     )
+                self.sim.agree_failure(error)  # (collective on several MPI ranks)
             else:
                 _, axes, values, file = source
-                outside = fk.grid_sample(p.position, axes[0], axes[1], axes[2], values,
+                outside = fk.grid_sample(p.position[:n], axes[0], axes[1], axes[2], values,
                                          self.velocity_buffer, 0, self._part())  # fmt: skip
                 self._outside_warning("thermal.fluid.velocity", file, outside, axes, time)
-        fk.relative_speed(p.velocity, self.velocity_buffer, uniform, fields)
+        fk.relative_speed(p.velocity[:n], self.velocity_buffer, uniform, fields)
 
     def fluid_velocity(self) -> np.ndarray:
         """u_f at the particles at the last update [m/s], (n, 3) (or (1, 3) if uniform)."""

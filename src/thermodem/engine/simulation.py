@@ -272,6 +272,20 @@ class Simulation(SimulationLedger):
         """``value`` summed over the MPI ranks (itself here)."""
         return value
 
+    #: whether this process says the run's warnings (on several MPI ranks: rank 0 only)
+    says_warnings = True
+
+    def agree_message(self, message: str | None) -> str | None:
+        """The warning of the whole simulation: ``message`` here (on several MPI ranks the
+        message of the lowest rank that has one, on every rank; collective)."""
+        return message
+
+    def agree_failure(self, error: SimulationError | None) -> None:
+        """Raise ``error`` (on several MPI ranks every rank raises the lowest failing rank's
+        error, the same message everywhere; collective)."""
+        if error is not None:
+            raise error
+
     def grid_box(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(lower, upper, periodic) of the region the neighbour grids cover: the domain (on
         several MPI ranks, this rank's box with its halo)."""

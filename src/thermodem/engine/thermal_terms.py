@@ -113,7 +113,7 @@ class TermEvaluation:
             return
         sim = self.sim
         if self.field_provider.active:
-            n = sim.particles.count
+            n = sim.owned_count  # (on several MPI ranks the ghosts take no per-particle term)
             if self.fields.shape != (field_kernels.NFIELDS, n):
                 self.fields = np.zeros((field_kernels.NFIELDS, n))
             self.field_provider.update(time, self.fields)
@@ -214,11 +214,14 @@ class TermEvaluation:
         )  # fmt: skip
 
     def _particle_term(self, term: HeatTerm, second: HeatTerm | None = None) -> None:
-        """A per-particle term, and the next one in the same pass if given."""
+        """A per-particle term, and the next one in the same pass if given, on the particles
+        this process owns (all; on several MPI ranks not the ghosts, whose heat their owners
+        compute: the pass loops over the length of the temperatures it is given)."""
         p = self.sim.particles
+        n = self.sim.owned_count
         other = second or term
         passes.particle_pass(
-            p.temperature, p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
+            p.temperature[:n], p.radius, p.type_id, self.fields, term.evaluator, term.model_id,
             term.table, term.column, other.evaluator, other.model_id, other.table,
             -1 if second is None else second.column, p.heat_columns,
             self.conductance_sum,

@@ -81,6 +81,7 @@ class DistributedSimulation(Simulation):
         self.comm = comm if comm is not None else MPI.COMM_WORLD
         self.rank = self.comm.Get_rank()
         self.size = self.comm.Get_size()
+        self.says_warnings = self.rank == 0
         self.rebalance_threshold = float(rebalance_threshold)
         #: hand each box to the next rank at every rebuild, so that every particle migrates
         #: with its state and pair histories (a test of the migration; results do not change)
@@ -123,7 +124,11 @@ class DistributedSimulation(Simulation):
         return self.particles.count - self.owned_count
 
     def sum_over_ranks(self, value: float) -> float:
-        return float(X.allreduce_sum(self.comm, np.array([float(value)]))[0])
+        """Collective. Before the first rebuild distributes them (a restart's rates computed
+        on the whole restored set, mpi/gather.py: load_distributed) every rank holds every
+        particle: its own sum is the whole simulation's."""
+        total = float(X.allreduce_sum(self.comm, np.array([float(value)]))[0])
+        return total if self._distributed else float(value)
 
     def grid_box(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self._grid if self._grid is not None else (self.lower, self.upper, self.periodic)
@@ -157,6 +162,21 @@ class DistributedSimulation(Simulation):
             message, step, time, particle = self.comm.bcast(payload, root=source)
             raise SimulationError(message, step, time, particle)
         return out[1:]
+
+    def agree_failure(self, error: SimulationError | None) -> None:
+        self.agree(error)
+
+    def agree_message(self, message: str | None) -> str | None:
+        """The message of the lowest rank that has one, on every rank (one reduction, and a
+        broadcast when some rank has one); the caller says it on rank 0 only
+        (``says_warnings``), so a warning of the whole simulation is said once."""
+        out = X.allreduce_min(
+            self.comm, np.array([self.rank if message is not None else self.size], np.int64)
+        )
+        source = int(out[0])
+        if source >= self.size:
+            return None
+        return self.comm.bcast(message if self.rank == source else None, root=source)
 
     def agree_thermal(
         self, limit: float, limit_particle: int, bad_particle: int, bad_temperature: float

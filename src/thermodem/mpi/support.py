@@ -5,7 +5,9 @@ every kind, moving walls, periodic axes), static insertion, the thermal engine w
 Euler, the contact conduction of the fused contact pass (every contact radius and direct
 conduction model, the conductance reuse, k(T) and c(T) tables), the range pair set (gap
 conduction of Batchelor & O'Brien complete / modified, indirect conduction through the
-fluid), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
+fluid), the per-particle terms that need no neighbours (convection with a fluid given as
+uniform / table / expression / grid and a global porosity, radiation ``surroundings`` with
+its walls), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
 sources, checkpoints, frames and time series.
 
 Refused, each with a message naming the case key (never a silently wrong result):
@@ -21,6 +23,15 @@ if TYPE_CHECKING:
     from thermodem.config.schema import Case
     from thermodem.engine.thermal import ThermalEngine
 
+#: porosity kinds computed from the neighbours of each particle, and what they count
+NEIGHBOUR_POROSITY = {
+    "cell": "the porosity of each cell from the particles in it",
+    "shell": "the porosity of a shell around each particle from its neighbours",
+    "voronoi": "the porosity of each particle's Voronoi cell (a global tessellation)",
+}
+#: radiation models that sum over each particle's neighbourhood
+NEIGHBOUR_RADIATION = ("zhou2009", "krause2017")
+
 #: (case key, why) of every refused feature, in the order they are checked (docs/mpi.md).
 REFUSED: tuple[tuple[str, str], ...] = (
     ("simulation.dimension: 2", "two-dimensional discs"),
@@ -30,10 +41,8 @@ REFUSED: tuple[tuple[str, str], ...] = (
     ("thermal.frozen_mechanics", "frozen mechanics"),
     ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
     ("thermal.external_source", "external sources shared by the particles of a box"),
-    ("thermal.convection", "per-particle terms (convection)"),
-    ("thermal.radiation", "per-particle terms (radiation)"),
-    ("thermal.porosity", "per-particle porosity fields"),
-    ("thermal.fluid", "fluid fields"),
+    ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
+    ("thermal.radiation", "radiation from the neighbourhood (zhou2009, krause2017)"),
     ("thermal.indirect_conduction", "Voronoi (external pair set) and contact-target models"),
     ("thermal.heat_generation", "heat generation from the mechanical dissipation"),
 )
@@ -69,10 +78,21 @@ def check_case(case: Case) -> None:
         raise _refuse(f"thermal.scheme = {th.scheme!r}", "the implicit heat schemes")
     if th.external_source:
         raise _refuse("thermal.external_source", "external sources shared over a box")
-    for key in ("convection", "radiation"):
-        choice = getattr(th, key)
-        if choice is not None and getattr(choice, "model", "none") != "none":
-            raise _refuse(f"thermal.{key} = {choice.model!r}", "per-particle heat terms")
+    porosity = th.porosity
+    if porosity is not None and porosity.kind in NEIGHBOUR_POROSITY:
+        raise _refuse(
+            f"thermal.porosity.kind = {porosity.kind!r}",
+            f"{NEIGHBOUR_POROSITY[porosity.kind]} (the neighbours of particles on other "
+            "ranks; porosity: {kind: global, value: ...} runs under MPI)",
+        )
+    radiation = th.radiation
+    if radiation is not None and radiation.model in NEIGHBOUR_RADIATION:
+        raise _refuse(
+            f"thermal.radiation = {radiation.model!r}",
+            "radiation from the particles of each one's neighbourhood (the neighbours of "
+            "particles on other ranks; radiation 'surroundings', with its walls, runs under "
+            "MPI)",
+        )
     ic = th.indirect_conduction
     if ic is not None and ic.model != "none" and ic.spec.target != "range":
         what = {
@@ -87,17 +107,13 @@ def check_case(case: Case) -> None:
             "heat generation (its per-particle accumulators and wall shares are not split by "
             "rank yet)",
         )
-    if th.porosity is not None:
-        raise _refuse("thermal.porosity", "per-particle porosity fields")
-    if th.fluid is not None:
-        raise _refuse("thermal.fluid", "fluid fields")
 
 
 def check_thermal(engine: ThermalEngine) -> None:
     """ConfigError for a heat term whose pair set MPI does not handle yet (the terms are
     known once the thermal engine has built them from the registry)."""
     for term in engine.terms:
-        if term.target == "range":
+        if term.target in ("range", "particles"):  # (neighbourhood models: check_case)
             continue
         what = {
             "external": "a Voronoi model (external pair set)",
