@@ -4,7 +4,7 @@ the contact pass), every 3rd step, ``substeps: auto``, the range set (rong_horio
 fixed-temperature particles, a heat flux and a volumetric source, and three restarts whose
 first thermal step is not fused with a contact pass; the per-particle terms (convection with
 a uniform / expression / grid / table fluid and a global porosity, radiation to the
-surroundings and the walls in view), with a serial checkpoint continued
+surroundings and the walls in view) and external sources, with a serial checkpoint continued
 on 2 ranks and a 2-rank checkpoint continued serially. The convection's validity-range
 warnings are said once (by rank 0), and the quantities warned travel in checkpoints.
 
@@ -81,6 +81,19 @@ GRID = {
         "velocity": [[0.0, 0, 0, 0.3], [1e-3, 0, 0, 1.5]],
     },
 }
+EXTERNAL = {
+    "external_source": [
+        {
+            "power": 2.0,
+            "region": {"lower": [0, 0, 3e-3], "upper": [W, W, 9e-3]},
+            "profile": "gaussian",
+            "sigma": 2e-3,
+            "axis": [0, 0, 1],
+        },
+        {"power": 0.5, "region": {"lower": [0, 0, 0], "upper": [W, W, H]}},
+    ]
+}
+
 #: name -> (thermal section, thermal section of the run that wrote the checkpoint at step 70
 #: or "fresh" for a run from t = 0, time step after the restart)
 CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
@@ -93,10 +106,11 @@ CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
     "substeps_auto_restart_half_time_step": ({"substeps": "auto"}, {"substeps": "auto"}, DT / 2),
     "range_heat_starts_at_restart": (
         {**RANGE, "direct_conduction": "none", "substeps": 2}, None, DT),
-    # per-particle terms
+    # per-particle terms and external sources
     "convection_radiation_walls": (CONVECTION, "fresh", DT),
     "gunn_expression_global_porosity": ({**GUNN, "substeps": 2}, "fresh", DT),
     "whitaker_grid_table": (GRID, "fresh", DT),
+    "external_source": (EXTERNAL, "fresh", DT),
     "convection_restart_half_time_step": (
         {**CONVECTION, "substeps": 3}, {**CONVECTION, "substeps": 3}, DT / 2),
 }  # fmt: skip

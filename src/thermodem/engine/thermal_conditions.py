@@ -247,7 +247,10 @@ class ThermalConditions:
         if self.source is self.base_source or self.source.shape[0] != n:
             self.source = np.empty(n)
         self.source[:] = self.base_source
-        rows = n // CHUNK + 1
+        # the weights of the particles this process owns, summed over the MPI ranks (the
+        # ghosts take no share here: their owners give them theirs)
+        self._weight[own:] = 0.0
+        rows = own // CHUNK + 1
         if self._part.shape[0] < rows:
             self._part = np.zeros(rows)
         for e in active:
@@ -258,9 +261,10 @@ class ThermalConditions:
                 centre[2] = 0.0  # (the plane of the discs)
             gaussian = e.profile == "gaussian"
             total = external_weights(
-                p.position, p.radius, lower, upper, gaussian, centre, axis,
-                float(e.sigma or 1.0), self._weight, self._part,
+                p.position[:own], p.radius[:own], lower, upper, gaussian, centre, axis,
+                float(e.sigma or 1.0), self._weight[:own], self._part,
             )  # fmt: skip
+            total = self.sim.sum_over_ranks(total)  # (collective on several MPI ranks)
             if total > 0.0:
                 add_weighted(self.source, self._weight, e.power / total)
         return self.fixed, self.source, reset

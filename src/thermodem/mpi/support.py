@@ -8,7 +8,7 @@ conduction of Batchelor & O'Brien complete / modified, indirect conduction throu
 fluid), the per-particle terms that need no neighbours (convection with a fluid given as
 uniform / table / expression / grid and a global porosity, radiation ``surroundings`` with
 its walls), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
-sources, checkpoints, frames and time series.
+sources, external sources, checkpoints, frames and time series.
 
 Refused, each with a message naming the case key (never a silently wrong result):
 """
@@ -40,7 +40,6 @@ REFUSED: tuple[tuple[str, str], ...] = (
     ("output.contacts", "contact frames"),
     ("thermal.frozen_mechanics", "frozen mechanics"),
     ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
-    ("thermal.external_source", "external sources shared by the particles of a box"),
     ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
     ("thermal.radiation", "radiation from the neighbourhood (zhou2009, krause2017)"),
     ("thermal.indirect_conduction", "Voronoi (external pair set) and contact-target models"),
@@ -76,8 +75,6 @@ def check_case(case: Case) -> None:
         raise _refuse("thermal.frozen_mechanics", "frozen mechanics (heat only)")
     if th.scheme != "explicit":
         raise _refuse(f"thermal.scheme = {th.scheme!r}", "the implicit heat schemes")
-    if th.external_source:
-        raise _refuse("thermal.external_source", "external sources shared over a box")
     porosity = th.porosity
     if porosity is not None and porosity.kind in NEIGHBOUR_POROSITY:
         raise _refuse(
