@@ -41,7 +41,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 
 from mpi_cases import column_case  # noqa: E402
-from test_mpi import BIN, MPIEXEC, _env, needs_mpi  # noqa: E402
+from test_mpi import BIN, MPIEXEC, _env, _run, _write_case, needs_mpi  # noqa: E402
 
 DT = 5e-6
 RANGE = {"indirect_conduction": "rong_horio1999", "gas": {"thermal_conductivity": 0.026}}
@@ -285,3 +285,18 @@ def test_heat_on_2_ranks_matches_serial(runs: dict[str, Any], name: str) -> None
         rel = np.abs(serial["continued"] / temperature - 1.0).max()
         assert rel <= 1e-12, f"continued serially: temperatures differ by {rel:.3g} relative"
         assert _agreed(serial["continued_said"]) == []  # (warned before the checkpoint)
+
+
+@needs_mpi
+def test_build_warnings_said_once_by_mpiexec(tmp_path: Path) -> None:
+    """``mpiexec -n 2 thermodem run``: the convection's validity-range warning of the first
+    evaluation (while the ranks build the simulation) is said once, on stdout and in
+    run.log as in a serial run; before, every rank that met it printed it to stderr, and
+    never to run.log."""
+    case = _case(CONVECTION, steps=20)
+    path = _write_case(tmp_path / "c.yaml", case)
+    res = _run(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"], 2, timeout=180)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.count("Re = 0.255") == 1, res.stdout
+    assert "Re = " not in res.stderr, res.stderr
+    assert (tmp_path / "o" / "run.log").read_text().count("Re = 0.255") == 1

@@ -434,7 +434,8 @@ def run_distributed(
             _agreed(comm, error)
             _together(comm, starting)
             try:
-                sim = _build(case, threads, rebalance_threshold, ckpt)
+                with _build_warnings(runlog):
+                    sim = _build(case, threads, rebalance_threshold, ckpt)
                 # the checks of the serial runner before the first step (engine/runner.py:
                 # run_case, run_from_checkpoint), collective: a refusal on one rank is every
                 # rank's
@@ -583,7 +584,8 @@ def restart_distributed(
             case = ckpt.case()
             if end_time is not None:
                 case.simulation.end_time = float(end_time)
-            sim = _build(case, threads, rebalance_threshold, ckpt)
+            with R.recorded_warnings() as built:  # (said by rank 0 once run.log is open)
+                sim = _build(case, threads, rebalance_threshold, ckpt)
             _together(comm, starting)  # (nothing written yet)
             run = None
             error = None
@@ -600,6 +602,7 @@ def restart_distributed(
                         f"restart from {ckpt.path} (step {ckpt.step}, t = {ckpt.time:.6g} s) "
                         f"to end time {case.simulation.end_time:g} s on {sim.size} MPI ranks"
                     )
+                    R.say_warnings(runlog, built)
                     if series_repair is not None:
                         runlog.warn(series_repair())
                     run = R._make_run(sim, output, runlog, status, True, progress,
@@ -646,6 +649,14 @@ def restart_distributed(
         return _drive(sim, out, pending=starting.signum)
     finally:
         _close(runlog, lock)
+
+
+def _build_warnings(runlog: Any) -> Any:
+    """Warnings while the ranks build the simulation: rank 0's go to the console and run.log
+    as in a serial run (engine/runner.py: logged_warnings), the other ranks' are dropped:
+    every rank builds the same case, and what concerns the particles of every rank (the
+    convection's validity ranges) is agreed and said by rank 0 (Simulation.agree_message)."""
+    return R.logged_warnings(runlog) if runlog is not None else R.recorded_warnings()
 
 
 def _time_step_check(sim: DistributedSimulation) -> list[str]:
