@@ -137,6 +137,63 @@ def test_bob_modified_series_network_by_hand():
         assert q == pytest.approx(10.0 / (1 / h_i + 1 / h_bob_w), rel=1e-12)
 
 
+def test_bob_conductivity_mean_arithmetic_by_hand():
+    """Two materials (k 2 and 6): conductivity_mean arithmetic takes k_p = (2 + 6)/2 = 4 in
+    every k_p of complete and modified (η, ln k_pf², the Dai correlation, the separated λ),
+    harmonic (the default) 2·2·6/8 = 3; the inner resistances keep each particle's own k."""
+    k_f, r_i, r_j, r_c = 0.05, 1e-3, 2e-3, 1e-4
+    r_eff = r_i * r_j / (r_i + r_j)
+
+    def h_contact(k_p, r_eff=r_eff):
+        eta = k_p / k_f * r_c / (2 * r_eff)
+        assert 1.0 < eta < 100.0
+        w = (eta - 1) / 99
+        h_t = (1 - w) * 0.17 * eta**2 + w * (2 * eta / PI - 2 * math.log(eta))
+        return 2 * PI * r_eff * k_f * (h_t + math.log((k_p / k_f) ** 2))
+
+    for mean, k_p in [("harmonic", 3.0), ("arithmetic", 4.0)]:
+        p = row("batchelor_obrien_complete", k_f=k_f, conductivity_mean=mean)
+        q = rate("batchelor_obrien_complete", p, 300.0, 310.0, r_i, r_j, 1e-6, r_c)
+        assert q == pytest.approx(10.0 * h_contact(k_p), rel=1e-12)
+        # separated (gap 1e-5 m < R*): near form ln k_pf² (λ = k_pf² d_s/(2R*) > 0.01, and
+        # the minimum of both forms between)
+        gap = 1e-5
+        lam = (k_p / k_f) ** 2 * gap / (2 * r_eff)
+        near = math.log((k_p / k_f) ** 2)
+        far = math.log(1 + (2.0 * r_eff) ** 2 / (2 * r_eff * gap))
+        x = near if lam < 0.01 else far if lam > 100 else min(near, far)
+        q = rate("batchelor_obrien_complete", p, 300.0, 310.0, r_i, r_j, -gap, 0.0)
+        assert q == pytest.approx(10.0 * 2 * PI * r_eff * k_f * x, rel=1e-12)
+        for option, r_bar in [
+            (2.0, 2.0 * r_eff),
+            ("dai2019_correlation", 1.3121 * (k_p / k_f) ** -0.19 * r_i),
+        ]:
+            p = row(
+                "batchelor_obrien_modified", k_f=k_f, cylinder_radius=option, conductivity_mean=mean
+            )
+            h_i, h_j = 2.0 * PI * r_bar**2 / r_i, 6.0 * PI * r_bar**2 / r_j
+            expected = 10.0 / (1 / h_i + 1 / h_j + 1 / h_contact(k_p))
+            q = rate("batchelor_obrien_modified", p, 300.0, 310.0, r_i, r_j, 1e-6, r_c)
+            assert q == pytest.approx(expected, rel=1e-12)
+        # a wall of material B: k_p of the particle's and the wall's k, R* = R_i
+        p = row("batchelor_obrien_complete", is_wall=True, k_f=k_f, conductivity_mean=mean)
+        q = rate("batchelor_obrien_complete", p, 300.0, 310.0, r_i, INF, 1e-6, r_c)
+        assert q == pytest.approx(10.0 * h_contact(k_p, r_i), rel=1e-12)
+    # one material: the two means are the same number
+    same = [
+        row("batchelor_obrien_complete", MAT_B, MAT_B, k_f=k_f, conductivity_mean=m)
+        for m in ("harmonic", "arithmetic")
+    ]
+    q = [rate("batchelor_obrien_complete", p, 300.0, 310.0, r_i, r_j, 1e-6, r_c) for p in same]
+    assert q[0] == q[1]
+    # k_pf > 1 is checked with the chosen mean: k 2 and 6 in a gas of 3.5 (harmonic 3 < 3.5)
+    with pytest.raises(ValueError, match="k_p/k_f > 1"):
+        row("batchelor_obrien_complete", k_f=3.5)
+    row("batchelor_obrien_complete", k_f=3.5, conductivity_mean="arithmetic")
+    with pytest.raises(ValueError):
+        row("batchelor_obrien_complete", conductivity_mean="geometric")
+
+
 SEP_KF = 0.1  # k_p = 1000 (K_HIGH), k_pf = 1e4, k_pf² = 1e8; R* = 0.5 mm: λ = 1e11 d_s
 
 

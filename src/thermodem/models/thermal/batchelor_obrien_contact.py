@@ -48,10 +48,19 @@ BATCHELOR_OBRIEN_COMPLETE = 2
 BATCHELOR_OBRIEN_MODIFIED = 3
 
 #: Batchelor & O'Brien complete (and modified: one column more).
-BOB_COLUMNS = (*HEAD, "k_f", "blend", "cylinder_ratio", "cutoff_gap_ratio", "regime")
+BOB_COLUMNS = (
+    *HEAD, "k_f", "blend", "cylinder_ratio", "cutoff_gap_ratio", "regime", "conductivity_mean"
+)  # fmt: skip
 BOB_K_F, BOB_BLEND, BOB_CYLINDER_RATIO, BOB_CUTOFF_RATIO, BOB_REGIME = 4, 5, 6, 7, 8
+BOB_MEAN = 9
 BOB_MODIFIED_COLUMNS = (*BOB_COLUMNS, "dai2019_correlation")
-BOB_DAI2019 = 9
+BOB_DAI2019 = 10
+
+#: k_p of two materials: the harmonic mean 2 k_i k_j/(k_i + k_j) (the default) or the
+#: arithmetic (k_i + k_j)/2 (Kratos ThermalDEM's reading); a runtime column, one kernel.
+MEAN_HARMONIC = 0
+MEAN_ARITHMETIC = 1
+_MEANS = {"harmonic": MEAN_HARMONIC, "arithmetic": MEAN_ARITHMETIC}
 
 BLEND_SPEC_LINEAR = 0
 BLEND_HERMITE = 1
@@ -126,6 +135,15 @@ def bob_conductance(k_p, k_f, r_eff, r_c, overlap, blend, r_cyl, cutoff_gap, reg
     return gap_conductance(k_p, k_f, r_eff, gap, r_cyl / r_eff, regime)
 
 
+@njit(cache=True, error_model="numpy")
+def particle_conductivity(k_i, k_j, mean):
+    """k_p of the pair: harmonic 2 k_i k_j/(k_i + k_j) (mean 0) or arithmetic (k_i + k_j)/2
+    (mean 1); equal for equal conductivities."""
+    if mean == MEAN_ARITHMETIC:
+        return 0.5 * (k_i + k_j)
+    return 2.0 * k_i * k_j / (k_i + k_j)
+
+
 class BatchelorOBrienCompleteParams(StrictModel):
     """Batchelor & O'Brien (1977) Proc. R. Soc. Lond. A 355, 313-333: contact through the
     contact circle and the surrounding fluid, and near (separated) particles (spec 2.3).
@@ -133,13 +151,14 @@ class BatchelorOBrienCompleteParams(StrictModel):
     Total conduction (direct + through the fluid near the contact): do not combine it with an
     indirect_conduction model. k_f is the conductivity of the case's gas (``thermal.gas``,
     ``pair.gas``). k_p = 2 k_i k_j/(k_i + k_j) (harmonic mean, so that the large-η limit is
-    batchelor_obrien_simple), k_pf = k_p/k_f must exceed 1. The 1 <= η <= 100 blend
+    batchelor_obrien_simple; ``conductivity_mean="arithmetic"``: (k_i + k_j)/2, Kratos
+    ThermalDEM's reading), k_pf = k_p/k_f must exceed 1. The 1 <= η <= 100 blend
     of the spec is not monotonic (see bob_contact_h); ``blend="hermite"`` is a monotonic one.
     Separated pairs conduct up to a gap ``cutoff_gap_ratio`` R* (Yun & Evans 2010: d_s < R̄),
     through a cylinder of radius ``cylinder_radius`` R* (a number, or a named choice of the
     spec: dai2019 = 2.00, Dai et al. 2019; for equal spheres R* = R/2, so 2.00 is a cylinder of
     the particle radius), with the λ rule ``regime`` (as batchelor_obrien_separated).
-    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime].
+    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime, 0 harmonic | 1 arithmetic].
     """
 
     blend: Literal[tuple(_BLENDS)] = Field(
@@ -153,6 +172,11 @@ class BatchelorOBrienCompleteParams(StrictModel):
         allow_inf_nan=False,
         description="largest conducting gap d_s / R* [-] of separated pairs",
     )
+    conductivity_mean: Literal[tuple(_MEANS)] = Field(
+        default="harmonic",
+        description="k_p of two materials: harmonic 2 k_i k_j/(k_i + k_j) (the large-η limit "
+        "is batchelor_obrien_simple) or arithmetic (k_i + k_j)/2 (Kratos ThermalDEM)",
+    )
 
     @field_validator("cylinder_radius")
     @classmethod
@@ -160,8 +184,8 @@ class BatchelorOBrienCompleteParams(StrictModel):
         return check_cylinder(v)
 
 
-def _check_kpf(k_i: float, k_j: float, k_f: float, model: str) -> None:
-    k_p = 2.0 * k_i * k_j / (k_i + k_j)
+def _check_kpf(k_i: float, k_j: float, k_f: float, model: str, mean: str) -> None:
+    k_p = 0.5 * (k_i + k_j) if mean == "arithmetic" else 2.0 * k_i * k_j / (k_i + k_j)
     if k_p <= k_f:
         raise ValueError(
             f"{model} needs particle conductivity above the gas's (k_p/k_f > 1): "
@@ -173,11 +197,13 @@ def pack_bob_complete(params: BatchelorOBrienCompleteParams, pair: PairContext) 
     model = "direct_conduction.batchelor_obrien_complete"
     k_i, k_j = conductivities(pair, model)
     k_f = pair.gas.thermal_conductivity
-    _check_kpf(k_i, k_j, k_f, model)
+    _check_kpf(k_i, k_j, k_f, model, params.conductivity_mean)
+    mean = _MEANS[params.conductivity_mean]
     values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
                                         "cylinder_ratio": cylinder_ratio(params.cylinder_radius),
                                         "cutoff_gap_ratio": params.cutoff_gap_ratio,
-                                        "regime": REGIMES[params.regime]}  # fmt: skip
+                                        "regime": REGIMES[params.regime],
+                                        "conductivity_mean": mean}  # fmt: skip
     return packed(BOB_COLUMNS, values)
 
 
@@ -190,7 +216,7 @@ def bob_interaction_range(params: StrictModel, radius_i: float, radius_j: float)
 @njit(cache=True, error_model="numpy")
 def bob_complete_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     r_eff = effective_radius(r_i, r_j)
-    k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
+    k_p = particle_conductivity(p[K_I], p[K_J], p[BOB_MEAN])
     r_cyl = p[BOB_CYLINDER_RATIO] * r_eff
     cutoff = p[BOB_CUTOFF_RATIO] * r_eff
     h = bob_conductance(
@@ -209,7 +235,7 @@ class BatchelorOBrienModifiedParams(BatchelorOBrienCompleteParams):
     r̄/R*, a named choice of the spec (as complete), or ``"dai2019_correlation"``: r̄ = 1.3121
     k_pf^-0.19 min(R_i, R_j) (Dai, Hanaor & Gan 2019, Int. J. Therm. Sci. 142, 266-279; fitted
     for k_pf < 1e3). A wall is isothermal: 1/H_j is dropped.
-    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime, 1 if dai2019_correlation].
+    Row: [k_i, k_j, 0, 0, k_f, blend, r̄/R*, d_s,max/R*, regime, mean, 1 if dai2019_correlation].
     """
 
     cylinder_radius: float | CylinderName | Literal["dai2019_correlation"] = Field(
@@ -228,13 +254,14 @@ def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) 
     model = "direct_conduction.batchelor_obrien_modified"
     k_i, k_j = conductivities(pair, model)
     k_f = pair.gas.thermal_conductivity
-    _check_kpf(k_i, k_j, k_f, model)
+    _check_kpf(k_i, k_j, k_f, model, params.conductivity_mean)
     dai = params.cylinder_radius == "dai2019_correlation"
     ratio = 0.0 if dai else cylinder_ratio(params.cylinder_radius)
     values = head_values([k_i, k_j]) | {"k_f": k_f, "blend": _BLENDS[params.blend],
                                         "cylinder_ratio": ratio,
                                         "cutoff_gap_ratio": params.cutoff_gap_ratio,
                                         "regime": REGIMES[params.regime],
+                                        "conductivity_mean": _MEANS[params.conductivity_mean],
                                         "dai2019_correlation": 1.0 if dai else 0.0}  # fmt: skip
     return packed(BOB_MODIFIED_COLUMNS, values)
 
@@ -242,7 +269,7 @@ def pack_bob_modified(params: BatchelorOBrienModifiedParams, pair: PairContext) 
 @njit(cache=True, error_model="numpy")
 def bob_modified_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_impact, m_eff):
     r_eff = effective_radius(r_i, r_j)
-    k_p = 2.0 * p[K_I] * p[K_J] / (p[K_I] + p[K_J])
+    k_p = particle_conductivity(p[K_I], p[K_J], p[BOB_MEAN])
     k_f = p[BOB_K_F]
     if p[BOB_DAI2019] == 1.0:
         r_cyl = 1.3121 * (k_p / k_f) ** -0.19 * min(r_i, r_j)
