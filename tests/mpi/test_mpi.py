@@ -219,6 +219,21 @@ def test_refused_under_mpi(change, key: str) -> None:  # noqa: ANN001
         assert "radiation 'surroundings', with its walls, runs under MPI" in str(info.value)
 
 
+@pytest.mark.parametrize(
+    "model", ["mechanical_dissipation", "rojek2014", "richard2008", "al_arkawazi2017"]
+)
+def test_heat_generation_runs_under_mpi(model: str) -> None:
+    """Heat generation is no longer refused (every model: the deposits of the contact passes,
+    docs/mpi.md; tests/mpi/test_mpi_thermal_paths.py compares it with the serial run)."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.mpi.support import REFUSED, check_case
+
+    case = bed_case(DATA / "mpi_bed_box.txt")
+    case["thermal"]["heat_generation"] = {"model": model}
+    check_case(case_from_dict(case))
+    assert not any("heat_generation" in key for key, _ in REFUSED)
+
+
 def test_two_dimensional_case_refused_under_mpi() -> None:
     """A disc simulation (simulation.dimension: 2) is refused under MPI, naming the key."""
     from thermodem.config.load import load_case

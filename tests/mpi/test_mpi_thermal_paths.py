@@ -5,8 +5,10 @@ fixed-temperature particles, a heat flux and a volumetric source, and three rest
 first thermal step is not fused with a contact pass; the per-particle terms (convection with
 a uniform / expression / grid / table fluid and a global porosity, radiation to the
 surroundings and the walls in view) and external sources, with a serial checkpoint continued
-on 2 ranks and a 2-rank checkpoint continued serially. The convection's validity-range
-warnings are said once (by rank 0), and the quantities warned travel in checkpoints.
+on 2 ranks and a 2-rank checkpoint continued serially; heat generation (mechanical_dissipation,
+al_arkawazi2017) with the spheres moving across the ranks' cut, its ledger and balances. The
+convection's validity-range warnings are said once (by rank 0), and the quantities warned
+travel in checkpoints.
 
 Before the fix (mpi/gather.py: load_distributed) the restarts went wrong on 2 ranks:
 
@@ -94,6 +96,12 @@ EXTERNAL = {
     ]
 }
 
+#: heat generation (every mechanism of mechanical_dissipation; al_arkawazi2017's kinetic energy
+#: lost in collisions): the spheres of these cases start moving (_case: MOVING), so that they
+#: slide, roll and collide across the ranks' cut
+DISSIPATION = {"heat_generation": {"model": "mechanical_dissipation", "partition": "conductivity"}}
+COLLISION = {"heat_generation": {"model": "al_arkawazi2017"}}
+
 #: name -> (thermal section, thermal section of the run that wrote the checkpoint at step 70
 #: or "fresh" for a run from t = 0, time step after the restart)
 CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
@@ -113,9 +121,14 @@ CONFIGURATIONS: dict[str, tuple[dict[str, Any], Any, float]] = {
     "external_source": (EXTERNAL, "fresh", DT),
     "convection_restart_half_time_step": (
         {**CONVECTION, "substeps": 3}, {**CONVECTION, "substeps": 3}, DT / 2),
+    # heat generation: each rank keeps its own particles' deposits of the pairs across the cut
+    "generation_dissipation": ({**DISSIPATION, "substeps": 2}, "fresh", DT),
+    "generation_collision": ({**COLLISION, "substeps": 3}, "fresh", DT),
+    "generation_restart_half_time_step": (DISSIPATION, DISSIPATION, DT / 2),
 }  # fmt: skip
 #: configurations whose 2-rank run also writes a checkpoint at step 70, continued serially
-CONTINUED_SERIALLY = ("gunn_expression_global_porosity", "whitaker_grid_table")
+CONTINUED_SERIALLY = ("gunn_expression_global_porosity", "whitaker_grid_table",
+                      "generation_dissipation", "generation_collision")  # fmt: skip
 
 SCRIPT = """
 import json, sys, warnings
@@ -195,7 +208,29 @@ def _case(thermal: dict[str, Any] | None, **kw: Any) -> dict[str, Any]:
     case = column_case(thermal, **kw)
     if thermal is not None and "radiation" in thermal:
         case["materials"]["glass"]["emissivity"] = 0.9
+    if thermal is not None and "heat_generation" in thermal:
+        case["insertion"] = [MOVING]
     return case
+
+
+def _moving() -> dict[str, Any]:
+    """The column's lattice (the same order: layer by layer from the floor), each sphere with
+    a velocity of ~0.2 m/s, mostly sideways: neighbours slide and roll on each other (across
+    the ranks' cut between layers 3 and 4 too), hit each other and the walls."""
+    k = np.arange(54)
+    x, y, z = (1e-3 + 2e-3 * a for a in (k % 3, (k // 3) % 3, k // 9))
+    velocity = 0.2 * np.stack([np.sin(2.3 * k), np.cos(1.3 * k), 0.5 * np.sin(0.7 * k)], 1)
+    return {
+        "kind": "list",
+        "material": "glass",
+        "radius": 1e-3,
+        "overlap_check": False,
+        "positions": np.stack([x, y, z], 1).tolist(),
+        "velocities": velocity.tolist(),
+    }
+
+
+MOVING = _moving()
 
 
 def _serial(job: dict[str, Any]) -> dict[str, Any]:
@@ -274,6 +309,8 @@ def test_heat_on_2_ranks_matches_serial(runs: dict[str, Any], name: str) -> None
         diff = abs(parallel[key] - report[key])
         assert diff <= 1e-9 * scale or diff == 0.0, f"{key}: {parallel[key]!r} / {report[key]!r}"
     assert abs(parallel["heat_balance_error"]) <= 1e-12 * parallel["thermal_energy"]
+    if name.startswith("generation"):
+        _check_generation(name, report, parallel)
     # validity-range warnings: said once (rank 0), the same quantities warned on every rank
     ranks = [json.loads(Path(f"{job['out']}.rank{r}.json").read_text()) for r in (0, 1)]
     assert len(_agreed(ranks[0]["said"])) == len(_agreed(serial["said"]))
@@ -285,6 +322,30 @@ def test_heat_on_2_ranks_matches_serial(runs: dict[str, Any], name: str) -> None
         rel = np.abs(serial["continued"] / temperature - 1.0).max()
         assert rel <= 1e-12, f"continued serially: temperatures differ by {rel:.3g} relative"
         assert _agreed(serial["continued_said"]) == []  # (warned before the checkpoint)
+
+
+def _check_generation(name: str, report: dict[str, float], parallel: dict[str, float]) -> None:
+    """The heat generation ledger of the 2-rank run against the serial run's (the heat
+    columns are compared with the other heat columns): what the mechanics dissipated and its
+    heat, the collision energy lost, the balances."""
+    keys = [k for k in report if k.startswith(("generated_", "dissipated_"))
+            or k in ("collision_energy_loss", "stiffness_work", "wall_work")]  # fmt: skip
+    assert keys == [k for k in parallel if k in keys]
+    generated = sum(report[k] for k in report if k.startswith("generated_"))
+    into = sum(report[k] for k in report if k.startswith("heat_in_generation_"))
+    assert into > 1e-6, f"{name}: no heat generated ({into:.3g} J)"
+    if name == "generation_dissipation":  # (every mechanism but the plastic one)
+        for g in ("sliding_friction", "rolling_friction", "normal_damping", "tangential_damping"):
+            assert report[f"heat_in_generation_{g}"] > 1e-8 * into, g
+    for key in keys:
+        diff = abs(parallel[key] - report[key])
+        assert diff <= 1e-9 * abs(report[key]) or diff == 0.0, f"{key}: {parallel[key]!r}"
+    for rep in (report, parallel):
+        assert abs(rep["generation_balance_error"]) <= 1e-12 * generated
+    # the mechanical balance (its first-order error: the same on 2 ranks as serially)
+    scale = sum(report[k] for k in report if k.startswith("dissipated_"))
+    diff = abs(parallel["energy_balance_error"] - report["energy_balance_error"])
+    assert diff <= 1e-9 * scale, (parallel["energy_balance_error"], report["energy_balance_error"])
 
 
 @needs_mpi

@@ -11,7 +11,7 @@ particles, to the walls and what waits for the next thermal step; they close to 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from thermodem.kernels import generation as kernels
 from thermodem.state import heat
@@ -46,10 +46,31 @@ def ledger(engine: ThermalEngine) -> dict[str, float]:
     particles (``heat_in_generation_<g>``, the heat ledger) they close:
     ``generation_balance_error`` = Σ_g generated - in - walls - pending, round-off."""
     sim = engine.sim
+    # (the particles this process owns: all of them; on several MPI ranks the owned ones,
+    # mpi/gather.py sums ledger_of over the ranks)
+    pending = sim.particles.generation_energy[: sim.owned_count].sum(axis=0)
+    return ledger_of(engine, sim.ledger_cumulative, pending, engine.cumulative)
+
+
+def ledger_keys(engine: ThermalEngine) -> list[str]:
+    """The keys of the mechanical ledger (``ledger_cumulative``) that :func:`ledger_of`
+    reads."""
+    keys = []
+    for g in engine.generation.mechanisms:
+        name = heat.GENERATION[g]
+        source = "collision_energy_loss" if g == heat.G_COLLISION else name
+        keys += [source, f"wall_generation_{name}"]
+    return keys
+
+
+def ledger_of(
+    engine: ThermalEngine, cum: dict[str, float], pending: Any, cumulative: dict[str, float]
+) -> dict[str, float]:
+    """:func:`ledger` from the mechanical ledger ``cum``, the energies waiting in the
+    accumulators ``pending`` (one per mechanism of GENERATION) and the heat ledger
+    ``cumulative`` (the sums over the ranks on several MPI ranks)."""
     gen = engine.generation
     chi = gen.conversion_fraction
-    cum = sim.ledger_cumulative
-    pending = sim.particles.generation_energy.sum(axis=0)
     out: dict[str, float] = {}
     error = 0.0
     for g in gen.mechanisms:
@@ -61,7 +82,7 @@ def ledger(engine: ThermalEngine) -> dict[str, float]:
         out[f"generated_{name}"] = generated
         out[f"heat_to_walls_generation_{name}"] = walls
         out[f"heat_pending_generation_{name}"] = waiting
-        into = engine.cumulative[f"heat_in_generation_{name}"]
+        into = cumulative[f"heat_in_generation_{name}"]
         error += generated - walls - waiting - into
     out["generation_balance_error"] = error
     return out

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from thermodem.engine import generation
 from thermodem.engine.restart import THERMAL_RECOMPUTED  # stored empty in a gathered checkpoint
 from thermodem.engine.simulation_ledger import LEDGER_DISSIPATION
 from thermodem.mpi import exchange as X
@@ -38,30 +39,37 @@ THERMAL_PARTICLE_ARRAYS = ("conductance_sum",)
 # ---------------------------------------------------------------------------------- reports
 def global_energies(sim: DistributedSimulation) -> dict[str, float]:
     """Simulation.energies() of the whole simulation (collective)."""
+    return global_ledger(sim)[0]
+
+
+def global_ledger(sim: DistributedSimulation) -> tuple[dict[str, float], dict[str, float]]:
+    """Simulation.energies() of the whole simulation and its ``ledger_cumulative`` (every
+    key: the heat generation's ``collision_energy_loss`` and ``wall_generation_<g>`` too)
+    summed over the ranks; collective, one reduction."""
     p = sim.particles
     n = sim.owned_count
     m, v, w = p.mass[:n], p.velocity[:n], p.angular_velocity[:n]
     cum = sim.ledger_cumulative
+    keys = list(cum)  # (the same keys in the same order on every rank: the same case)
     local = np.array(
         [
             0.5 * float(np.sum(m * np.sum(v**2, axis=1))),
             0.5 * float(np.sum(p.moment_of_inertia[:n] * np.sum(w**2, axis=1))),
             -float(np.sum(m * (p.position[:n] @ sim.gravity))),
             *(float(e) for e in sim.elastic),
-            *(cum[k] for k in LEDGER_DISSIPATION),
-            *(cum.get(k, 0.0) for k in LEDGER_KEYS),
+            *(cum[k] for k in keys),
         ]
     )
     total = X.allreduce_sum(sim.comm, local)
     out = dict(zip(ENERGY_KEYS, (float(x) for x in total[:6]), strict=True))
-    k = 6
+    ledger = dict(zip(keys, (float(x) for x in total[6:]), strict=True))
     for name in LEDGER_DISSIPATION:
-        out[f"dissipated_{name}"] = float(total[k])
-        k += 1
+        out[f"dissipated_{name}"] = ledger[name]
+    if sim.generation:  # kinetic energy lost in collisions (as Simulation.energies)
+        out["collision_energy_loss"] = ledger["collision_energy_loss"]
     for name in LEDGER_KEYS:
-        out[name] = float(total[k])
-        k += 1
-    return out
+        out[name] = ledger.get(name, 0.0)
+    return out, ledger
 
 
 def global_report(sim: DistributedSimulation) -> dict[str, float]:
@@ -103,8 +111,14 @@ def global_thermal_summary(sim: DistributedSimulation) -> dict[str, float]:
     if th.range_set is not None:
         rs = th.range_set
         range_pairs = int(np.count_nonzero(rs.i[: rs.count] < n))  # once: i, the lower id
+    gen_keys: list[str] = []
+    pending: list[float] = []
+    if th.generation.active:  # the ledger it reads, the energies waiting in owned particles
+        gen_keys = generation.ledger_keys(th)
+        pending = p.generation_energy[:n].sum(axis=0).tolist()
     local = np.array([float(t.sum()), float(n), *rates, *(th.cumulative[k] for k in cum_keys),
-                      float(range_pairs)])  # fmt: skip
+                      float(range_pairs), *(sim.ledger_cumulative[k] for k in gen_keys),
+                      *pending])  # fmt: skip
     total = X.allreduce_sum(sim.comm, local)
     extremes = X.allreduce_max(
         sim.comm, np.array([float(t.max()) if n else -np.inf, -float(t.min()) if n else -np.inf])
@@ -133,9 +147,15 @@ def global_thermal_summary(sim: DistributedSimulation) -> dict[str, float]:
     out["heat_balance_error"] = (energy - th.initial_energy - boundary
                                  + cumulative["fixed_absorbed"] - cumulative["inserted_heat"]
                                  - cumulative["fixed_reset"])  # fmt: skip
+    range_count = int(total[q])
+    q += 1
+    if th.generation.active:
+        summed = dict(zip(gen_keys, (float(x) for x in total[q : q + len(gen_keys)]),
+                          strict=True))  # fmt: skip
+        out.update(generation.ledger_of(th, summed, total[q + len(gen_keys) :], cumulative))
     out["thermal_limit"] = th.limit
     if th.range_set is not None:
-        out["range_pair_count"] = int(total[q])
+        out["range_pair_count"] = range_count
     return out
 
 
@@ -251,7 +271,7 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
     gathered = _gathered_particles(sim, tuple(extras))
     pair_rows = gather_rows(sim.comm, _pair_rows(sim, sim.pairs, wall=False))
     wall_rows = gather_rows(sim.comm, _pair_rows(sim, sim.walls, wall=True))
-    energies = global_energies(sim)  # (collective: the ledger sums)
+    ledger = global_ledger(sim)[1]  # (collective: the ledger sums)
     counts = X.allreduce_sum(sim.comm, np.array([sim.contact_count], np.int64))
     elastic = X.allreduce_sum(sim.comm, np.asarray(sim.elastic, np.float64))
     worst = X.allreduce_max(sim.comm, np.array([sim.max_overlap_ratio]))
@@ -281,10 +301,7 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
         _needs_rebuild=True, slab_axis=None, max_overlap_ratio=float(worst[0]),
         contact_count=int(counts[0]),
     )  # fmt: skip
-    scalars["ledger_cumulative"] = {
-        k: float(energies[f"dissipated_{k}"] if k in LEDGER_DISSIPATION else energies[k])
-        for k in sim.ledger_cumulative
-    }
+    scalars["ledger_cumulative"] = ledger
     scalars["rng"] = sim.rng.bit_generator.state
     scalars["pourers"] = []
     scalars["material_names"] = list(sim.material_names)

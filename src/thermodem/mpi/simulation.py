@@ -268,15 +268,17 @@ class DistributedSimulation(Simulation):
         layout = self.history_layout.offsets
         th = self.thermal
         heat_due = th is not None and th.next_step <= self.step_count
-        # as in the serial step: the fused pass only with a contact conduction model (heat
-        # generation is refused under MPI, mpi/support.py: its deposits are compiled out)
+        # as in the serial step: the fused pass only with a contact conduction model
         fused = heat_due and th.contact.active
         if heat_due:
             th.prepare(self.time)
         pair_pass, wall_pass = self._contact_passes(th is not None and th.contact.active)
         if not fused:
             pair_heat = self._no_heat
-        gen = (False, *self._no_generation)
+        if self.generation:  # both passes deposit into both sides; the owned side is kept
+            gen = (True, p.generation_energy, th.generation.select, th.generation.partition)
+        else:
+            gen = (False, *self._no_generation)
         nwchunks = (p.count + PP.WALL_CHUNK - 1) // PP.WALL_CHUNK
         if heat_due:
             th.fresh = True

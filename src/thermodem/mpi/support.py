@@ -8,7 +8,8 @@ conduction of Batchelor & O'Brien complete / modified, indirect conduction throu
 fluid), the per-particle terms that need no neighbours (convection with a fluid given as
 uniform / table / expression / grid and a global porosity, radiation ``surroundings`` with
 its walls), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
-sources, external sources, checkpoints, frames and time series.
+sources, external sources, heat generation (every model: the deposits of the contact passes,
+each rank keeping its own particles' side), checkpoints, frames and time series.
 
 Refused, each with a message naming the case key (never a silently wrong result):
 """
@@ -43,7 +44,6 @@ REFUSED: tuple[tuple[str, str], ...] = (
     ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
     ("thermal.radiation", "radiation from the neighbourhood (zhou2009, krause2017)"),
     ("thermal.indirect_conduction", "Voronoi (external pair set) and contact-target models"),
-    ("thermal.heat_generation", "heat generation from the mechanical dissipation"),
 )
 
 
@@ -97,13 +97,6 @@ def check_case(case: Case) -> None:
             "contacts": "heat terms on the contact lists outside the fused contact pass",
         }.get(ic.spec.target, f"heat terms on the pair set {ic.spec.target!r}")
         raise _refuse(f"thermal.indirect_conduction = {ic.model!r}", what)
-    hg = getattr(th, "heat_generation", None)
-    if hg is not None and getattr(hg, "model", "none") != "none":
-        raise _refuse(
-            f"thermal.heat_generation = {hg.model!r}",
-            "heat generation (its per-particle accumulators and wall shares are not split by "
-            "rank yet)",
-        )
 
 
 def check_thermal(engine: ThermalEngine) -> None:
