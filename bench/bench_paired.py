@@ -1,0 +1,80 @@
+"""Paired heat-overhead benchmark on the shared bed: mechanics and heat in one process.
+
+``bench_shared_bed.py`` runs each case in a fresh process; on this kind of VM the same case
+moves by 15-25 % between processes and between minutes, more than the ≤ 15 % margins of
+issues 17 §5 and 12. Here the mechanics case and a heat case (``region`` or ``material``:
+the bottom layer held at 400 K) are built in one process from the same bed
+(``bench_shared_bed.case_dict``), warmed up, and then timed in alternating blocks of
+``--block`` steps (mechanics, heat, mechanics, ...), so that both see the same machine at
+nearly the same moment; the overhead is the ratio of the summed times, and the spread of the
+per-pair block ratios (median, lower and upper quartile) says how far to trust it.
+
+    python bench/bench_paired.py [--threads 1] [--heat region] [--blocks 20] [--block 100]
+        [--warmup 300]
+
+Prints particle-steps per second of both, the heat overhead (heat time / mechanics time - 1)
+and the quartiles of the block ratios, with the load average. Run it once per thread count
+(``--threads 1``, ``--threads 2``): the 2-thread speed-up of each case is the ratio of its
+throughputs in the two runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+import bench_shared_bed as shared  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--heat", default="region", choices=["region", "material", "heat"])
+    ap.add_argument("--blocks", type=int, default=20, help="timed blocks of each case")
+    ap.add_argument("--block", type=int, default=100, help="steps per block")
+    ap.add_argument("--warmup", type=int, default=300)
+    args = ap.parse_args()
+
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+
+    shared.particle_files()
+    sims = {
+        kind: Simulation(case_from_dict(shared.case_dict(kind, None, 1)), threads=args.threads)
+        for kind in ("mechanics", args.heat)
+    }
+    for sim in sims.values():
+        sim.run(steps=args.warmup)
+    load_before = shared.load_average()
+    seconds = {kind: [] for kind in sims}
+    for _ in range(args.blocks):
+        for kind, sim in sims.items():
+            t0 = time.perf_counter()
+            sim.run(steps=args.block)
+            seconds[kind].append(time.perf_counter() - t0)
+    mech = np.array(seconds["mechanics"])
+    heat = np.array(seconds[args.heat])
+    n = sims["mechanics"].particles.count
+    steps = args.blocks * args.block
+    ratios = heat / mech - 1.0
+    q1, med, q3 = np.percentile(ratios, [25, 50, 75])
+    print(
+        f"threads {args.threads}, {n} particles, {args.blocks} blocks of {args.block} steps, "
+        f"load {load_before:.2f} -> {shared.load_average():.2f}"
+    )
+    print(f"mechanics     {n * steps / mech.sum() / 1e6:6.2f} M particle-steps/s")
+    print(f"{args.heat:<13} {n * steps / heat.sum() / 1e6:6.2f} M particle-steps/s")
+    print(
+        f"heat overhead {heat.sum() / mech.sum() - 1.0:+.1%} (block ratios: median {med:+.1%}, "
+        f"quartiles {q1:+.1%} .. {q3:+.1%})"
+    )
+
+
+if __name__ == "__main__":
+    main()
