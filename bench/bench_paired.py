@@ -11,6 +11,11 @@ per-pair block ratios (median, lower and upper quartile) says how far to trust i
 
     python bench/bench_paired.py [--threads 1] [--heat region] [--blocks 20] [--block 100]
         [--warmup 300]
+    python bench/bench_paired.py --drum [--threads 1] ...
+
+``--drum``: the same pairing on ``bench_drum.py``'s rotating drum (50,000 spheres after 0.1 s
+of flow, cached in bench/.cache): mechanics against ``generation`` (heat generation every
+step, issue 12); both advance in step, so they see the same flow.
 
 Prints particle-steps per second of both, the heat overhead (heat time / mechanics time - 1)
 and the quartiles of the block ratios, with the load average. Run it once per thread count
@@ -39,15 +44,25 @@ def main() -> None:
     ap.add_argument("--blocks", type=int, default=20, help="timed blocks of each case")
     ap.add_argument("--block", type=int, default=100, help="steps per block")
     ap.add_argument("--warmup", type=int, default=300)
+    ap.add_argument("--drum", action="store_true", help="the drum: mechanics vs generation")
     args = ap.parse_args()
 
     from thermodem.config.load import case_from_dict
     from thermodem.engine.simulation import Simulation
 
-    shared.particle_files()
+    if args.drum:
+        import bench_drum as drum
+
+        args.heat = "generation"
+        bed = str(drum.settle(drum.BASE, 0.1))
+        cases = {
+            kind: drum.case_dict(drum.BASE, bed, kind, 1) for kind in ("mechanics", "generation")
+        }
+    else:
+        shared.particle_files()
+        cases = {kind: shared.case_dict(kind, None, 1) for kind in ("mechanics", args.heat)}
     sims = {
-        kind: Simulation(case_from_dict(shared.case_dict(kind, None, 1)), threads=args.threads)
-        for kind in ("mechanics", args.heat)
+        kind: Simulation(case_from_dict(case), threads=args.threads) for kind, case in cases.items()
     }
     for sim in sims.values():
         sim.run(steps=args.warmup)
