@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numba
 import numpy as np
 import pytest
 
@@ -26,13 +25,7 @@ EXTRA = 0.1 * R0
 SKIN = 0.25 * R0
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """Small systems: one Numba thread (results do not depend on it, see test_threads.py)."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 def material() -> dict:

@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numba
 import numpy as np
 import pytest
 from scipy.special import beta
@@ -51,14 +50,7 @@ STEPS_PER_CONTACT = 400
 SPEEDS = (0.5, 2.0)  # impact speeds [m/s]
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """Two-body runs: one Numba thread (results do not depend on it, see test_threads.py;
-    parallel regions on a busy machine cost milliseconds per call for two particles)."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 # ------------------------------------------------------------------------- closed forms

@@ -18,7 +18,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numba
 import numpy as np
 import pytest
 
@@ -35,13 +34,7 @@ MASS = DENSITY * 4.0 / 3.0 * math.pi * RADIUS**3
 MATERIAL = {"density": DENSITY, "youngs_modulus": YOUNG, "poisson_ratio": POISSON}
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """Few-particle runs: one Numba thread (results do not depend on it, see test_threads.py)."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 def _file(path: Path, position, material: str) -> str:

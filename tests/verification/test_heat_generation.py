@@ -33,7 +33,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numba
 import numpy as np
 import pytest
 
@@ -52,13 +51,7 @@ C = 800.0  # specific heat [J/(kg K)]
 STEPS_PER_CONTACT = 200
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """Few-particle runs: one Numba thread (results do not depend on it, test_threads.py)."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 def material(**kw) -> dict:

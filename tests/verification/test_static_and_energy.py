@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numba
 import numpy as np
 import pytest
 
@@ -35,13 +34,7 @@ E_STAR = 1.0 / (2.0 * (1.0 - POISSON**2) / YOUNG)  # same material for sphere an
 STIFFNESS = 2.0e4
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """Few-particle runs: one Numba thread (results do not depend on it, see test_threads.py)."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 def make_sim(

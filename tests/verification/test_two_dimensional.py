@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 import pytest
 
@@ -34,12 +33,7 @@ E_STAR = 1.0 / (2.0 * (1.0 - POISSON**2) / YOUNG)
 STEPS_PER_CONTACT = 400
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 def material(e: float, mu: float = 0.0, mu_r: float = 0.0) -> dict:
