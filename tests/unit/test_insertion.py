@@ -865,7 +865,7 @@ def test_given_particles_inside_the_domain_and_not_coincident(tmp_path):
 
 def test_overlap_search_equals_brute_force():
     """The k-d tree search finds the first too-deep pair that an O(n²) loop finds."""
-    from thermodem.geometry.insertion import _deepest_overlap
+    from thermodem.geometry.given_particles import _deepest_overlap
 
     rng = np.random.default_rng(3)
     for _ in range(20):
