@@ -75,6 +75,7 @@ def step_work(sim) -> float:  # noqa: ANN001
     from thermodem.kernels.integrate import external_power
 
     p = sim.particles
-    power = external_power(p.velocity, p.angular_velocity, p.external_force, p.external_torque,
-                           sim.chunk_check)  # fmt: skip
+    n = sim.owned_count  # (all of them; on several MPI ranks the ghosts are others' to count)
+    power = external_power(p.velocity[:n], p.angular_velocity[:n], p.external_force[:n],
+                           p.external_torque[:n], sim.chunk_check)  # fmt: skip
     return sim.dt * power

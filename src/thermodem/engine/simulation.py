@@ -301,9 +301,27 @@ class Simulation(SimulationLedger):
     # ------------------------------------------------------------------ particles in and out
     def add_particles(self, new: InsertedParticles) -> None:
         """Append particles of one material; they get fresh global ids."""
+        extra = self.new_particles(new)
+        if extra is None:
+            return
+        self.particles.append(extra)
+        if hasattr(self, "reference"):
+            self.reference = np.concatenate([self.reference, extra.position])
+        self._needs_rebuild = True
+
+    def pour(self) -> None:
+        """Insert the batches of the pour entries that are due at this step's time."""
+        for pourer in self.pourers:
+            if pourer.due(self.time, self.dt):
+                p = self.particles
+                self.add_particles(pourer.emit(self.time, p.position, p.radius))
+
+    def new_particles(self, new: InsertedParticles) -> Particles | None:
+        """The particle arrays of ``new`` (None if empty), with fresh global ids, their
+        external loads, and their energies entered in the ledgers (not yet added)."""
         n = len(new)
         if n == 0:
-            return
+            return None
         t = self.material_index[new.material]
         temperature = new.temperature
         if temperature is None and self.thermal is not None:
@@ -333,10 +351,7 @@ class Simulation(SimulationLedger):
             )
         if self.thermal is not None and hasattr(self, "ledger_cumulative"):
             self.thermal.inserted(extra.temperature, extra.mass, extra.type_id)
-        self.particles.append(extra)
-        if hasattr(self, "reference"):
-            self.reference = np.concatenate([self.reference, extra.position])
-        self._needs_rebuild = True
+        return extra
 
     # ------------------------------------------------------------------------- neighbours
     def rebuild(self) -> None:
@@ -497,11 +512,7 @@ class Simulation(SimulationLedger):
         self.step_count += 1
         if self.wall_rows.shape[0]:
             advance_walls(self.wall_rows, WL.COL_POINT, WL.COL_VELOCITY, self.dt)
-        for pourer in self.pourers:
-            if pourer.due(self.time, self.dt):
-                self.add_particles(
-                    pourer.emit(self.time, self.particles.position, self.particles.radius)
-                )
+        self.pour()
         self._compute_forces(kick=True)
         self._check_overlap()
 

@@ -378,6 +378,10 @@ class Pourer:
         t = self.last_time + self.entry.interval
         return t if self.entry.end_time is None else min(t, self.entry.end_time)
 
+    def region_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Bounding box (lower, upper) of the pour region [m]."""
+        return self._region.bbox()
+
     def due(self, time: float, dt: float) -> bool:
         """Whether a batch should be emitted in the step at ``time`` of length ``dt``.
 

@@ -210,9 +210,16 @@ class GatheredView:
         self.wall_labels = sim.wall_labels
         self.time = sim.time
         self.step_count = sim.step_count
+        self._contacts: dict[str, np.ndarray] | None = None
 
     def coordination_number(self) -> np.ndarray:
         return self._coordination
+
+    def contacts(self) -> dict[str, np.ndarray]:
+        """The contacts of every rank (gathered with the particles: ``output.contacts``)."""
+        if self._contacts is None:
+            raise RuntimeError("the contacts were not gathered with this frame")
+        return self._contacts
 
     def complete_rates(self) -> None:
         """The ranks formed their heat rates before the gather (:func:`gathered_view`)."""
@@ -221,12 +228,29 @@ class GatheredView:
 def gathered_view(sim: DistributedSimulation) -> GatheredView | None:
     """The frame data gathered to rank 0 (None on the other ranks); collective."""
     sim.complete_rates()  # heat rates left to the next thermal step (Simulation.step)
+    contacts = sim.contacts() if sim.case.output.contacts else None
     z = sim.coordination_number()[: sim.owned_count].astype(np.float64)
     out = _gathered_particles(sim, (np.concatenate([z, np.zeros(sim.ghost_count)]),))
     if out is None:
         return None
     particles, (coordination,) = out
-    return GatheredView(sim, particles, coordination.astype(np.int32))
+    view = GatheredView(sim, particles, coordination.astype(np.int32))
+    view._contacts = contacts
+    return view
+
+
+def gathered_contacts(sim: DistributedSimulation, local: dict[str, np.ndarray]) -> dict:
+    """Every rank's per-contact arrays ``local`` joined on every rank (collective): the
+    particle pairs of ranks 0, 1, ... then their wall contacts."""
+    parts = sim.comm.allgather(local)
+    pair = [part["wall"] < 0 for part in parts]
+    return {
+        key: np.concatenate(
+            [part[key][mask] for part, mask in zip(parts, pair, strict=True)]
+            + [part[key][~mask] for part, mask in zip(parts, pair, strict=True)]
+        )
+        for key in local
+    }
 
 
 def _pair_rows(sim: DistributedSimulation, buf: Any, wall: bool) -> np.ndarray:
@@ -303,7 +327,7 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
     )  # fmt: skip
     scalars["ledger_cumulative"] = ledger
     scalars["rng"] = sim.rng.bit_generator.state
-    scalars["pourers"] = []
+    scalars["pourers"] = [pourer.state_dict() for pourer in sim.pourers]  # (the same on all)
     scalars["material_names"] = list(sim.material_names)
     scalars["history_width"] = width
     scalars["history_layout"] = sim.history_layout.describe()

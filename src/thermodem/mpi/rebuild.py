@@ -3,7 +3,8 @@
 In order (every step collective, see the simulation module's docstring):
 
 1. this rank's share: its owned particles (before the first build every rank holds the same
-   full set, from the insertion or a checkpoint, and takes the slice N r / P .. N (r+1) / P);
+   full set, from the insertion or a checkpoint, and takes the slice N r / P .. N (r+1) / P),
+   on rank 0 with the particles poured since the last rebuild;
 2. history records of the share's touching pairs (particle pairs whose lower global id is
    in the share, wall pairs of the share): rows ``[gid, other, history...]`` keyed by the
    two global ids (the wall index for a wall pair), which travel with particle ``gid``;
@@ -118,6 +119,11 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     owned = X.take_particles(p, share)
     extra_own = tuple(e[share].copy() for e in extras)
     del p
+    if sim.poured:  # particles poured since the last rebuild (rank 0): owned until migrated
+        k = sum(q.count for q in sim.poured)
+        owned = X.concatenate_particles([owned, *sim.poured])
+        extra_own = tuple(np.concatenate([e, np.zeros(k)]) for e in extra_own)
+        sim.poured = []
     # 3. global numbers and the decomposition
     local_r = float(owned.radius.max()) if owned.count else 0.0
     stats = X.allreduce_max(comm, np.array([float(owned.count), local_r]))

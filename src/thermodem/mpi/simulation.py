@@ -34,15 +34,18 @@ Ledgers are per rank and summed over the ranks when reported (:mod:`thermodem.mp
 from __future__ import annotations
 
 import time as wallclock
+import warnings
 from typing import Any
 
 import numpy as np
 
 from thermodem.config.schema import Case
+from thermodem.engine import external_loads as EL
 from thermodem.engine.neighbor_list import rebuild_due
 from thermodem.engine.simulation import Simulation
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
+from thermodem.geometry.insertion import InsertedParticles
 from thermodem.kernels import contact as C
 from thermodem.kernels import pair_pass as PP
 from thermodem.kernels.integrate import (
@@ -57,6 +60,7 @@ from thermodem.mpi import exchange as X
 from thermodem.mpi.decomposition import box_distance, point_box_distance
 from thermodem.mpi.support import check_case, check_thermal
 from thermodem.state.pairs import PairBuffers
+from thermodem.state.particles import Particles
 
 #: Default imbalance (largest rank count / mean - 1) above which a rebuild re-bisects.
 REBALANCE_THRESHOLD = 0.1
@@ -102,6 +106,8 @@ class DistributedSimulation(Simulation):
         self.stop_requested = 0  # set by a signal handler of this rank
         self.stop_agreed = 0  # any rank asked to stop (after each step)
         self._global_contacts = 0
+        #: particles poured on rank 0 waiting for the next rebuild (add_particles)
+        self.poured: list[Particles] = []
         super().__init__(case, threads, insert_particles=insert_particles)
         if self.thermal is not None:
             check_thermal(self.thermal)
@@ -231,12 +237,60 @@ class DistributedSimulation(Simulation):
         moved, stop = self.agree(error, moved, float(self.stop_requested))
         self.moved = float(moved)
         self.stop_agreed = int(stop)
+        if p.external_force.shape[1]:  # (this rank's share; the ledgers are summed)
+            self.ledger_cumulative["external_work"] += EL.step_work(self)
         self.time = (self.step_count + 1) * self.dt
         self.step_count += 1
         if self.wall_rows.shape[0]:
             advance_walls(self.wall_rows, WL.COL_POINT, WL.COL_VELOCITY, self.dt)
+        self.pour()
         self._compute_forces(kick=True)
         self._check_overlap()
+
+    # --------------------------------------------------------------------------- pouring
+    def pour(self) -> None:
+        """The batches of the pour entries due at this step (collective). Every rank runs each
+        due entry on the same data, so their random generators stay in step: the owned
+        particles that could touch the entry's region (centre closer to its bounding box
+        than its radius: a candidate lies wholly inside the region) are gathered from every
+        rank, and every rank draws and checks the same candidates as the serial run. The
+        new particles join rank 0's owned ones and the rebuild that follows sends them to
+        the ranks whose boxes hold them (:meth:`add_particles`)."""
+        if not self._distributed:  # (every rank holds the whole set: as in serial)
+            Simulation.pour(self)
+            return
+        for pourer in self.pourers:
+            if not pourer.due(self.time, self.dt):
+                continue
+            lower, upper = pourer.region_bounds()
+            p, own = self.particles, self.owned_count
+            position, radius = p.position[:own], p.radius[:own]
+            outside = np.maximum(np.maximum(lower - position, position - upper), 0.0)
+            near = np.einsum("ij,ij->i", outside, outside) <= radius * radius
+            mine = np.concatenate([position[near], radius[near, None]], axis=1)
+            rows = np.concatenate(self.comm.allgather(mine))
+            with warnings.catch_warnings():
+                if self.rank != 0:  # (rank 0 says the warnings of the run)
+                    warnings.simplefilter("ignore")
+                new = pourer.emit(self.time, rows[:, :3].copy(), rows[:, 3].copy())
+            self.add_particles(new)
+
+    def add_particles(self, new: InsertedParticles) -> None:
+        """Particles inserted while the run goes (collective, every rank with the same
+        ``new``): every rank numbers them; rank 0 builds them, enters their energy in its
+        ledgers and keeps them until the rebuild that follows adds them to its owned share
+        (mpi/rebuild.py), from where they migrate to their boxes' ranks."""
+        if not self._distributed:
+            Simulation.add_particles(self, new)
+            return
+        if len(new) == 0:
+            return
+        if self.rank == 0:
+            extra = self.new_particles(new)
+            self.poured.append(extra)
+        else:
+            self.next_global_id += len(new)
+        self._needs_rebuild = True
 
     def _check_overlap(self) -> None:
         limit = self.case.simulation.max_overlap_ratio
@@ -341,6 +395,16 @@ class DistributedSimulation(Simulation):
 
         self.complete_rates()  # heat rates left to the next thermal step (Simulation.step)
         return global_report(self)
+
+    def contacts(self) -> dict[str, np.ndarray]:
+        """The per-contact arrays of the whole simulation (engine/contacts.py), on every rank
+        (collective): each rank evaluates its list ``pairs`` (a pair across the cut is in the
+        list of the rank owning its lower global id: once) and its owned wall pairs, and the
+        rows are gathered in rank order, the particle pairs of every rank first, then the wall
+        contacts, as the serial order has them."""
+        from thermodem.mpi.gather import gathered_contacts
+
+        return gathered_contacts(self, Simulation.contacts(self))
 
     def coordination_number(self) -> np.ndarray:
         """Touching contacts of each particle of this rank (exact for the owned ones)."""

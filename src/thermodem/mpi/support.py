@@ -1,15 +1,17 @@
 """What a run on several MPI ranks supports, checked before any simulation time is spent.
 
 Supported (docs/mpi.md): the mechanics (every normal, tangential and rolling model, walls of
-every kind, moving walls, periodic axes), static insertion, the thermal engine with explicit
-Euler, the contact conduction of the fused contact pass (every contact radius and direct
-conduction model, the conductance reuse, k(T) and c(T) tables), the range pair set (gap
+every kind, moving walls, periodic axes, constant external forces and torques), static
+insertion and pouring (mpi/simulation.py: DistributedSimulation.pour), the thermal engine
+with explicit Euler, the contact conduction of the fused contact pass (every contact radius
+and direct conduction model, the conductance reuse, k(T) and c(T) tables), the range pair set (gap
 conduction of Batchelor & O'Brien complete / modified, indirect conduction through the
 fluid), the per-particle terms that need no neighbours (convection with a fluid given as
 uniform / table / expression / grid and a global porosity, radiation ``surroundings`` with
 its walls), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
 sources, external sources, heat generation (every model: the deposits of the contact passes,
-each rank keeping its own particles' side), checkpoints, frames and time series.
+each rank keeping its own particles' side), checkpoints, frames (contact frames included) and
+time series.
 
 Refused, each with a message naming the case key (never a silently wrong result):
 """
@@ -36,9 +38,6 @@ NEIGHBOUR_RADIATION = ("zhou2009", "krause2017")
 #: (case key, why) of every refused feature, in the order they are checked (docs/mpi.md).
 REFUSED: tuple[tuple[str, str], ...] = (
     ("simulation.dimension: 2", "two-dimensional discs"),
-    ("insertion.N.kind: pour", "pouring inserts particles while the run goes"),
-    ("external_force", "constant external loads"),
-    ("output.contacts", "contact frames"),
     ("thermal.frozen_mechanics", "frozen mechanics"),
     ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
     ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
@@ -59,15 +58,6 @@ def check_case(case: Case) -> None:
     """ConfigError for the first case key that a multi-rank run does not support."""
     if getattr(case.simulation, "dimension", 3) == 2:
         raise _refuse("simulation.dimension = 2", "two-dimensional discs")
-    for k, entry in enumerate(case.insertion):
-        if entry.kind == "pour":
-            raise _refuse(
-                f"insertion.{k}.kind", "pouring ('pour' inserts particles during the run)"
-            )
-    if case.external_force:
-        raise _refuse("external_force", "constant external loads")
-    if case.output.contacts:
-        raise _refuse("output.contacts", "contact frames")
     th = case.thermal
     if th is None:
         return
