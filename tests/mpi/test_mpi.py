@@ -174,8 +174,8 @@ def test_plain_run_does_not_import_mpi4py(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("change", "key"),
     [
-        (lambda c: c["thermal"].update(frozen_mechanics=True, time_step=1e-3),
-         "thermal.frozen_mechanics"),
+        (lambda c: c["thermal"].update(frozen_mechanics=True, time_step=1e-3,
+                                       scheme="backward_euler"), "thermal.scheme"),
         # per-particle terms that need the neighbours (the others run under MPI)
         (lambda c: c["thermal"].update(convection="gunn1978", fluid={"temperature": 300.0},
                                        porosity={"kind": "cell"}),
@@ -386,6 +386,35 @@ def test_contact_frames_on_2_ranks(tmp_path: Path) -> None:
 
 
 @needs_mpi
+@pytest.mark.parametrize("heat", ["contact", "range"])
+def test_frozen_mechanics_on_2_ranks(tmp_path: Path, heat: str) -> None:
+    """``thermal.frozen_mechanics`` (the heat-only passes over the list and the mirror list,
+    the ghosts' temperatures exchanged every step): the settled bed heated from its bottom
+    layer (contact: Batchelor & O'Brien simple; range: complete, its gap term on the range
+    set, a hot wall) over 100 thermal steps of 0.05 s on 2 ranks against the serial run, and
+    the 2-rank checkpoint of step 50 continued serially."""
+    steps, time_step = 100, 0.05
+    case = bed_case(DATA / "mpi_bed_box.txt", heat=heat, end_time=steps * time_step)
+    case["thermal"].update(frozen_mechanics=True, time_step=time_step)
+    case["output"] = {"vtu": False, "timeseries_interval": 10 * time_step,
+                      "checkpoint_interval": 50 * time_step, "checkpoint_keep": None}  # fmt: skip
+    path = _write_case(tmp_path / "frozen.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"f{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    serial, parallel = _final(tmp_path / "f1", steps), _final(tmp_path / "f2", steps)
+    heated = serial["temperature"] - _final(tmp_path / "f1", 0)["temperature"]
+    assert np.count_nonzero(heated > 1e-3) > 100  # (the heat has spread over the bed)
+    _assert_same_state(serial, parallel)
+    _assert_same_ledgers(tmp_path / "f1", tmp_path / "f2")
+    checkpoint = tmp_path / "f2" / "checkpoints" / "checkpoint_000000050.h5"
+    out = tmp_path / "from2on1"
+    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
+    assert res.returncode == 0, res.stderr
+    _assert_same_state(serial, _final(out, steps))
+
+
+@needs_mpi
 def test_periodic_bed_with_range_set_on_2_ranks(tmp_path: Path) -> None:
     """Periodic x and y, Batchelor & O'Brien complete (separated pairs on the range set) and
     a hot floor: 400 steps on 2 ranks against the serial run."""
@@ -505,12 +534,12 @@ def test_failure_stops_every_rank_with_one_message(tmp_path: Path) -> None:
 @needs_mpi
 def test_unsupported_key_refused_by_mpiexec(tmp_path: Path) -> None:
     case = bed_case(DATA / "mpi_bed_box.txt", end_time=10 * DT)
-    case["thermal"].update(frozen_mechanics=True, time_step=1e-3)
+    case["thermal"].update(frozen_mechanics=True, time_step=1e-3, scheme="backward_euler")
     path = _write_case(tmp_path / "c.yaml", case)
     res = _run(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"], 2, timeout=300)
     assert res.returncode == 2
     assert res.stderr.count("MPI does not support it yet") == 1, res.stderr
-    assert "thermal.frozen_mechanics" in res.stderr
+    assert "thermal.scheme" in res.stderr
 
 
 DISK_FULL_SCRIPT = """

@@ -130,6 +130,8 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
             self.check_ranges(self._radius_bound())
         # per-pair conductances of the contact conduction (heat-only passes, frozen reuse)
         self.pair_conductance = np.zeros(0)
+        #: H of the mirror list's pairs (several MPI ranks: i a ghost, j owned)
+        self.mirror_conductance = np.zeros(0)
         self.wall_conductance = np.zeros(0)
         # per-pair conductances of the other terms, stored with frozen mechanics
         self.term_conductance = [np.zeros(0) for _ in self.terms]
@@ -313,15 +315,31 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
     # ------------------------------------------------------------------------------ step
     def _buffers(self) -> None:
         sim = self.sim
+        mirror = getattr(sim, "mirror", None)
+        mirror_capacity = mirror.capacity if mirror is not None else 0
         if (
             self.pair_conductance.shape[0] < sim.pairs.capacity
             or self.wall_conductance.shape[0] < sim.walls.capacity
+            or self.mirror_conductance.shape[0] < mirror_capacity
         ):
             self.conductance_ready = False
         if self.pair_conductance.shape[0] < sim.pairs.capacity:
             self.pair_conductance = np.zeros(sim.pairs.capacity)
         if self.wall_conductance.shape[0] < sim.walls.capacity:
             self.wall_conductance = np.zeros(sim.walls.capacity)
+        if self.mirror_conductance.shape[0] < mirror_capacity:
+            self.mirror_conductance = np.zeros(mirror_capacity)
+
+    def _contact_lists(self) -> list[tuple]:
+        """The contact lists of the heat-only passes with their conductance arrays: the list
+        and, on several MPI ranks, the mirror list (pairs whose particle i is a ghost and j
+        owned, mpi/simulation.py), whose heat the owned particle j needs."""
+        sim = self.sim
+        out = [(sim.pairs, self.pair_conductance)]
+        mirror = getattr(sim, "mirror", None)
+        if mirror is not None and mirror.count:
+            out.append((mirror, self.mirror_conductance))
+        return out
 
     def prepare(self, time: float) -> None:
         """Buffers, wall temperatures at ``time``, fixed particles and sources, and the k(T),
@@ -342,7 +360,9 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
             self.rhoc_w = self.density_by_type[sim.wall_material] * self._interp(
                 self.c_t, self.c_v, self.c_n, sim.wall_material, wt
             )
-        rows = max(sim.pairs.count, sim.walls.count) // kernels.CHUNK + 1
+        mirror = getattr(sim, "mirror", None)
+        listed = max(sim.pairs.count, sim.walls.count, mirror.count if mirror is not None else 0)
+        rows = listed // kernels.CHUNK + 1
         self._scratch_rows(rows)
         if self.conductance_sum.shape[0] != p.count:
             self.conductance_sum = np.zeros(p.count)
@@ -368,7 +388,8 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
 
     def conduction_passes(self) -> None:
         """Contact conduction by the heat-only passes (frozen mechanics, start): zeroes the
-        mechanism columns and the conductance sums, then adds the contact conduction.
+        mechanism columns and the conductance sums, then adds the contact conduction (on
+        several MPI ranks over the list and the mirror list: every owned particle's pairs).
 
         With frozen mechanics and temperature-independent properties the conductances cannot
         change (same positions, contacts, forces and materials), so after the first pass only
@@ -376,26 +397,31 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
         """
         sim = self.sim
         p = sim.particles
-        pb = sim.pairs
         by_mech = p.heat_columns
         passes.zero_heat(by_mech, self.conductance_sum)
         if not self.contact.active:
             return
         reuse = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
+        lists = self._contact_lists()
         if not (reuse and self.conductance_ready):
-            kernels.conduction_pair_pass_for(self.radius_id, self.conduction_id, self.override)(
-                p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.count,
-                pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
-                self.radius_id, self.radius_table, self.conduction_id, self.conduction_table,
-                self.override, self.k_p, self.rhoc_p, self.scratch, self.pair_conductance,
-                sim.history_layout.reuse, self.tolerance,
-            )  # fmt: skip
+            pair_pass = kernels.conduction_pair_pass_for(
+                self.radius_id, self.conduction_id, self.override
+            )
+            for buf, conductance in lists:
+                pair_pass(
+                    p.position, p.radius, p.mass, p.temperature, p.type_id, buf.i, buf.j,
+                    buf.count, buf.state, buf.normal_force, buf.history, sim.lower, sim.upper,
+                    sim.periodic, self.radius_id, self.radius_table, self.conduction_id,
+                    self.conduction_table, self.override, self.k_p, self.rhoc_p, self.scratch,
+                    conductance, sim.history_layout.reuse, self.tolerance,
+                )  # fmt: skip
             self._wall_conductances()
             self.conductance_ready = reuse
-        passes.pair_heat_from_conductance(
-            pb.i, pb.j, pb.group_start, self.pair_conductance, p.temperature, heat.M_DIRECT,
-            by_mech, self.conductance_sum,
-        )  # fmt: skip
+        for buf, conductance in lists:
+            passes.pair_heat_from_conductance(
+                buf.i, buf.j, buf.group_start, conductance, p.temperature, heat.M_DIRECT,
+                by_mech, self.conductance_sum,
+            )  # fmt: skip
         self._wall_heat()
 
     def wall_conduction(self) -> None:

@@ -213,6 +213,9 @@ class DistributedSimulation(Simulation):
         :meth:`Simulation.step` (the total heat rates may be left to the next update)."""
         self._complete = complete
         th = self.thermal
+        if th is not None and th.settings.frozen_mechanics:
+            self._frozen_step()
+            return
         if th is not None and self.step_count >= th.next_step:
             n = th.substeps
             th.step(n * self.dt, self.time, clear=n == 1)
@@ -246,6 +249,18 @@ class DistributedSimulation(Simulation):
         self.pour()
         self._compute_forces(kick=True)
         self._check_overlap()
+
+    def _frozen_step(self) -> None:
+        """A step of frozen mechanics (collective): the ghosts take their owners' temperatures
+        (the halo exchange), then the heat-only thermal step on the owned particles over the
+        list and the mirror list, as the serial step; a stop asked on any rank is agreed."""
+        th = self.thermal
+        self.halo.exchange(self.comm, self.particles)
+        th.step(th.settings.time_step, self.time)
+        (stop,) = self.agree(None, float(self.stop_requested))
+        self.stop_agreed = int(stop)
+        self.step_count += 1
+        self.time = self.step_count * th.settings.time_step
 
     # --------------------------------------------------------------------------- pouring
     def pour(self) -> None:
@@ -321,7 +336,9 @@ class DistributedSimulation(Simulation):
         nid, tid, rid = self.model_ids
         layout = self.history_layout.offsets
         th = self.thermal
-        heat_due = th is not None and th.next_step <= self.step_count
+        heat_due = (  # (as in serial: frozen mechanics heat in their own step)
+            th is not None and not th.settings.frozen_mechanics and th.next_step <= self.step_count
+        )
         # as in the serial step: the fused pass only with a contact conduction model
         fused = heat_due and th.contact.active
         if heat_due:

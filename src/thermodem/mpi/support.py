@@ -38,7 +38,6 @@ NEIGHBOUR_RADIATION = ("zhou2009", "krause2017")
 #: (case key, why) of every refused feature, in the order they are checked (docs/mpi.md).
 REFUSED: tuple[tuple[str, str], ...] = (
     ("simulation.dimension: 2", "two-dimensional discs"),
-    ("thermal.frozen_mechanics", "frozen mechanics"),
     ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
     ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
     ("thermal.radiation", "radiation from the neighbourhood (zhou2009, krause2017)"),
@@ -61,8 +60,6 @@ def check_case(case: Case) -> None:
     th = case.thermal
     if th is None:
         return
-    if th.frozen_mechanics:
-        raise _refuse("thermal.frozen_mechanics", "frozen mechanics (heat only)")
     if th.scheme != "explicit":
         raise _refuse(f"thermal.scheme = {th.scheme!r}", "the implicit heat schemes")
     porosity = th.porosity
