@@ -227,16 +227,50 @@ def test_heat_generation_runs_under_mpi(model: str) -> None:
     assert not any("heat_generation" in key for key, _ in REFUSED)
 
 
-def test_two_dimensional_case_refused_under_mpi() -> None:
-    """A disc simulation (simulation.dimension: 2) is refused under MPI, naming the key."""
+def test_two_dimensional_case_accepted_under_mpi() -> None:
+    """A disc simulation (simulation.dimension: 2) is no longer refused under MPI."""
     from thermodem.config.load import load_case
-    from thermodem.errors import ConfigError
-    from thermodem.mpi.support import check_case
+    from thermodem.mpi.support import REFUSED, check_case
 
-    case = load_case(Path(__file__).parents[2] / "examples" / "drum_2d.yaml")
-    with pytest.raises(ConfigError, match="MPI does not support it yet") as info:
-        check_case(case)
-    assert "simulation.dimension" in str(info.value)
+    check_case(load_case(Path(__file__).parents[2] / "examples" / "drum_2d.yaml"))
+    assert not any("dimension" in key for key, _ in REFUSED)
+
+
+@needs_mpi
+def test_two_dimensional_drum_on_2_ranks(tmp_path: Path) -> None:
+    """The 2D drum example (a turning, hot mantle; thermal pipe conduction) with a bed of
+    touching discs at 300-350 K in its lower part instead of its random fill, 1500 steps on
+    2 ranks against the serial run: the bisection cuts x and y only and each rank's grid has
+    one cell layer along z, as the serial list; the discs stay in the plane (z = 0, v_z = 0)
+    and heat flows (from the mantle and between the discs)."""
+    steps = 1500
+    case = yaml.safe_load((Path(__file__).parents[2] / "examples" / "drum_2d.yaml").read_text())
+    case["simulation"]["end_time"] = steps * 4e-6
+    radius, spacing = 2e-3, 3.99e-3  # (a hexagonal bed, each disc pressed by 1 % of R)
+    centres = [
+        (col * spacing + (row % 2) * spacing / 2, -0.036 + row * spacing * np.sqrt(3) / 2)
+        for row in range(6) for col in range(-10, 11)
+    ]  # fmt: skip
+    centres = [(x, y) for x, y in centres if np.hypot(x, y) <= 0.04 - radius + 1e-5]
+    rng = np.random.default_rng(1)
+    temperatures = rng.uniform(300, 350, len(centres)).tolist()
+    case["insertion"] = [{"kind": "list", "material": "glass", "radius": radius,
+                          "positions": [[float(x), float(y)] for x, y in centres],
+                          "temperatures": temperatures}]  # fmt: skip
+    case["output"] = {"vtu": False, "timeseries_interval": 300 * 4e-6,
+                      "checkpoint_interval": 1500 * 4e-6, "checkpoint_keep": None}  # fmt: skip
+    case["neighbors"] = {"skin": 1e-4}  # (rebuilds and migration while the discs fall)
+    path = _write_case(tmp_path / "drum2d.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"d{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    serial, parallel = _final(tmp_path / "d1", steps), _final(tmp_path / "d2", steps)
+    assert np.abs(parallel["position"][:, 2]).max() == 0.0
+    assert np.abs(parallel["velocity"][:, 2]).max() == 0.0
+    start = _final(tmp_path / "d2", 0)["temperature"]
+    assert len(centres) > 70 and np.abs(parallel["temperature"] - start).max() > 1e-3
+    _assert_same_state(serial, parallel)
+    _assert_same_ledgers(tmp_path / "d1", tmp_path / "d2")
 
 
 def test_bisection_balances_and_tiles() -> None:
@@ -258,6 +292,25 @@ def test_bisection_balances_and_tiles() -> None:
             assert np.all(inside == 0.0)
         moved = d.rotated(1).owner(x)
         np.testing.assert_array_equal(moved, (owner + 1) % size)
+
+
+def test_bisection_of_discs_cuts_the_plane_only() -> None:
+    """Discs (planar) in a domain whose z slab is the longest side (1 m for zero thickness,
+    engine/simulation.py): the boxes are cut along x and y only, and balanced."""
+    from thermodem.mpi.decomposition import bisect
+
+    rng = np.random.default_rng(6)
+    lower, upper = np.array([0.0, 0.0, -0.5]), np.array([0.2, 0.1, 0.5])
+    x = rng.random((999, 3)) * (upper - lower) + lower
+    x[:, 2] = 0.0
+    for size in (2, 3, 4):
+        d = bisect(None, x, lower, upper, size, planar=True)
+        assert np.all(d.axis != 2), d.axis
+        np.testing.assert_array_equal(d.boxes[:, 0, 2], lower[2])
+        np.testing.assert_array_equal(d.boxes[:, 1, 2], upper[2])
+        counts = np.bincount(d.owner(x), minlength=size)
+        assert counts.max() - counts.min() <= 1, counts
+    assert np.any(bisect(None, x, lower, upper, 2).axis == 2)  # (3D: the longest side)
 
 
 # ----------------------------------------------------------------------- several ranks

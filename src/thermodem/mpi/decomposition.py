@@ -94,10 +94,12 @@ def bisect(
     lower: np.ndarray,
     upper: np.ndarray,
     size: int,
+    planar: bool = False,
 ) -> Decomposition:
     """RCB of the box [lower, upper] into ``size`` boxes, balancing the particles whose
     positions are ``position`` on this rank (and their counterparts on the others); a
-    collective call (``comm``: an mpi4py communicator, or None for one process)."""
+    collective call (``comm``: an mpi4py communicator, or None for one process). ``planar``
+    (discs in the plane z = 0): cut along x and y only."""
     from thermodem.mpi.exchange import allreduce_sum
 
     lower = np.asarray(lower, np.float64)
@@ -119,7 +121,10 @@ def bisect(
         return Decomposition(axis[:0], cut[:0], left[:0], right[:0], boxes)
     while level:
         m = len(level)
-        ax = np.array([int(np.argmax(hi - lo)) for _, lo, hi, _, _, _ in level], np.int64)
+        cut_axes = 2 if planar else 3
+        ax = np.array(
+            [int(np.argmax((hi - lo)[:cut_axes])) for _, lo, hi, _, _, _ in level], np.int64
+        )
         a = np.array([lo[ax[q]] for q, (_, lo, _, _, _, _) in enumerate(level)])
         b = np.array([hi[ax[q]] for q, (_, _, hi, _, _, _) in enumerate(level)])
         target = np.array([cnt * (r // 2) // r for _, _, _, _, r, cnt in level], np.int64)

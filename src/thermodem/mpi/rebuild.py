@@ -148,7 +148,9 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     if sim.decomposition is None or imbalance > sim.rebalance_threshold:
         if sim.decomposition is not None:
             sim.rebalances += 1
-        sim.decomposition = bisect(comm, owned.position, sim.lower, sim.upper, size)
+        sim.decomposition = bisect(
+            comm, owned.position, sim.lower, sim.upper, size, planar=bool(sim.planar)
+        )
     if sim.rotate_owners:  # (tests: every particle migrates, the results must not change)
         sim.decomposition = sim.decomposition.rotated(1)
     # 4. migration
@@ -189,6 +191,9 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
             ghi[a] = min(sim.upper[a], box[1, a] + h)
     sim._grid = (glo, ghi, gper)
     dims, edge = NB.cell_grid(glo, ghi, cell, gper)
+    if sim.planar:  # 2D: one cell layer along z (as the serial list, engine/neighbor_list.py)
+        dims[2] = 1
+        edge[2] = ghi[2] - glo[2]
     axis = int(SL.choose_axis(owned.position, glo, edge, dims)) if owned.count else 0
     axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
     order = _cell_order(owned.position, glo, edge, dims, axes)

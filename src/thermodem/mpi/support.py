@@ -37,7 +37,6 @@ NEIGHBOUR_RADIATION = ("zhou2009", "krause2017")
 
 #: (case key, why) of every refused feature, in the order they are checked (docs/mpi.md).
 REFUSED: tuple[tuple[str, str], ...] = (
-    ("simulation.dimension: 2", "two-dimensional discs"),
     ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
     ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
     ("thermal.radiation", "radiation from the neighbourhood (zhou2009, krause2017)"),
@@ -55,8 +54,6 @@ def _refuse(key: str, what: str) -> ConfigError:
 
 def check_case(case: Case) -> None:
     """ConfigError for the first case key that a multi-rank run does not support."""
-    if getattr(case.simulation, "dimension", 3) == 2:
-        raise _refuse("simulation.dimension = 2", "two-dimensional discs")
     th = case.thermal
     if th is None:
         return
