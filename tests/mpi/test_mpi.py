@@ -191,7 +191,8 @@ def test_plain_run_does_not_import_mpi4py(tmp_path: Path) -> None:
         (lambda c: c["thermal"].update(radiation={"model": "krause2017",
                                                   "environment_temperature": 300.0}),
          "thermal.radiation = 'krause2017'"),
-        (lambda c: c["thermal"].update(indirect_conduction="vargas_mccarthy2002"),
+        (lambda c: c["thermal"].update(indirect_conduction="voronoi_a",
+                                       gas={"thermal_conductivity": 0.026}),
          "thermal.indirect_conduction"),
     ],
 )  # fmt: skip
@@ -465,6 +466,36 @@ def test_frozen_mechanics_on_2_ranks(tmp_path: Path, heat: str) -> None:
     res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
     assert res.returncode == 0, res.stderr
     _assert_same_state(serial, _final(out, steps))
+
+
+@needs_mpi
+@pytest.mark.parametrize("frozen", [False, True])
+def test_contact_list_heat_term_on_2_ranks(tmp_path: Path, frozen: bool) -> None:
+    """Vargas & McCarthy (2002) indirect conduction, a heat term on the contact lists outside
+    the fused pass (over the list and the mirror list on several ranks), with Batchelor &
+    O'Brien simple: 300 steps of the settled bed on 2 ranks against the serial run; with
+    frozen mechanics (its conductances stored and reused) 60 thermal steps of 0.05 s."""
+    steps = 60 if frozen else 300
+    time_step = 0.05 if frozen else DT
+    case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=steps * time_step)
+    case["materials"]["glass"]["thermal_accommodation"] = 0.8
+    case["thermal"].update(indirect_conduction="vargas_mccarthy2002",
+                           gas={"thermal_conductivity": 0.026})  # fmt: skip
+    if frozen:
+        case["thermal"].update(frozen_mechanics=True, time_step=time_step)
+    case["output"] = {"vtu": False, "timeseries_interval": 20 * time_step,
+                      "checkpoint_interval": steps * time_step}  # fmt: skip
+    path = _write_case(tmp_path / "vm.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"v{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    serial, parallel = _final(tmp_path / "v1", steps), _final(tmp_path / "v2", steps)
+    _assert_same_state(serial, parallel)
+    _assert_same_ledgers(tmp_path / "v1", tmp_path / "v2")
+    from thermodem.io.run_files import read_timeseries
+
+    ledger = read_timeseries(tmp_path / "v2" / "timeseries.csv")
+    assert ledger["heat_rate_indirect_conduction"].min() > 1.0  # [W] (the term carries heat)
 
 
 @needs_mpi

@@ -319,7 +319,7 @@ THERMAL_LAYOUT: tuple[str, ...] = (
 #: checkpoint gathered from MPI ranks, thermodem.mpi.gather) with ``conductance_ready`` False.
 THERMAL_RECOMPUTED: tuple[str, ...] = (
     "k_p", "rhoc_p", "k_w", "rhoc_w", "fields", "pair_conductance", "wall_conductance",
-    "external_wall_conductance",
+    "external_wall_conductance", "mirror_conductance",
 )  # fmt: skip
 
 

@@ -136,6 +136,8 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
         # per-pair conductances of the other terms, stored with frozen mechanics
         self.term_conductance = [np.zeros(0) for _ in self.terms]
         self.term_wall_conductance = [np.zeros(0) for _ in self.terms]
+        #: (several MPI ranks: a contact term's conductances of the mirror list's pairs)
+        self.term_mirror_conductance = [np.zeros(0) for _ in self.terms]
         self.term_ready = np.zeros(len(self.terms), np.bool_)
         #: per-particle fields read by per-particle terms (columns: kernels/fields.py), filled
         #: by the providers of engine/fields.py before the terms run (fluid, porosity, ...)

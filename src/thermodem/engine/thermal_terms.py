@@ -277,31 +277,45 @@ class TermEvaluation:
         self.term_ready[index] = frozen
 
     def _contact_term(self, index: int, term: HeatTerm, frozen: bool) -> None:
+        """A heat term on the contact list (and, on several MPI ranks, on the mirror list:
+        pairs whose particle i is a ghost and j owned, whose heat j needs) and the wall
+        contacts."""
         sim = self.sim
         p = sim.particles
         pb, wb = sim.pairs, sim.walls
         by_mech = p.heat_columns
         store = frozen or self.record_conductances
         pair_h, wall_h = self._stored(index, pb.count if store else 0, wb.count if store else 0)
+        lists = [(pb, pair_h)]
+        mirror = getattr(sim, "mirror", None)
+        if mirror is not None and mirror.count:
+            mirror_h = self.term_mirror_conductance[index]
+            if store and mirror_h.shape[0] < mirror.count:
+                mirror_h = self.term_mirror_conductance[index] = np.zeros(mirror.capacity)
+                self.term_ready[index] = False
+            lists.append((mirror, mirror_h))
         if frozen and self.term_ready[index]:
-            passes.pair_heat_from_conductance(
-                pb.i, pb.j, pb.group_start, pair_h, p.temperature, term.column, by_mech,
-                self.conductance_sum,
-            )  # fmt: skip
+            for buf, h in lists:
+                passes.pair_heat_from_conductance(
+                    buf.i, buf.j, buf.group_start, h, p.temperature, term.column, by_mech,
+                    self.conductance_sum,
+                )  # fmt: skip
             passes.wall_heat_from_conductance(
                 wb.j, sim.wall_row_start, sim.wall_rows, wall_h, p.temperature,
                 term.wall_column, by_mech, self.conductance_sum,
             )  # fmt: skip
             return
         k_i, k_j = term.k_columns if self.override else (-1, -1)
-        rows = max(pb.ngroups, p.count // passes.WALL_CHUNK + 1)
+        rows = max(*(buf.ngroups for buf, _ in lists), p.count // passes.WALL_CHUNK + 1)
         scratch = self._term_rows(rows)
-        passes.contact_term_pair_pass(
-            p.position, p.radius, p.mass, p.temperature, p.type_id, pb.i, pb.j, pb.group_start,
-            pb.state, pb.normal_force, pb.history, sim.lower, sim.upper, sim.periodic,
-            self.radius_id, self.radius_table, term.evaluator, term.model_id, term.table, k_i,
-            k_j, self.k_p, scratch, term.column, by_mech, self.conductance_sum, store, pair_h,
-        )  # fmt: skip
+        for buf, h in lists:
+            passes.contact_term_pair_pass(
+                p.position, p.radius, p.mass, p.temperature, p.type_id, buf.i, buf.j,
+                buf.group_start, buf.state, buf.normal_force, buf.history, sim.lower,
+                sim.upper, sim.periodic, self.radius_id, self.radius_table, term.evaluator,
+                term.model_id, term.table, k_i, k_j, self.k_p, scratch, term.column, by_mech,
+                self.conductance_sum, store, h,
+            )  # fmt: skip
         passes.contact_term_wall_pass(
             p.position, p.radius, p.mass, p.temperature, p.type_id, wb.j, sim.wall_row_start,
             wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,

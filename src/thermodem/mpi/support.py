@@ -10,8 +10,9 @@ fluid), the per-particle terms that need no neighbours (convection with a fluid 
 uniform / table / expression / grid and a global porosity, radiation ``surroundings`` with
 its walls), fixed-temperature walls, fixed-temperature particles, heat flux and volumetric
 sources, external sources, heat generation (every model: the deposits of the contact passes,
-each rank keeping its own particles' side), checkpoints, frames (contact frames included) and
-time series.
+each rank keeping its own particles' side), heat terms on the contact lists outside the fused
+pass (vargas_mccarthy2002: over the list and the mirror list), frozen mechanics with the
+explicit scheme, discs (2D), checkpoints, frames (contact frames included) and time series.
 
 Refused, each with a message naming the case key (never a silently wrong result):
 """
@@ -40,7 +41,7 @@ REFUSED: tuple[tuple[str, str], ...] = (
     ("thermal.scheme", "the implicit schemes (backward Euler, CN, TR-BDF2, exponential)"),
     ("thermal.porosity.kind", "local porosities from the neighbours (cell, shell, voronoi)"),
     ("thermal.radiation", "radiation from the neighbourhood (zhou2009, krause2017)"),
-    ("thermal.indirect_conduction", "Voronoi (external pair set) and contact-target models"),
+    ("thermal.indirect_conduction", "Voronoi models (their external pair set)"),
 )
 
 
@@ -75,10 +76,9 @@ def check_case(case: Case) -> None:
             "MPI)",
         )
     ic = th.indirect_conduction
-    if ic is not None and ic.model != "none" and ic.spec.target != "range":
+    if ic is not None and ic.model != "none" and ic.spec.target not in ("range", "contacts"):
         what = {
             "external": "Voronoi models (their external pair set)",
-            "contacts": "heat terms on the contact lists outside the fused contact pass",
         }.get(ic.spec.target, f"heat terms on the pair set {ic.spec.target!r}")
         raise _refuse(f"thermal.indirect_conduction = {ic.model!r}", what)
 
@@ -87,11 +87,9 @@ def check_thermal(engine: ThermalEngine) -> None:
     """ConfigError for a heat term whose pair set MPI does not handle yet (the terms are
     known once the thermal engine has built them from the registry)."""
     for term in engine.terms:
-        if term.target in ("range", "particles"):  # (neighbourhood models: check_case)
+        if term.target in ("range", "contacts", "particles"):  # (neighbourhoods: check_case)
             continue
         what = {
             "external": "a Voronoi model (external pair set)",
-            "contacts": "a heat term on the contact lists outside the fused contact pass",
-            "particles": "a per-particle heat term",
         }.get(term.target, f"a heat term on the pair set {term.target!r}")
         raise _refuse(f"{term.key} = {term.choice.model!r}", what)
