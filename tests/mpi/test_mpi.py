@@ -176,21 +176,10 @@ def test_plain_run_does_not_import_mpi4py(tmp_path: Path) -> None:
     [
         (lambda c: c["thermal"].update(frozen_mechanics=True, time_step=1e-3,
                                        scheme="backward_euler"), "thermal.scheme"),
-        # per-particle terms that need the neighbours (the others run under MPI)
+        # the Voronoi porosity (cell, shell and global run under MPI)
         (lambda c: c["thermal"].update(convection="gunn1978", fluid={"temperature": 300.0},
-                                       porosity={"kind": "cell"}),
-         "thermal.porosity.kind = 'cell'"),
-        (lambda c: c["thermal"].update(radiation={"model": "surroundings",
-                                                  "environment_temperature": 800.0,
-                                                  "exposure": "fraction"},
-                                       porosity={"kind": "shell", "radius_ratio": 3.0}),
-         "thermal.porosity.kind = 'shell'"),
-        (lambda c: c["thermal"].update(radiation={"model": "zhou2009"},
-                                       fluid={"temperature": 300.0}, porosity=0.4),
-         "thermal.radiation = 'zhou2009'"),
-        (lambda c: c["thermal"].update(radiation={"model": "krause2017",
-                                                  "environment_temperature": 300.0}),
-         "thermal.radiation = 'krause2017'"),
+                                       porosity={"kind": "voronoi"}),
+         "thermal.porosity.kind = 'voronoi'"),
         (lambda c: c["thermal"].update(indirect_conduction="voronoi_a",
                                        gas={"thermal_conductivity": 0.026}),
          "thermal.indirect_conduction"),
@@ -208,9 +197,7 @@ def test_refused_under_mpi(change, key: str) -> None:  # noqa: ANN001
         check_case(case_from_dict(case))
     assert key in str(info.value)
     if "porosity" in key:  # (what runs instead)
-        assert "porosity: {kind: global, value: ...} runs under MPI" in str(info.value)
-    if "radiation" in key:
-        assert "radiation 'surroundings', with its walls, runs under MPI" in str(info.value)
+        assert "porosity cell, shell and global run under MPI" in str(info.value)
 
 
 @pytest.mark.parametrize(
@@ -496,6 +483,54 @@ def test_contact_list_heat_term_on_2_ranks(tmp_path: Path, frozen: bool) -> None
 
     ledger = read_timeseries(tmp_path / "v2" / "timeseries.csv")
     assert ledger["heat_rate_indirect_conduction"].min() > 1.0  # [W] (the term carries heat)
+
+
+#: per-particle terms whose fields sum over each particle's neighbours (the ghosts reach as
+#: far as the neighbourhoods: mpi/simulation.py: halo_width)
+NEIGHBOURHOODS = {
+    "gunn_cell_porosity": {"convection": "gunn1978", "porosity": {"kind": "cell"},
+                           "fluid": {"temperature": 500.0, "velocity": [0.0, 0.0, 0.5]}},
+    "surroundings_shell_porosity": {
+        "radiation": {"model": "surroundings", "environment_temperature": 800.0,
+                      "exposure": "fraction"},
+        "porosity": {"kind": "shell", "radius_ratio": 3.0}},
+    "zhou2009": {"radiation": {"model": "zhou2009"}, "porosity": {"kind": "shell"},
+                 "fluid": {"temperature": 500.0}},
+    "krause2017": {"radiation": {"model": "krause2017", "environment_temperature": 800.0}},
+}  # fmt: skip
+
+
+@needs_mpi
+@pytest.mark.parametrize("name", sorted(NEIGHBOURHOODS))
+def test_neighbourhood_fields_on_2_ranks(tmp_path: Path, name: str) -> None:
+    """Cell and shell porosities and the continuum radiation models (Zhou et al. 2009,
+    Krause et al. 2017) sum over the neighbours of each particle, which may be other ranks'
+    particles: the settled bed with the contact conduction over 200 steps on 2 ranks against
+    the serial run (the cut runs through the bed), and the 2-rank checkpoint of step 100 (its
+    neighbourhood set and listing emptied: they hold a rank's indices) continued serially."""
+    steps = 200
+    case = bed_case(DATA / "mpi_bed_box.txt", heat="contact", end_time=steps * DT)
+    case["materials"]["glass"]["emissivity"] = 0.9
+    case["thermal"].update(NEIGHBOURHOODS[name])
+    case["output"] = {"vtu": False, "timeseries_interval": 50 * DT,
+                      "checkpoint_interval": 100 * DT, "checkpoint_keep": None}  # fmt: skip
+    path = _write_case(tmp_path / "nb.yaml", case)
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", str(tmp_path / f"n{ranks}"), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    serial, parallel = _final(tmp_path / "n1", steps), _final(tmp_path / "n2", steps)
+    _assert_same_state(serial, parallel)
+    _assert_same_ledgers(tmp_path / "n1", tmp_path / "n2")
+    from thermodem.io.run_files import read_timeseries
+
+    ledger = read_timeseries(tmp_path / "n2" / "timeseries.csv")
+    column = "heat_in_convection" if "convection" in NEIGHBOURHOODS[name] else "heat_in_radiation"
+    assert abs(ledger[column][-1]) > 0.0
+    checkpoint = tmp_path / "n2" / "checkpoints" / "checkpoint_000000100.h5"
+    out = tmp_path / "from2on1"
+    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
+    assert res.returncode == 0, res.stderr
+    _assert_same_state(serial, _final(out, steps))
 
 
 @needs_mpi

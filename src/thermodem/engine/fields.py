@@ -383,7 +383,11 @@ class FieldProvider(FluidSources):
             if self.radiation_mode & nh.NB_KRAUSE:
                 nh.neighbourhood_weights(p.radius, p.temperature, p.type_id, self.emissivity,
                                          area, emission)  # fmt: skip
-            nh.neighbourhood_sums(p.position, p.radius, p.temperature, *self.members, area,
+            # the rows of the owned particles (all; on several MPI ranks not the ghosts, whose
+            # rows lack the neighbours beyond the halo: their owners sum theirs)
+            offsets, border, index = self.members
+            nh.neighbourhood_sums(p.position, p.radius, p.temperature,
+                                  offsets[: sim.owned_count + 1], border, index, area,
                                   emission, member_area, member_count, sim.lower, sim.upper,
                                   sim.periodic, self.radiation_ratio, self.radiation_mode,
                                   fields)  # fmt: skip
@@ -396,8 +400,9 @@ class FieldProvider(FluidSources):
             width = 4 * max(sim.wall_kind.shape[0], 1)
             if self.scratch.shape[0] < self._chunks() or self.scratch.shape[1] < width:
                 self.scratch = np.zeros((self._chunks(), width))
-            pk.shell_porosity(p.position, p.radius, sim.wall_kind, sim.wall_rows,
-                              self.shell_ratio, self.lattice, self.sums, self.scratch,
+            own = sim.owned_count  # (as above: the owned particles' shells)
+            pk.shell_porosity(p.position[:own], p.radius[:own], sim.wall_kind, sim.wall_rows,
+                              self.shell_ratio, self.lattice, self.sums[:own], self.scratch,
                               fields)  # fmt: skip
 
     def _list_members(self) -> None:
@@ -456,6 +461,39 @@ class FieldProvider(FluidSources):
         nh.member_constants(*self.members, area, member_area, member_count)
         self.member_sums = (area, emission, member_area, member_count)
 
+    # ---------------------------------------------------------------- several ranks
+    def _largest_radius(self) -> float:
+        """R_max of the whole simulation (on several MPI ranks a reduction: every rank must
+        make the same cells)."""
+        p = self.sim.particles
+        local = float(p.radius.max()) if p.count else 0.0
+        comm = getattr(self.sim, "comm", None)
+        if comm is None:
+            return local
+        from thermodem.mpi.exchange import allreduce_max
+
+        return float(allreduce_max(comm, np.array([local]))[0])
+
+    def default_cell_size(self, r_max: float) -> float:
+        """Edge asked for the porosity cells: ``cell_size``, else 6 R_max [m]."""
+        return float(self.porosity.cell_size or 6.0 * r_max)
+
+    def halo_reach(self, r_max: float) -> float:
+        """The largest centre distance [m] at which another particle enters a particle's
+        fields (several MPI ranks: the ghosts must hold these neighbours): q R_max for the
+        continuum radiation's sphere, (q + 1) R_max for a porosity shell (the neighbours
+        that cut it), and the largest cell edge (at most 1.5 × the size asked, rounded to
+        tile the domain) for the cell porosity; 0 without such a field."""
+        reach = self.radiation_ratio * r_max
+        if self.shell_ratio > 0.0:
+            reach = max(reach, (self.shell_ratio + 1.0) * r_max)
+        if isinstance(self.porosity, CellPorosity) and r_max > 0.0:
+            size = self.default_cell_size(r_max) if self.cell_size == 0.0 else self.cell_size
+            length = self.sim.upper - self.sim.lower
+            dims = np.maximum(np.round(length / size), 1.0)
+            reach = max(reach, float(np.max(length / dims)))
+        return reach
+
     # ------------------------------------------------------------------ cell porosity
     def _cell_grid(self, size: float) -> None:
         """Cells of edge ``size`` (rounded to tile the domain)."""
@@ -474,7 +512,7 @@ class FieldProvider(FluidSources):
         sim = self.sim
         p = sim.particles
         if self.cell_fluid.shape[0] == 0:
-            self._cell_grid(self.porosity.cell_size or 6.0 * float(p.radius.max()))
+            self._cell_grid(self.default_cell_size(self._largest_radius()))
         geometry = np.concatenate([sim.wall_rows[:, :6], sim.wall_rows[:, 9:15]], axis=1)
         if self._cell_walls.shape != geometry.shape or not np.array_equal(
             self._cell_walls, geometry

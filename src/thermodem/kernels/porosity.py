@@ -166,9 +166,11 @@ def cell_moves(position, lower, edge, dims, cell, part):
 def cell_porosity(position, radius, lower, edge, dims, fluid_volume, solid, cell, fields):
     """Porosity of the cell of each particle's centre, 1 - V_solid / V_cell, clipped to
     [0, 1]: V_solid the volume of the particles whose centre is in the cell, V_cell the
-    cell's volume on the particles' side of the walls (:func:`cell_fluid_volume`)."""
+    cell's volume on the particles' side of the walls (:func:`cell_fluid_volume`). Every
+    particle given is binned; the first ``fields.shape[1]`` take their cell's porosity (on
+    several MPI ranks the owned ones: the ghosts are binned, their owners take theirs)."""
     _bin_solid(position, radius, lower, edge, dims, solid, cell)
-    n = position.shape[0]
+    n = fields.shape[1]
     for c in prange((n + CHUNK - 1) // CHUNK):
         for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
             k = cell[i]

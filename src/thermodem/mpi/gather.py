@@ -357,7 +357,8 @@ def gathered_state(sim: DistributedSimulation) -> dict | None:
 def _thermal_state(
     sim: DistributedSimulation, conductance_sum: np.ndarray, cumulative: dict
 ) -> dict:
-    from thermodem.engine.thermal_ledger import RANGE_PREFIX
+    from thermodem.engine.fields import MEMBER_ARRAYS
+    from thermodem.engine.thermal_ledger import FIELDS_PREFIX, RANGE_PREFIX
 
     th = sim.thermal
     state = th.state_dict()
@@ -370,16 +371,30 @@ def _thermal_state(
             arrays[name] = np.zeros((0, *arrays[name].shape[1:]), arrays[name].dtype)
     if "term_ready" in arrays:
         arrays["term_ready"] = np.zeros_like(arrays["term_ready"])
+    # the pair sets hold this rank's indices: empty, built again at the first use
     if "range_set" in scalars:
-        rs = dict(scalars["range_set"])
-        rs.update(count=0, wall_count=0, valid=False)
-        scalars["range_set"] = rs
-        for name in ("i", "j", "wall_i", "wall_w"):
-            arrays[f"{RANGE_PREFIX}{name}"] = np.zeros(0, np.int32)
-        arrays[f"{RANGE_PREFIX}group_start"] = np.zeros(2, np.int64)
-        arrays[f"{RANGE_PREFIX}reference"] = np.zeros((0, 3))
-        arrays[f"{RANGE_PREFIX}wall_row_start"] = np.zeros(1, np.int64)
+        scalars["range_set"] = _emptied_set(scalars["range_set"], arrays, RANGE_PREFIX)
+    fields = scalars.get("field_provider")
+    if fields is not None and "neighbourhood" in fields:
+        fields = dict(fields)
+        fields["neighbourhood"] = _emptied_set(fields["neighbourhood"], arrays, FIELDS_PREFIX)
+        fields.pop("members", None)  # (the radiation's listing: made again from the set)
+        for name in (*MEMBER_ARRAYS, "members_reference"):
+            arrays.pop(f"{FIELDS_PREFIX}{name}", None)
+        scalars["field_provider"] = fields
     return state
+
+
+def _emptied_set(scalars: dict, arrays: dict, prefix: str) -> dict:
+    """The state of a range pair set (engine/range_set.py) with no pairs, to be built again."""
+    out = dict(scalars)
+    out.update(count=0, wall_count=0, valid=False)
+    for name in ("i", "j", "wall_i", "wall_w"):
+        arrays[f"{prefix}{name}"] = np.zeros(0, np.int32)
+    arrays[f"{prefix}group_start"] = np.zeros(2, np.int64)
+    arrays[f"{prefix}reference"] = np.zeros((0, 3))
+    arrays[f"{prefix}wall_row_start"] = np.zeros(1, np.int64)
+    return out
 
 
 def load_distributed(sim: DistributedSimulation, state: dict) -> None:

@@ -509,7 +509,8 @@ def halo_members(
 
 
 def halo_width(sim: DistributedSimulation, r_max: float) -> float:
-    """2 R_max + skin + max(extra distance, largest conducting gap of the range set)."""
+    """2 R_max + skin + max(extra distance, largest conducting gap of the range set, the
+    reach of the neighbourhood fields beyond 2 R_max: engine/fields.py: halo_reach)."""
     gap = 0.0
     th = sim.thermal
     if th is not None and r_max > 0.0:  # (no particles yet: a restart's empty start)
@@ -517,6 +518,7 @@ def halo_width(sim: DistributedSimulation, r_max: float) -> float:
             if term.target == "range":
                 g, w = term.max_gap(r_max)
                 gap = max(gap, g)
+        gap = max(gap, th.field_provider.halo_reach(r_max) - 2.0 * r_max)
     return 2.0 * r_max + (sim.skin or 0.0) + max(sim.extra, gap)
 
 
