@@ -40,12 +40,13 @@ from thermodem.engine import diagnostics as D
 from thermodem.engine import external_loads as EL
 from thermodem.engine.malloc import fix_mmap_threshold
 from thermodem.engine.neighbor_list import rebuild_due, rebuild_lists
+from thermodem.engine.simulation_insertion import ParticleInsertion
 from thermodem.engine.simulation_ledger import LEDGER_DISSIPATION, SimulationLedger
 from thermodem.engine.threads import ThreadGovernor, apply_threads
 from thermodem.engine.validation import check_completeness, check_insertion_memory
 from thermodem.errors import SimulationError
 from thermodem.geometry import wall_layout as WL
-from thermodem.geometry.insertion import InsertedParticles, Pourer, insert
+from thermodem.geometry.insertion import Pourer, insert
 from thermodem.geometry.walls import wall_rows
 from thermodem.kernels import contact as C
 from thermodem.kernels import pair_pass as PP
@@ -81,7 +82,7 @@ def history_layout_of(case: Case) -> HistoryLayout:
     )
 
 
-class Simulation(SimulationLedger):
+class Simulation(ParticleInsertion, SimulationLedger):
     """A thermal DEM simulation built from a validated :class:`~thermodem.config.schema.Case`."""
 
     #: the MPI communicator of a run on several ranks (``thermodem.mpi``); None here
@@ -297,61 +298,6 @@ class Simulation(SimulationLedger):
         """The explicit Euler limit, its particle (global id) and the first particle with a
         bad temperature (global id or -1) of the whole simulation (the arguments here)."""
         return limit, limit_particle, bad_particle, bad_temperature
-
-    # ------------------------------------------------------------------ particles in and out
-    def add_particles(self, new: InsertedParticles) -> None:
-        """Append particles of one material; they get fresh global ids."""
-        extra = self.new_particles(new)
-        if extra is None:
-            return
-        self.particles.append(extra)
-        if hasattr(self, "reference"):
-            self.reference = np.concatenate([self.reference, extra.position])
-        self._needs_rebuild = True
-
-    def pour(self) -> None:
-        """Insert the batches of the pour entries that are due at this step's time."""
-        for pourer in self.pourers:
-            if pourer.due(self.time, self.dt):
-                p = self.particles
-                self.add_particles(pourer.emit(self.time, p.position, p.radius))
-
-    def new_particles(self, new: InsertedParticles) -> Particles | None:
-        """The particle arrays of ``new`` (None if empty), with fresh global ids, their
-        external loads, and their energies entered in the ledgers (not yet added)."""
-        n = len(new)
-        if n == 0:
-            return None
-        t = self.material_index[new.material]
-        temperature = new.temperature
-        if temperature is None and self.thermal is not None:
-            temperature = self.thermal.initial_temperature(new.position, np.full(n, t))
-        elif temperature is None:
-            temperature = np.full(n, self.case.simulation.initial_temperature)
-        gids = np.arange(self.next_global_id, self.next_global_id + n, dtype=np.int64)
-        self.next_global_id += n
-        extra = Particles.create(
-            new.position,
-            new.radius,
-            np.full(n, self.density[t]),
-            np.full(n, t, np.int32),
-            gids,
-            new.velocity,
-            temperature,
-            mechanisms=self.mechanisms,
-            external=bool(self.case.external_force),
-            disc_thickness=self.disc_thickness,
-            generation=self.generation,
-        )
-        EL.assign(self.case, extra, self.material_index)
-        if hasattr(self, "ledger_cumulative"):
-            self.ledger_cumulative["inserted_energy"] += float(
-                0.5 * np.sum(extra.mass * np.sum(extra.velocity**2, axis=1))
-                - np.sum(extra.mass * (extra.position @ self.gravity))
-            )
-        if self.thermal is not None and hasattr(self, "ledger_cumulative"):
-            self.thermal.inserted(extra.temperature, extra.mass, extra.type_id)
-        return extra
 
     # ------------------------------------------------------------------------- neighbours
     def rebuild(self) -> None:

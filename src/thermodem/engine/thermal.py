@@ -24,9 +24,10 @@ mechanisms (walls, sources, ...), minus the heat absorbed by fixed-temperature p
 (pairwise terms cancel by construction); ``balance_error`` returns the difference, which is
 round-off.
 
-The class is split by concern: this module (set-up, contact conduction, the explicit step),
+The class is split by concern: this module (set-up, the explicit step),
+``engine/thermal_contacts.py`` (the contact conduction's heat-only passes),
 ``engine/thermal_terms.py`` (the other terms' passes) and ``engine/thermal_ledger.py`` (ledger
-and checkpoint state), the last two as mixins.
+and checkpoint state), the last three as mixins.
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ from thermodem.engine.fields import FieldProvider
 from thermodem.engine.range_set import RangePairSet
 from thermodem.engine.terms import build_generation, build_terms
 from thermodem.engine.thermal_conditions import ThermalConditions
+from thermodem.engine.thermal_contacts import ContactConduction
 from thermodem.engine.thermal_ledger import ThermalLedger
 from thermodem.engine.thermal_terms import TermEvaluation
 from thermodem.engine.voronoi import VoronoiProvider
@@ -56,7 +58,7 @@ if TYPE_CHECKING:
     from thermodem.engine.simulation import Simulation
 
 
-class ThermalEngine(TermEvaluation, ThermalLedger):
+class ThermalEngine(ContactConduction, TermEvaluation, ThermalLedger):
     """Owns every thermal array and the thermal step of a :class:`Simulation`."""
 
     def __init__(self, sim: Simulation, settings: ThermalSettings) -> None:
@@ -332,17 +334,6 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
         if self.mirror_conductance.shape[0] < mirror_capacity:
             self.mirror_conductance = np.zeros(mirror_capacity)
 
-    def _contact_lists(self) -> list[tuple]:
-        """The contact lists of the heat-only passes with their conductance arrays: the list
-        and, on several MPI ranks, the mirror list (pairs whose particle i is a ghost and j
-        owned, mpi/simulation.py), whose heat the owned particle j needs."""
-        sim = self.sim
-        out = [(sim.pairs, self.pair_conductance)]
-        mirror = getattr(sim, "mirror", None)
-        if mirror is not None and mirror.count:
-            out.append((mirror, self.mirror_conductance))
-        return out
-
     def prepare(self, time: float) -> None:
         """Buffers, wall temperatures at ``time``, fixed particles and sources, and the k(T),
         ρc(T) arrays for the passes of this thermal step."""
@@ -387,73 +378,6 @@ class ThermalEngine(TermEvaluation, ThermalLedger):
         n = self.sim.particles.count
         if self.conductance_sum.shape[0] != n:
             self.conductance_sum = np.zeros(n)
-
-    def conduction_passes(self) -> None:
-        """Contact conduction by the heat-only passes (frozen mechanics, start): zeroes the
-        mechanism columns and the conductance sums, then adds the contact conduction (on
-        several MPI ranks over the list and the mirror list: every owned particle's pairs).
-
-        With frozen mechanics and temperature-independent properties the conductances cannot
-        change (same positions, contacts, forces and materials), so after the first pass only
-        the heat rates H (T_j - T_i) are recomputed from them (bit-identical, tested).
-        """
-        sim = self.sim
-        p = sim.particles
-        by_mech = p.heat_columns
-        passes.zero_heat(by_mech, self.conductance_sum)
-        if not self.contact.active:
-            return
-        reuse = self.reuse_conductance and self.settings.frozen_mechanics and self.override == 0
-        lists = self._contact_lists()
-        if not (reuse and self.conductance_ready):
-            pair_pass = kernels.conduction_pair_pass_for(
-                self.radius_id, self.conduction_id, self.override
-            )
-            for buf, conductance in lists:
-                pair_pass(
-                    p.position, p.radius, p.mass, p.temperature, p.type_id, buf.i, buf.j,
-                    buf.count, buf.state, buf.normal_force, buf.history, sim.lower, sim.upper,
-                    sim.periodic, self.radius_id, self.radius_table, self.conduction_id,
-                    self.conduction_table, self.override, self.k_p, self.rhoc_p, self.scratch,
-                    conductance, sim.history_layout.reuse, self.tolerance,
-                )  # fmt: skip
-            self._wall_conductances()
-            self.conductance_ready = reuse
-        for buf, conductance in lists:
-            passes.pair_heat_from_conductance(
-                buf.i, buf.j, buf.group_start, conductance, p.temperature, heat.M_DIRECT,
-                by_mech, self.conductance_sum,
-            )  # fmt: skip
-        self._wall_heat()
-
-    def wall_conduction(self) -> None:
-        """The contact conduction of the wall pairs, after the fused contact pass (which
-        conducts through the particle pairs only; kernels/pair_pass.py)."""
-        self._wall_conductances()
-        self._wall_heat()
-
-    def _wall_conductances(self) -> None:
-        if not self.walls_conduct:  # adiabatic walls: every wall pair's H stays 0
-            return
-        sim = self.sim
-        p, wb = sim.particles, sim.walls
-        kernels.conduction_wall_pass_for(self.radius_id, self.conduction_id, self.override)(
-            p.position, p.radius, p.mass, p.temperature, p.type_id, wb.i, wb.j, wb.count,
-            wb.state, wb.normal_force, wb.history, sim.wall_kind, sim.wall_rows,
-            sim.wall_material, self.radius_id, self.radius_table, self.conduction_id,
-            self.conduction_table, self.override, self.k_p, self.rhoc_p, self.k_w, self.rhoc_w,
-            self.scratch, self.wall_conductance, sim.history_layout.reuse, self.tolerance,
-        )  # fmt: skip
-
-    def _wall_heat(self) -> None:
-        if not self.walls_conduct:
-            return
-        sim = self.sim
-        p = sim.particles
-        passes.wall_heat_from_conductance(
-            sim.walls.j, sim.wall_row_start, sim.wall_rows, self.wall_conductance, p.temperature,
-            heat.M_WALL_DIRECT, p.heat_columns, self.conductance_sum,
-        )  # fmt: skip
 
     # ------------------------------------------------------------------------- the rates
     def compute_rates(self, time: float) -> np.ndarray:
