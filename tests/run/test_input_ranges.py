@@ -547,6 +547,7 @@ def test_a_heat_generation_mechanism_the_contact_laws_cannot_produce_is_told(
 
     def told(contact: dict, generation: dict | str) -> list[str]:
         data = json.loads(json.dumps(CASE))
+        data["materials"]["glass"]["rolling_friction"] = 0.1  # (the default 0 gives no heat)
         data["contact"] = contact
         data["thermal"] = {"heat_generation": generation}
         return generation_mechanism_warnings(case_from_dict(data))

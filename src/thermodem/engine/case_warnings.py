@@ -229,34 +229,56 @@ def _mechanism_zero_reason(mechanism: str, case: Case) -> str | None:
 def generation_mechanism_warnings(case: Case) -> list[str]:
     """A heat generation mechanism the case names (``mechanical_dissipation``'s listed
     ``mechanisms``, ``rojek2014``'s sliding friction, ``richard2008``'s normal damping) that
-    the contact laws cannot produce: it gives zero heat. A warning each, naming the mechanism,
-    the contact law and why. ``mechanical_dissipation``'s default list (all five) is not told
-    about."""
+    the contact laws cannot produce, or that the material values switch off for every pair of
+    materials that can meet (sliding friction 0, restitution 1, ...:
+    ``engine/generation_materials.py``): it gives zero heat. A warning each, naming the
+    mechanism and why (the law, or the keys and values). ``mechanical_dissipation``'s default
+    list (all five) is told about only when none of them gives heat."""
+    from thermodem.engine.generation_materials import material_zero_reason
+
     th = case.thermal
     if th is None:
         return []
     generation = th.heat_generation
     key = f"thermal.heat_generation = {generation.model!r}"
+    default = False
     if generation.model == "mechanical_dissipation":
-        if "mechanisms" not in generation.params.model_fields_set:
-            return []
         listed = list(generation.params.mechanisms)
-        key = "thermal.heat_generation.mechanisms"
+        default = "mechanisms" not in generation.params.model_fields_set
+        if not default:
+            key = "thermal.heat_generation.mechanisms"
     elif generation.model == "rojek2014":
         listed = ["sliding_friction"]
     elif generation.model == "richard2008":
         listed = ["normal_damping"]
     else:
         return []
-    out = []
+    out, reasons = [], []
     for mechanism in listed:
         reason = _mechanism_zero_reason(mechanism, case)
         if reason is not None:
+            reasons.append(f"{mechanism!r}: {reason}")
             out.append(
                 f"{key}: {mechanism!r} gives zero heat with these contact laws: {reason}; "
                 "remove it, or choose a contact law that dissipates that way"
             )
-    return out
+            continue
+        reason = material_zero_reason(mechanism, case)
+        if reason is not None:
+            reasons.append(f"{mechanism!r}: {reason}")
+            out.append(
+                f"{key}: {mechanism!r} gives zero heat with these material values: {reason}; "
+                "remove it, or give values that dissipate that way"
+            )
+    if not default:
+        return out
+    if len(reasons) < len(listed):
+        return []
+    return [
+        f"{key} gives zero heat: none of its mechanisms (the default, all five) dissipates with "
+        f"these contact laws and material values ({'; '.join(reasons)}); give values that "
+        "dissipate, or heat_generation: none"
+    ]
 
 
 def time_table_warnings(case: Case) -> list[str]:

@@ -286,8 +286,8 @@ def periodic_gradient(
 def effective_conductivity_of_case(case, axes: str = "xyz", **options) -> list[AxisConductivity]:  # noqa: ANN001, ANN003
     """Build the simulation of a case (its initial packing and contacts) and measure k_eff
     (``periodic=True``: by the periodic gradient, the other options then do not apply)."""
-    from thermodem.engine.simulation import Simulation
+    from thermodem.engine.validation import built_simulation
 
     if options.pop("periodic", False):
-        return periodic_gradient(Simulation(case), axes)
-    return effective_conductivity(Simulation(case), axes, **options)
+        return periodic_gradient(built_simulation(case), axes)
+    return effective_conductivity(built_simulation(case), axes, **options)

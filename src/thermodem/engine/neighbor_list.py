@@ -62,10 +62,15 @@ def rebuild_lists(sim: Simulation) -> None:
     length = sim.upper - sim.lower
     for a in range(3):
         if sim.periodic[a] and length[a] < 2.0 * cell:
+            r_max = float(p.radius.max())
             raise SimulationError(
-                f"periodic axis {'xyz'[a]}: domain length {length[a]:.6g} m is shorter than "
-                f"twice the interaction cut-off {cell:.6g} m (minimum image needs >= "
-                f"{2 * cell:.6g} m)",
+                f"domain.periodic: axis {'xyz'[a]} is periodic, but the domain is "
+                f"{length[a]:.6g} m long along it (domain.upper - domain.lower), shorter than "
+                f"twice the neighbour cell {cell:.6g} m (2 R_max {2.0 * r_max:.6g} m + "
+                + (f"neighbors.extra_distance {sim.extra:.6g} m + " if sim.extra else "")
+                + f"neighbors.skin {sim.skin or 0.0:.6g} m); the minimum image needs >= "
+                f"{2 * cell:.6g} m: a longer periodic axis, smaller particles or a smaller "
+                "neighbors.skin",
                 sim.step_count,
                 sim.time,
             )

@@ -76,6 +76,7 @@ from thermodem.engine.run_info import output_summary  # noqa: F401 (re-exported)
 from thermodem.engine.run_signals import Starting, StopRequest, not_started
 from thermodem.engine.simulation import Simulation
 from thermodem.engine.validation import (
+    built_simulation,
     check_completeness,
     check_resources,
     estimate_resources,
@@ -564,7 +565,7 @@ def run_case(
         try:
             try:
                 with starting, logged_warnings(runlog):
-                    sim = Simulation(case, threads=threads)
+                    sim = built_simulation(case, threads)
                     for warning in pre_run_checks(sim):  # (the MPI runner calls the same)
                         runlog.warn(warning)
                     _header(runlog, sim, threads, output)

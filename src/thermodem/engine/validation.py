@@ -67,7 +67,7 @@ from thermodem.engine.start_checks import (
     check_wall_overlaps,
     check_walls_in_domain,
 )
-from thermodem.errors import ConfigError
+from thermodem.errors import ConfigError, SimulationError
 
 if TYPE_CHECKING:
     from thermodem.config.schema import Case
@@ -359,6 +359,20 @@ def with_warnings(exc: ConfigError, case: Case, told: list[str] | None = None) -
     return exc
 
 
+def built_simulation(case: Case, threads: int | None = None) -> Simulation:
+    """``Simulation(case)`` of a fresh run (``validate``, ``run``, ``etc``): a SimulationError
+    met while it is built, before step 0 (a periodic axis shorter than two neighbour cells of
+    the inserted particles, a tessellation the start positions cannot make), is an error of
+    the input, not of a run: a ConfigError with its message (exit code 2). Failures met while
+    the run steps stay SimulationErrors."""
+    from thermodem.engine.simulation import Simulation
+
+    try:
+        return Simulation(case, threads=threads)
+    except SimulationError as exc:
+        raise ConfigError(f"{exc} (met while the case was built, before any step)") from None
+
+
 @dataclass
 class Validation:
     case: Case
@@ -370,12 +384,11 @@ class Validation:
 def validate_case(path: str | os.PathLike[str], threads: int | None = None) -> Validation:
     """Layers 1-3 for a case file; raises ConfigError at the first layer that fails."""
     from thermodem.config.load import load_case
-    from thermodem.engine.simulation import Simulation
 
     case = load_case(path)
     try:
         check_completeness(case)
-        sim = Simulation(case, threads=threads)
+        sim = built_simulation(case, threads)
         warnings = pre_run_checks(sim)
     except ConfigError as exc:
         with_warnings(exc, case)
