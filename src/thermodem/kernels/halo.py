@@ -43,6 +43,23 @@ def unpack_moving(
 
 
 @njit(cache=True, error_model="numpy")
+def rows_with_history(history, pair_i, count, selected, out):
+    """The rows k < ``count`` whose history has a non-zero value and whose particle
+    ``pair_i[k]`` is ``selected``, into ``out``; returns how many (one pass: numpy's
+    ``any(history != 0, axis=1)`` made a temporary of the whole history)."""
+    m = 0
+    for k in range(count):
+        if not selected[pair_i[k]]:
+            continue
+        for c in range(history.shape[1]):
+            if history[k, c] != 0.0:
+                out[m] = k
+                m += 1
+                break
+    return m
+
+
+@njit(cache=True, error_model="numpy")
 def key_positions(keys, wanted, table, out):
     """``out[q]``: the index k with ``keys[k] == wanted[q]``, -1 when absent (keys unique and
     non-negative). An open-addressing hash table (``table``: int64, a power of two >= 2 and

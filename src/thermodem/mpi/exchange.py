@@ -133,6 +133,31 @@ def take_particles(p: Particles, index: np.ndarray | slice) -> Particles:
     return Particles(**{f.name: _take(getattr(p, f.name), index) for f in fields(p)})
 
 
+def take_joined(a: Particles, a_rows: np.ndarray, b: Particles, b_rows: np.ndarray) -> Particles:
+    """The particles ``a_rows`` of ``a`` followed by ``b_rows`` of ``b``, each array copied
+    once into its new place (a take and a concatenation would copy ``a``'s rows twice)."""
+    na, nb = a_rows.shape[0], b_rows.shape[0]
+    arrays = {}
+    for f in fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        order = "F" if _fortran(x) else "C"
+        out = np.empty((na + nb, *x.shape[1:]), x.dtype, order=order)
+        if order == "F":  # (the heat rates by mechanism: row blocks through the transpose)
+            out.T[:, :na] = x.T[:, a_rows]
+            out.T[:, na:] = y.T[:, b_rows]
+        else:
+            np.take(x, a_rows, axis=0, out=out[:na], mode="clip")
+            np.take(y, b_rows, axis=0, out=out[na:], mode="clip")
+        arrays[f.name] = out
+    return Particles(**arrays)
+
+
+def view_particles(p: Particles, rows: slice) -> Particles:
+    """The particles ``rows`` as views of ``p``'s arrays (no copy: the caller must not
+    change ``p`` while it uses them)."""
+    return Particles(**{f.name: getattr(p, f.name)[rows] for f in fields(p)})
+
+
 def _joined(arrays: list[np.ndarray]) -> np.ndarray:
     if _fortran(arrays[0]):
         return np.ascontiguousarray(np.concatenate([a.T for a in arrays], axis=1)).T

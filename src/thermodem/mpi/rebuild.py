@@ -30,7 +30,7 @@ from thermodem.geometry import wall_layout as WL
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
 from thermodem.kernels import slabs as SL
-from thermodem.kernels.halo import key_positions
+from thermodem.kernels.halo import key_positions, rows_with_history
 from thermodem.mpi import exchange as X
 from thermodem.mpi.decomposition import bisect
 from thermodem.state.pairs import PairBuffers
@@ -47,7 +47,8 @@ def pair_records(
     particle i is ``selected`` (a mask over the particles), and the index of each one's i."""
     c = buf.count
     history = buf.history[:c]
-    keep = np.nonzero(np.any(history != 0.0, axis=1) & selected[buf.i[:c]])[0]
+    keep = np.empty(c, np.int64)
+    keep = keep[: rows_with_history(history, buf.i, c, selected, keep)]
     owner = buf.i[keep].astype(np.int64)
     rows = np.empty((keep.shape[0], 2 + history.shape[1]))
     rows[:, 0] = global_id[owner]
@@ -116,8 +117,8 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     if th is not None:
         cs = th.conductance_sum if th.conductance_sum.shape[0] == n_all else np.zeros(n_all)
         extras = (cs,)
-    owned = X.take_particles(p, share)
-    extra_own = tuple(e[share].copy() for e in extras)
+    owned = X.view_particles(p, share)  # (views: the cell sort below copies them)
+    extra_own = tuple(e[share] for e in extras)
     del p
     if sim.poured:  # particles poured since the last rebuild (rank 0): owned until migrated
         k = sum(q.count for q in sim.poured)
@@ -170,7 +171,9 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     for recs, owner in ((records, rec_owner), (wall_records, wall_owner)):
         go = leave[owner]
         sent, _ = X.alltoallv_rows(comm, _split(dest[owner[go]], recs[go], size), rec_width)
-        moved_records.append(np.concatenate([recs[~go], sent]))
+        if go.any() or sent.shape[0]:  # (else the records stay as they are: no copy)
+            recs = np.concatenate([recs[~go], sent])
+        moved_records.append(recs)
     records, wall_records = moved_records
     if leaving.shape[0] or arrived.count:  # (else the owned particles stay as they are)
         staying = np.nonzero(~leave)[0]
@@ -197,21 +200,22 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     axis = int(SL.choose_axis(owned.position, glo, edge, dims)) if owned.count else 0
     axes = np.array([axis, *(a for a in range(3) if a != axis)], np.int64)
     order = _cell_order(owned.position, glo, edge, dims, axes)
-    owned = X.take_particles(owned, order)
-    extra_own = [e[order] for e in extra_own]
     own = owned.count
+    # (the owned particles are copied in this order once, with the ghosts after them, in 7;
+    # until then the sorted positions and ids alone, and the sorted index k is order[k])
+    sorted_position = owned.position[order]
     # 6. ghosts with their records
     neighbours = neighbour_ranks(sim, h)
-    rec_owner = _positions_of(owned.global_id, records[:, 0].astype(np.int64))
+    rec_owner = _positions_of(owned.global_id[order], records[:, 0].astype(np.int64))
     ghost_blocks = [np.zeros((0, width)) for _ in range(size)]
     record_blocks = [np.zeros((0, rec_width)) for _ in range(size)]
     send = []
     for r in neighbours:
-        idx = halo_members(sim, owned.position, r, h)
+        idx = halo_members(sim, sorted_position, r, h)
         if idx.shape[0] == 0:
             continue
         send.append((r, idx.astype(np.int64)))
-        ghost_blocks[r] = X.pack_particles(owned, idx, tuple(extra_own))
+        ghost_blocks[r] = X.pack_particles(owned, order[idx], tuple(extra_own))
         member = np.zeros(own, np.bool_)
         member[idx] = True
         record_blocks[r] = records[member[rec_owner]]
@@ -221,8 +225,6 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     ghosts, extra_ghost = X.unpack_particles(ghost_rows, owned, widths)
     source = np.repeat(np.arange(size), from_rank)
     gorder = _cell_order(ghosts.position, glo, edge, dims, axes)
-    ghosts = X.take_particles(ghosts, gorder)
-    extra_ghost = [e[gorder] for e in extra_ghost]
     landing = np.empty(gorder.shape[0], np.int64)  # received row -> local index
     landing[gorder] = own + np.arange(gorder.shape[0])
     recv = []
@@ -233,10 +235,10 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     sim.halo.send, sim.halo.recv = send, recv
     sim.halo.allocate(with_temperature=th is not None)
     # 7. the particles of this rank, the lists
-    sim.particles = X.concatenate_particles([owned, ghosts])
+    sim.particles = X.take_joined(owned, order, ghosts, gorder)
     sim._owned, sim._total, sim._distributed = own, total, True
     if th is not None:
-        th.conductance_sum = np.ascontiguousarray(np.concatenate([extra_own[0], extra_ghost[0]]))
+        th.conductance_sum = np.concatenate([extra_own[0][order], extra_ghost[0][gorder]])
         th.particles_reordered()
     sim.slab_axis = axis
     all_records = np.concatenate([records, ghost_records])
