@@ -661,6 +661,24 @@ def test_unsupported_key_refused_by_mpiexec(tmp_path: Path) -> None:
     assert "thermal.scheme" in res.stderr
 
 
+@needs_mpi
+def test_a_failure_while_the_case_is_built_is_an_input_error_under_mpi(tmp_path: Path) -> None:
+    """A periodic axis shorter than two neighbour cells, met by the distributing rebuild while
+    the ranks build the simulation, is an input error on 2 ranks too: exit 2, the message
+    (naming domain.periodic, as the serial one) said once."""
+    case = bed_case(None, heat=None, periodic=True, end_time=10 * DT)
+    case["domain"]["upper"][0] = 3.5e-3
+    case["walls"] = []
+    entry = case["insertion"][0]
+    entry.update(count=20)
+    entry["upper"][0] = 3.5e-3
+    path = _write_case(tmp_path / "short.yaml", case)
+    res = _run(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"], 2, timeout=300)
+    assert res.returncode == 2, res.stderr
+    assert res.stderr.count("domain.periodic: axis x is periodic") == 1, res.stderr
+    assert "(met while the case was built, before any step)" in res.stderr
+
+
 DISK_FULL_SCRIPT = """
 import errno
 import sys

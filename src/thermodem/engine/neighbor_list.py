@@ -46,6 +46,25 @@ def cell_grid(sim: Simulation, cell: float) -> tuple[np.ndarray, np.ndarray]:
     return dims, edge
 
 
+def check_periodic_length(sim: Simulation, cell: float, r_max: float) -> None:
+    """SimulationError naming ``domain.periodic`` when a periodic axis is shorter than two
+    neighbour cells of ``cell`` = 2 R_max + extra distance + skin (the minimum image)."""
+    length = sim.upper - sim.lower
+    for a in range(3):
+        if sim.periodic[a] and length[a] < 2.0 * cell:
+            raise SimulationError(
+                f"domain.periodic: axis {'xyz'[a]} is periodic, but the domain is "
+                f"{length[a]:.6g} m long along it (domain.upper - domain.lower), shorter than "
+                f"twice the neighbour cell {cell:.6g} m (2 R_max {2.0 * r_max:.6g} m + "
+                + (f"neighbors.extra_distance {sim.extra:.6g} m + " if sim.extra else "")
+                + f"neighbors.skin {sim.skin or 0.0:.6g} m); the minimum image needs >= "
+                f"{2 * cell:.6g} m: a longer periodic axis, smaller particles or a smaller "
+                "neighbors.skin",
+                sim.step_count,
+                sim.time,
+            )
+
+
 def rebuild_lists(sim: Simulation) -> None:
     """Sort particles by cell, list pairs and wall pairs, carry the history by identity."""
     p = sim.particles
@@ -59,21 +78,7 @@ def rebuild_lists(sim: Simulation) -> None:
         sim.wall_row_start = np.zeros(1, np.int64)
         sim.reference = p.position.copy()
         return
-    length = sim.upper - sim.lower
-    for a in range(3):
-        if sim.periodic[a] and length[a] < 2.0 * cell:
-            r_max = float(p.radius.max())
-            raise SimulationError(
-                f"domain.periodic: axis {'xyz'[a]} is periodic, but the domain is "
-                f"{length[a]:.6g} m long along it (domain.upper - domain.lower), shorter than "
-                f"twice the neighbour cell {cell:.6g} m (2 R_max {2.0 * r_max:.6g} m + "
-                + (f"neighbors.extra_distance {sim.extra:.6g} m + " if sim.extra else "")
-                + f"neighbors.skin {sim.skin or 0.0:.6g} m); the minimum image needs >= "
-                f"{2 * cell:.6g} m: a longer periodic axis, smaller particles or a smaller "
-                "neighbors.skin",
-                sim.step_count,
-                sim.time,
-            )
+    check_periodic_length(sim, cell, float(p.radius.max()))
     dims, edge = cell_grid(sim, cell)
     axis = int(SL.choose_axis(p.position, sim.lower, edge, dims))
     sim.slab_axis = axis  # the particles' memory order is by layers along it (range set)

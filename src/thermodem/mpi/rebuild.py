@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from thermodem.errors import SimulationError
+from thermodem.engine.neighbor_list import check_periodic_length
 from thermodem.geometry import wall_layout as WL
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
@@ -135,16 +135,7 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     cell = 2.0 * r_max + sim.extra + (sim.skin or 0.0)
     if not cell > 0.0:  # no particles (a restart's empty start): one cell
         cell = float(np.max(sim.upper - sim.lower))
-    length = sim.upper - sim.lower
-    for a in range(3):
-        if sim.periodic[a] and length[a] < 2.0 * cell:
-            raise SimulationError(
-                f"periodic axis {'xyz'[a]}: domain length {length[a]:.6g} m is shorter than "
-                f"twice the interaction cut-off {cell:.6g} m (minimum image needs >= "
-                f"{2 * cell:.6g} m)",
-                sim.step_count,
-                sim.time,
-            )
+    check_periodic_length(sim, cell, r_max)
     imbalance = stats[0] * size / max(total, 1) - 1.0
     if sim.decomposition is None or imbalance > sim.rebalance_threshold:
         if sim.decomposition is not None:

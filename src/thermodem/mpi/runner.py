@@ -45,7 +45,7 @@ from thermodem.engine.validation import (
     on_every_rank,
     pre_run_checks,
 )
-from thermodem.errors import ConfigError, RunInterrupted
+from thermodem.errors import ConfigError, RunInterrupted, SimulationError
 from thermodem.io.checkpoint import (
     Checkpoint,
     list_checkpoints,
@@ -374,8 +374,11 @@ def _read_on_all(comm: Any, path: str | os.PathLike[str]) -> Checkpoint:
 def _build(
     case: Case, threads: int | None, rebalance_threshold: float, ckpt: Checkpoint | None
 ) -> DistributedSimulation:
-    if ckpt is None:
-        return DistributedSimulation(case, threads, rebalance_threshold=rebalance_threshold)
+    if ckpt is None:  # (a failure while it is built is the input's: as engine/validation.py's
+        try:  # built_simulation)
+            return DistributedSimulation(case, threads, rebalance_threshold=rebalance_threshold)
+        except SimulationError as exc:
+            raise ConfigError(f"{exc} (met while the case was built, before any step)") from None
     if ckpt.kind == "failed":
         raise ConfigError(
             f"{ckpt.path} holds the state at a failure (for inspection) and cannot be "
