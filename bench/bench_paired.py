@@ -13,6 +13,12 @@ per-pair block ratios (median, lower and upper quartile) says how far to trust i
         [--warmup 300]
     python bench/bench_paired.py --drum [--threads 1] ...
 
+``--indirect MODEL [--indirect-param KEY=VALUE ...]`` (issue 10 §3): a third case, the heat
+case with that indirect conduction model on the range set (e.g. ``--indirect
+rong_horio1999 --indirect-param layer_thickness_ratio=0.25``: a gap cut-off of 0.5 R̄),
+timed in the same rotation; its overhead over mechanics and the gap term's own cost (its
+time over the heat case's, in units of the mechanics time) are printed too.
+
 ``--drum``: the same pairing on ``bench_drum.py``'s rotating drum (50,000 spheres after 0.1 s
 of flow, cached in bench/.cache): mechanics against ``generation`` (heat generation every
 step, issue 12); both advance in step, so they see the same flow.
@@ -45,6 +51,8 @@ def main() -> None:
     ap.add_argument("--block", type=int, default=100, help="steps per block")
     ap.add_argument("--warmup", type=int, default=300)
     ap.add_argument("--drum", action="store_true", help="the drum: mechanics vs generation")
+    ap.add_argument("--indirect", default=None, help="a third case: heat + this range model")
+    ap.add_argument("--indirect-param", nargs="*", default=[], help="KEY=VALUE parameters")
     args = ap.parse_args()
 
     from thermodem.config.load import case_from_dict
@@ -61,6 +69,12 @@ def main() -> None:
     else:
         shared.particle_files()
         cases = {kind: shared.case_dict(kind, None, 1) for kind in ("mechanics", args.heat)}
+        if args.indirect:
+            indirect: dict = {"model": args.indirect}
+            for kv in args.indirect_param:
+                key, value = kv.split("=", 1)
+                indirect[key] = float(value)
+            cases["gap"] = shared.case_dict(args.heat, indirect, 1)
     sims = {
         kind: Simulation(case_from_dict(case), threads=args.threads) for kind, case in cases.items()
     }
@@ -89,6 +103,16 @@ def main() -> None:
         f"heat overhead {heat.sum() / mech.sum() - 1.0:+.1%} (block ratios: median {med:+.1%}, "
         f"quartiles {q1:+.1%} .. {q3:+.1%})"
     )
+    if "gap" in seconds:
+        gap = np.array(seconds["gap"])
+        ratios = gap / mech - 1.0
+        q1, med, q3 = np.percentile(ratios, [25, 50, 75])
+        print(f"+ {args.indirect:<11} {n * steps / gap.sum() / 1e6:6.2f} M particle-steps/s")
+        print(
+            f"heat + gap over mechanics {gap.sum() / mech.sum() - 1.0:+.1%} (block ratios: "
+            f"median {med:+.1%}, quartiles {q1:+.1%} .. {q3:+.1%}); the gap term alone "
+            f"{(gap.sum() - heat.sum()) / mech.sum():+.1%} of mechanics"
+        )
 
 
 if __name__ == "__main__":
