@@ -136,6 +136,25 @@ def _assert_same_ledgers(serial_dir: Path, parallel_dir: Path) -> None:
         assert worst <= 1e-9, f"{name}: differs by {worst:.3g} of its scale"
 
 
+def _serial_and_2_ranks(path: Path, out: Path, steps: int) -> tuple[dict, dict]:
+    """The case ``path`` run serially into ``out``1 and on 2 ranks into ``out``2; their final
+    states (checked equal) and ledgers (checked equal to round-off)."""
+    for ranks in (1, 2):
+        res = _run(["run", str(path), "-o", f"{out}{ranks}", "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+    serial, parallel = _final(Path(f"{out}1"), steps), _final(Path(f"{out}2"), steps)
+    _assert_same_state(serial, parallel)
+    _assert_same_ledgers(Path(f"{out}1"), Path(f"{out}2"))
+    return serial, parallel
+
+
+def _continued_serially(checkpoint: Path, out: Path, steps: int) -> dict:
+    """The final state of a serial run continuing from ``checkpoint`` to step ``steps``."""
+    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
+    assert res.returncode == 0, res.stderr
+    return _final(out, steps)
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """The settled bed over 1000 steps: serially and on 2 ranks (shared by the tests)."""
@@ -249,16 +268,11 @@ def test_two_dimensional_drum_on_2_ranks(tmp_path: Path) -> None:
                       "checkpoint_interval": 1500 * 4e-6, "checkpoint_keep": None}  # fmt: skip
     case["neighbors"] = {"skin": 1e-4}  # (rebuilds and migration while the discs fall)
     path = _write_case(tmp_path / "drum2d.yaml", case)
-    for ranks in (1, 2):
-        res = _run(["run", str(path), "-o", str(tmp_path / f"d{ranks}"), "--no-progress"], ranks)
-        assert res.returncode == 0, res.stderr
-    serial, parallel = _final(tmp_path / "d1", steps), _final(tmp_path / "d2", steps)
+    serial, parallel = _serial_and_2_ranks(path, tmp_path / "d", steps)
     assert np.abs(parallel["position"][:, 2]).max() == 0.0
     assert np.abs(parallel["velocity"][:, 2]).max() == 0.0
     start = _final(tmp_path / "d2", 0)["temperature"]
     assert len(centres) > 70 and np.abs(parallel["temperature"] - start).max() > 1e-3
-    _assert_same_state(serial, parallel)
-    _assert_same_ledgers(tmp_path / "d1", tmp_path / "d2")
 
 
 def test_bisection_balances_and_tiles() -> None:
@@ -373,24 +387,16 @@ def test_pouring_and_external_loads_on_2_ranks(tmp_path: Path) -> None:
     case["output"] = {"vtu": False, "timeseries_interval": 50 * DT,
                       "checkpoint_interval": 200 * DT, "checkpoint_keep": None}  # fmt: skip
     path = _write_case(tmp_path / "pour.yaml", case)
-    for ranks in (1, 2):
-        res = _run(["run", str(path), "-o", str(tmp_path / f"o{ranks}"), "--no-progress"], ranks)
-        assert res.returncode == 0, res.stderr
-    serial, parallel = _final(tmp_path / "o1", steps), _final(tmp_path / "o2", steps)
+    serial, _ = _serial_and_2_ranks(path, tmp_path / "o", steps)
     poured = serial["global_id"].shape[0] - 500
     assert poured >= 80, poured  # (10 batches of 10 requested)
-    _assert_same_state(serial, parallel)
-    _assert_same_ledgers(tmp_path / "o1", tmp_path / "o2")
     from thermodem.io.run_files import read_timeseries
 
     ledger = read_timeseries(tmp_path / "o2" / "timeseries.csv")
     assert ledger["external_work"][-1] != 0.0
     assert ledger["inserted_energy"][-1] != 0.0
     checkpoint = tmp_path / "o2" / "checkpoints" / "checkpoint_000000200.h5"
-    out = tmp_path / "from2on1"
-    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
-    assert res.returncode == 0, res.stderr
-    _assert_same_state(serial, _final(out, steps))
+    _assert_same_state(serial, _continued_serially(checkpoint, tmp_path / "from2on1", steps))
 
 
 @needs_mpi
@@ -440,19 +446,11 @@ def test_frozen_mechanics_on_2_ranks(tmp_path: Path, heat: str) -> None:
     case["output"] = {"vtu": False, "timeseries_interval": 10 * time_step,
                       "checkpoint_interval": 50 * time_step, "checkpoint_keep": None}  # fmt: skip
     path = _write_case(tmp_path / "frozen.yaml", case)
-    for ranks in (1, 2):
-        res = _run(["run", str(path), "-o", str(tmp_path / f"f{ranks}"), "--no-progress"], ranks)
-        assert res.returncode == 0, res.stderr
-    serial, parallel = _final(tmp_path / "f1", steps), _final(tmp_path / "f2", steps)
+    serial, _ = _serial_and_2_ranks(path, tmp_path / "f", steps)
     heated = serial["temperature"] - _final(tmp_path / "f1", 0)["temperature"]
     assert np.count_nonzero(heated > 1e-3) > 100  # (the heat has spread over the bed)
-    _assert_same_state(serial, parallel)
-    _assert_same_ledgers(tmp_path / "f1", tmp_path / "f2")
     checkpoint = tmp_path / "f2" / "checkpoints" / "checkpoint_000000050.h5"
-    out = tmp_path / "from2on1"
-    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
-    assert res.returncode == 0, res.stderr
-    _assert_same_state(serial, _final(out, steps))
+    _assert_same_state(serial, _continued_serially(checkpoint, tmp_path / "from2on1", steps))
 
 
 @needs_mpi
@@ -473,12 +471,7 @@ def test_contact_list_heat_term_on_2_ranks(tmp_path: Path, frozen: bool) -> None
     case["output"] = {"vtu": False, "timeseries_interval": 20 * time_step,
                       "checkpoint_interval": steps * time_step}  # fmt: skip
     path = _write_case(tmp_path / "vm.yaml", case)
-    for ranks in (1, 2):
-        res = _run(["run", str(path), "-o", str(tmp_path / f"v{ranks}"), "--no-progress"], ranks)
-        assert res.returncode == 0, res.stderr
-    serial, parallel = _final(tmp_path / "v1", steps), _final(tmp_path / "v2", steps)
-    _assert_same_state(serial, parallel)
-    _assert_same_ledgers(tmp_path / "v1", tmp_path / "v2")
+    serial, _ = _serial_and_2_ranks(path, tmp_path / "v", steps)
     from thermodem.io.run_files import read_timeseries
 
     ledger = read_timeseries(tmp_path / "v2" / "timeseries.csv")
@@ -515,22 +508,14 @@ def test_neighbourhood_fields_on_2_ranks(tmp_path: Path, name: str) -> None:
     case["output"] = {"vtu": False, "timeseries_interval": 50 * DT,
                       "checkpoint_interval": 100 * DT, "checkpoint_keep": None}  # fmt: skip
     path = _write_case(tmp_path / "nb.yaml", case)
-    for ranks in (1, 2):
-        res = _run(["run", str(path), "-o", str(tmp_path / f"n{ranks}"), "--no-progress"], ranks)
-        assert res.returncode == 0, res.stderr
-    serial, parallel = _final(tmp_path / "n1", steps), _final(tmp_path / "n2", steps)
-    _assert_same_state(serial, parallel)
-    _assert_same_ledgers(tmp_path / "n1", tmp_path / "n2")
+    serial, _ = _serial_and_2_ranks(path, tmp_path / "n", steps)
     from thermodem.io.run_files import read_timeseries
 
     ledger = read_timeseries(tmp_path / "n2" / "timeseries.csv")
     column = "heat_in_convection" if "convection" in NEIGHBOURHOODS[name] else "heat_in_radiation"
     assert abs(ledger[column][-1]) > 0.0
     checkpoint = tmp_path / "n2" / "checkpoints" / "checkpoint_000000100.h5"
-    out = tmp_path / "from2on1"
-    res = _run(["run", "--restart", str(checkpoint), "-o", str(out), "--no-progress"], 1)
-    assert res.returncode == 0, res.stderr
-    _assert_same_state(serial, _final(out, steps))
+    _assert_same_state(serial, _continued_serially(checkpoint, tmp_path / "from2on1", steps))
 
 
 @needs_mpi
