@@ -3,19 +3,25 @@
 heat agrees with the serial run to round-off (its line in the log, the heat columns from zero,
 the balance closed), and a case whose walls or t = 0 particles differ from the checkpoint's
 is refused before anything is written (mpi/runner.py: run_distributed calls
-run_checks.check_restart_start; before, the run went on with the checkpoint's walls)."""
+run_checks.check_restart_start; before, the run went on with the checkpoint's walls). A
+periodic case continues on 2 ranks, and one whose changed domain is too short for the
+restored particles' lists is refused while the ranks set up; a run that starts without
+particles (all poured) runs on 2 ranks as serially."""
 
 from __future__ import annotations
 
 import copy
+import json
 import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "run"))
 
+from test_input_at_build import PERIODIC, _periodic  # noqa: E402
 from test_mpi import _assert_same_ledgers, _run, needs_mpi  # noqa: E402
 from test_restart_changes import SETTLE, _particles, _write  # noqa: E402
 
@@ -80,3 +86,69 @@ def test_restart_of_a_run_that_never_started_on_2_ranks(tmp_path: Path) -> None:
     assert "never started (status.json: its input was refused: simulation.end_time" in res.stderr
     assert f"run it again: mpiexec -n 2 thermodem run CASE --output {out}" in res.stderr
     assert res.stderr.count("error:") == 1, res.stderr
+
+
+@needs_mpi
+def test_a_periodic_restart_on_2_ranks_and_one_whose_lists_cannot_be_built(
+    tmp_path: Path,
+) -> None:
+    """A restart of a periodic case on 2 ranks was refused whenever the periodic axis was
+    shorter than twice the domain's longest edge: the empty start's rebuild (no particles yet)
+    checked the axis against a cell of that edge ('2 R_max 0 m', exit 1). It continues now, as
+    serially; a changed case whose periodic axis is shorter than two neighbour cells of the
+    restored particles is refused while the ranks set up (exit 2, once, the key named, a
+    refused record), as serially (tests/run/test_input_at_build.py)."""
+    base = _write(tmp_path / "base.yaml", PERIODIC)
+    res = _run(["run", str(base), "-o", str(tmp_path / "s"), "--no-progress"])
+    assert res.returncode == 0, res.stderr
+    ckpt = tmp_path / "s" / "checkpoints" / "checkpoint_000000020.h5"
+    longer = _periodic(tmp_path, "longer")
+    res = _run(["run", str(longer), "--restart", str(ckpt), "-o", str(tmp_path / "p"),
+                "--no-progress"], 2)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    res = _run(["restart", str(tmp_path / "p"), "--end-time", "0.0006", "--no-progress"], 2)
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "p" / "checkpoints" / "checkpoint_000000060.h5").exists()
+    short = _periodic(tmp_path, "short", upper_x=0.004)
+    out = tmp_path / "short"
+    res = _run(["run", str(short), "--restart", str(ckpt), "-o", str(out), "--no-progress"], 2)
+    assert res.returncode == 2, res.stderr
+    message = (
+        "domain.periodic: axis x is periodic, but the domain is 0.004 m long along it "
+        "(domain.upper - domain.lower), shorter than twice the neighbour cell 0.0022 m (2 R_max "
+        "0.002 m + neighbors.skin 0.0002 m); the minimum image needs >= 0.0044 m: a longer "
+        "periodic axis, smaller particles or a smaller neighbors.skin (met while the restart "
+        f"from {ckpt} was set up, before any step)"
+    )
+    assert res.stderr.count(f"error: {message}") == 1, res.stderr
+    status = json.loads((out / "status.json").read_text())
+    assert status["refused_input"] is True and status["message"] == message
+    assert not any((out / "checkpoints").glob("*.h5"))
+
+
+@needs_mpi
+@pytest.mark.parametrize("periodic", [True, False])
+def test_a_run_that_starts_empty_and_pours_on_2_ranks(tmp_path: Path, periodic: bool) -> None:
+    """The same empty start in a fresh run, a case whose particles are all poured: refused on
+    2 ranks with a periodic axis ('2 R_max 0 m', as above), and with none the ranks stopped at
+    the first step without a pour (TypeError: no skin before the first particle is listed;
+    engine/neighbor_list.py: rebuild_due). Now both run as serially, to the same particles."""
+    case = copy.deepcopy(PERIODIC)
+    case["domain"] = {"lower": [0, 0, 0], "upper": [0.008, 0.008, 0.02],
+                      "periodic": [periodic, periodic, False]}  # fmt: skip
+    case["insertion"] = [
+        {"kind": "pour", "material": "glass", "rate": 1.0e5, "interval": 5.0e-5,
+         "end_time": 1.0e-4, "distribution": {"kind": "mono", "radius": 5.0e-4},
+         "region": {"kind": "box", "lower": [0, 0, 0.01], "upper": [0.008, 0.008, 0.02]}}
+    ]  # fmt: skip
+    path = _write(tmp_path / "pour.yaml", case)
+    finals = []
+    for ranks in (1, 2):
+        out = tmp_path / f"o{ranks}"
+        res = _run(["run", str(path), "-o", str(out), "--no-progress"], ranks)
+        assert res.returncode == 0, res.stderr
+        finals.append(_particles(out / "checkpoints" / "checkpoint_000000020.h5"))
+    serial, parallel = finals
+    assert serial["global_id"].shape[0] == 10
+    np.testing.assert_array_equal(serial["global_id"], parallel["global_id"])
+    np.testing.assert_allclose(parallel["position"], serial["position"], rtol=0, atol=1e-12)

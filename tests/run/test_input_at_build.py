@@ -1,7 +1,8 @@
 """Inputs whose fault shows only once the case is built, through the installed command in a
 subprocess as a user runs it: a failure met while the simulation is built (before step 0) is an
-input error (exit 2, the key named), not a failed run (exit 1); a heat generation mechanism that
-the material values switch off for every pair that can meet is warned about."""
+input error (exit 2, the key named), not a failed run (exit 1), and so is a restart whose
+(changed) case the restored particles' lists cannot be built with; a heat generation mechanism
+that the material values switch off for every pair that can meet is warned about."""
 
 from __future__ import annotations
 
@@ -10,7 +11,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import h5py
 import yaml
+
+from thermodem.io.checkpoint import read_checkpoint
 
 EXE = str(Path(sys.executable).with_name("thermodem"))
 
@@ -102,18 +106,120 @@ def test_a_failure_while_the_case_is_built_is_an_input_error(tmp_path: Path) -> 
 
 def test_a_tessellation_the_start_cannot_make_is_an_input_error(tmp_path: Path) -> None:
     """A Voronoi case with a plane wall across the bed: the tessellation made while the
-    simulation is built failed with exit 1; it is an input error naming thermal.tessellation."""
+    simulation is built failed with exit 1; it is an input error naming thermal.tessellation,
+    the wall as the case does (walls.K and its name; before: 'plane wall 5', a wall row) and
+    the particle by its global id (before: its array index, 2 here, after the cell sort)."""
     data = yaml.safe_load((Path(__file__).parents[2] / "examples" / "voronoi_bed.yaml").read_text())
     data["simulation"]["end_time"] = 1.0e-4
-    data["walls"].append(
-        {"kind": "plane", "point": [0, 0, 0.003], "normal": [0, 0, 1], "material": "steel"}
-    )
+    data["walls"].append({"kind": "plane", "point": [0, 0, 0.004], "normal": [0, 0, -1],
+                          "material": "steel", "name": "lid"})  # fmt: skip
     case = tmp_path / "voronoi.yaml"
     case.write_text(yaml.safe_dump(data))
     res = _cli("validate", case)
     assert res.returncode == 2, res.stdout + res.stderr
-    assert "error: thermal.tessellation (plain): particle index 0 " in res.stderr
-    assert "(met while the case was built, before any step)" in res.stderr
+    assert "error: thermal.tessellation (plain): particle 50 (centre [0.0018999999" in res.stderr
+    assert (
+        "0.0051] m) is not on the particles' side of the plane walls.1 (lid): its cell cannot "
+        "be clipped by it (step 0, t = 0 s, 125 particles) (met while the case was built, before "
+        "any step)"
+    ) in res.stderr
+    del data["walls"][1]["name"]  # (without a name: its kind and index, as the other messages)
+    case.write_text(yaml.safe_dump(data))
+    res = _cli("validate", case)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert "is not on the particles' side of the plane walls.1 (plane1): its cell" in res.stderr
+
+
+#: a periodic x axis 0.006 m long (twice the neighbour cell, 2.2 mm, is 4.4 mm), four spheres
+#: of 1 mm; 20 steps, checkpoints at steps 10 and 20
+PERIODIC = {
+    **CASE,
+    "simulation": {"time_step": 1.0e-5, "end_time": 2.0e-4},
+    "domain": {"lower": [0, 0, 0], "upper": [0.006, 0.01, 0.01], "periodic": [True, False, False]},
+    "insertion": [{**CASE["insertion"][0], "upper": [0.0025, 0.006, 0.006], "count": [1, 2, 2]}],
+    "output": {"vtu": False, "checkpoint_interval": 1.0e-4, "checkpoint_keep": None},
+}
+
+
+def _periodic(tmp_path: Path, name: str, upper_x: float = 0.006, **neighbors: float) -> Path:
+    data = json.loads(json.dumps(PERIODIC))
+    data["simulation"]["end_time"] = 4.0e-4
+    data["domain"]["upper"][0] = upper_x
+    if neighbors:
+        data["neighbors"] = neighbors
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def _files(out: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(out)): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+
+
+def test_a_restart_whose_lists_cannot_be_built_is_refused_before_any_step(tmp_path: Path) -> None:
+    """run CASE --restart CKPT with a changed case whose periodic axis is shorter than two
+    neighbour cells of the restored particles (a shorter domain; a larger neighbors.skin) ran
+    on until the first rebuild and failed there (exit 1, a half-written run). Now refused while
+    the restart is set up: exit 2, the key named, nothing written. The skin of the changed case
+    is the one run (before, the checkpoint's was kept, silently) and the lists are built with
+    it at the first step. ``thermodem restart DIR`` of a directory whose newest checkpoint
+    stores such a case (continued before this check) is refused, the directory unchanged."""
+    base = tmp_path / "base.yaml"
+    base.write_text(yaml.safe_dump(PERIODIC))
+    res = _cli("run", base, "--output", tmp_path / "out", "--no-progress")
+    assert res.returncode == 0, res.stdout + res.stderr
+    ckpt = tmp_path / "out" / "checkpoints" / "checkpoint_000000020.h5"
+    set_up = f"(met while the restart from {ckpt} was set up, before any step; nothing was changed)"
+    short = _periodic(tmp_path, "short", upper_x=0.004)
+    res = _cli("run", short, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: domain.periodic: axis x is periodic, but the domain is 0.004 m long along it "
+        "(domain.upper - domain.lower), shorter than twice the neighbour cell 0.0022 m (2 R_max "
+        "0.002 m + neighbors.skin 0.0002 m); the minimum image needs >= 0.0044 m: a longer "
+        f"periodic axis, smaller particles or a smaller neighbors.skin {set_up}"
+    ) in res.stderr
+    assert not (tmp_path / "new").exists()
+    wide = _periodic(tmp_path, "wide", skin=0.002)
+    res = _cli("run", wide, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: domain.periodic: axis x is periodic, but the domain is 0.006 m long along it "
+        "(domain.upper - domain.lower), shorter than twice the neighbour cell 0.004 m (2 R_max "
+        "0.002 m + neighbors.skin 0.002 m); the minimum image needs >= 0.008 m"
+    ) in res.stderr
+    assert set_up in res.stderr
+    assert not (tmp_path / "new").exists()
+    # a skin that fits: run, and the lists built with it at the first step
+    fits = _periodic(tmp_path, "fits", skin=0.0003)
+    res = _cli("run", fits, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "changed from the checkpoint's case: neighbors.skin (none) -> 0.0003" in res.stdout
+    assert read_checkpoint(ckpt).state["scalars"]["skin"] == 0.0002  # (the default 0.2 R)
+    last = read_checkpoint(tmp_path / "new" / "checkpoints" / "checkpoint_000000040.h5")
+    assert last.state["scalars"]["skin"] == 0.0003
+    assert (
+        last.state["scalars"]["rebuild_count"]
+        == read_checkpoint(ckpt).state["scalars"]["rebuild_count"] + 1
+    )
+    # restart DIR: the newest checkpoint (and case.resolved.yaml) with the short domain
+    out = tmp_path / "out"
+    stored = yaml.safe_load(read_checkpoint(ckpt).case_yaml)
+    stored["domain"]["upper"][0] = 0.004
+    text = yaml.safe_dump(stored)
+    with h5py.File(ckpt, "a") as f:
+        del f["case_yaml"]
+        f.create_dataset("case_yaml", data=text, dtype=h5py.string_dtype("utf-8"))
+    (out / "case.resolved.yaml").write_text(text)
+    before = _files(out)
+    res = _cli("restart", out, "--end-time", "0.0004", "--no-progress")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: domain.periodic: axis x is periodic, but the domain is 0.004 m long along it "
+    ) in res.stderr
+    assert set_up in res.stderr
+    assert _files(out) == before
+    assert json.loads((out / "status.json").read_text())["status"] == "finished"
 
 
 def test_a_generation_mechanism_the_material_values_switch_off_is_told(tmp_path: Path) -> None:
@@ -200,3 +306,37 @@ def test_the_default_mechanisms_are_told_only_when_none_gives_heat() -> None:
         "mechanisms (the default, all five) dissipates"
     )
     assert "'rolling_friction': contact.rolling is 'none'" in text
+
+
+def test_a_restart_whose_range_set_cannot_be_built_is_refused(tmp_path: Path) -> None:
+    """The thermal range pair set (a model that conducts across gaps) checks the periodic axes
+    against its own cells when it is built; for particles of a list (no radius bound known
+    before they are inserted) a restart met it at the set's first rebuild, in the run. Now
+    while the restart is set up, as the contact lists' check above."""
+    spheres = {
+        "kind": "list",
+        "material": "glass",
+        "radius": 0.001,
+        "positions": [[0.00125, y, z] for y in (0.002, 0.005) for z in (0.001, 0.004)],
+    }
+    data = {**json.loads(json.dumps(PERIODIC)), "insertion": [spheres],
+            "thermal": {"indirect_conduction": "batchelor_obrien_separated"}}  # fmt: skip
+    base = tmp_path / "base.yaml"
+    base.write_text(yaml.safe_dump(data))
+    res = _cli("run", base, "--output", tmp_path / "out", "--no-progress")
+    assert res.returncode == 0, res.stdout + res.stderr
+    ckpt = tmp_path / "out" / "checkpoints" / "checkpoint_000000020.h5"
+    data["simulation"]["end_time"] = 4.0e-4
+    data["domain"]["upper"][0] = 0.005  # (the contact lists need 0.0044 m, the range set 0.0054)
+    short = tmp_path / "short.yaml"
+    short.write_text(yaml.safe_dump(data))
+    res = _cli("run", short, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert (
+        "error: thermal.indirect_conduction.cutoff_gap_ratio = 1.0: periodic axis x of length "
+        "0.005 m is shorter than two cells of the range pair set (2 R_max 0.002 m + largest "
+        "conducting gap 0.0005 m + thermal.range_skin 0.0002 m each); allowed: cutoff_gap_ratio "
+        f"below 0.6 (or a larger domain) (met while the restart from {ckpt} was set up, before "
+        "any step; nothing was changed)"
+    ) in res.stderr
+    assert not (tmp_path / "new").exists()

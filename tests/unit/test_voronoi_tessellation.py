@@ -120,3 +120,7 @@ def test_a_periodic_box_of_two_cells_is_refused() -> None:
     with pytest.raises(ValueError, match="share more than one face"):
         tessellate(pos, np.full(len(pos), R), np.zeros(3), np.full(3, 2 * a), np.ones(3, bool),
                    [], "plain")  # fmt: skip
+    # named by their global ids when given (as the case and the outputs name them)
+    with pytest.raises(ValueError, match=r"^particle 10\d and particle 10\d share more"):
+        tessellate(pos, np.full(len(pos), R), np.zeros(3), np.full(3, 2 * a), np.ones(3, bool),
+                   [], "plain", np.arange(len(pos)) + 100)  # fmt: skip

@@ -46,9 +46,13 @@ def cell_grid(sim: Simulation, cell: float) -> tuple[np.ndarray, np.ndarray]:
     return dims, edge
 
 
-def check_periodic_length(sim: Simulation, cell: float, r_max: float) -> None:
+def check_periodic_length(
+    sim: Simulation, cell: float, r_max: float, skin: float | None = None
+) -> None:
     """SimulationError naming ``domain.periodic`` when a periodic axis is shorter than two
-    neighbour cells of ``cell`` = 2 R_max + extra distance + skin (the minimum image)."""
+    neighbour cells of ``cell`` = 2 R_max + extra distance + skin (the minimum image;
+    ``skin``: the one in ``cell``, default ``sim.skin``)."""
+    skin = sim.skin if skin is None else skin
     length = sim.upper - sim.lower
     for a in range(3):
         if sim.periodic[a] and length[a] < 2.0 * cell:
@@ -57,12 +61,25 @@ def check_periodic_length(sim: Simulation, cell: float, r_max: float) -> None:
                 f"{length[a]:.6g} m long along it (domain.upper - domain.lower), shorter than "
                 f"twice the neighbour cell {cell:.6g} m (2 R_max {2.0 * r_max:.6g} m + "
                 + (f"neighbors.extra_distance {sim.extra:.6g} m + " if sim.extra else "")
-                + f"neighbors.skin {sim.skin or 0.0:.6g} m); the minimum image needs >= "
+                + f"neighbors.skin {skin or 0.0:.6g} m); the minimum image needs >= "
                 f"{2 * cell:.6g} m: a longer periodic axis, smaller particles or a smaller "
                 "neighbors.skin",
                 sim.step_count,
                 sim.time,
             )
+
+
+def check_next_build(sim: Simulation) -> None:
+    """What the next :func:`rebuild_lists` of the particles present would refuse, checked
+    without building or changing anything (:func:`check_periodic_length`; the skin a first
+    build would default to): a restart sets up with it, so that a changed case whose fault
+    shows only when the lists are built (a shorter periodic axis) is refused before step 1."""
+    p = sim.particles
+    if p.count == 0:
+        return
+    r_max = float(p.radius.max())
+    skin = sim.skin if sim.skin is not None else 0.2 * r_max  # (as cell_size)
+    check_periodic_length(sim, 2.0 * r_max + sim.extra + skin, r_max, skin)
 
 
 def rebuild_lists(sim: Simulation) -> None:
@@ -175,8 +192,8 @@ def rebuild_lists(sim: Simulation) -> None:
 
 def rebuild_due(sim: Simulation) -> bool:
     """Whether the lists must be rebuilt before the next pair pass (see the module docstring)."""
-    if sim._needs_rebuild or sim.rebuild_every_step:
-        return True
+    if sim._needs_rebuild or sim.rebuild_every_step or sim.skin is None:
+        return True  # (no skin yet: no particle listed so far, on every MPI rank alike)
     moved = sim.moved
     wall_moved = 0.0
     if sim.wall_rows.shape[0]:

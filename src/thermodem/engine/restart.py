@@ -496,6 +496,13 @@ def restore(sim: Simulation, state: dict[str, Any]) -> None:
         elif value is not None:
             value = float(value)
         setattr(sim, name, value)
+    skin = sim.case.neighbors.skin
+    if skin is not None and float(skin) != sim.skin:
+        # a case with another neighbors.skin (run CASE --restart CKPT) runs it (the stored
+        # one was kept, silently); the stored lists are of the old skin: built again before
+        # the first pair pass. A case without one keeps the skin its first build chose.
+        sim.skin = float(skin)
+        sim._needs_rebuild = True
     fresh_ledger = dict(sim.ledger_cumulative)  # (the case's keys, for heat that starts)
     sim.ledger_cumulative = {k: float(v) for k, v in s["ledger_cumulative"].items()}
     _load_pairs(sim.pairs, state["pairs"], int(s["pair_count"]), int(s["pair_capacity"]))

@@ -16,7 +16,7 @@ from typing import Any
 
 from thermodem.config.schema import Case
 from thermodem.engine.simulation import Simulation
-from thermodem.errors import ConfigError
+from thermodem.errors import ConfigError, SimulationError
 from thermodem.io.checkpoint import Checkpoint, read_checkpoint
 from thermodem.io.run_files import STATUS_FILE, Status, _atomic_write_text
 
@@ -261,7 +261,7 @@ def restored_simulation(ckpt: Checkpoint, threads: int | None, case: Case) -> Si
     a changed case whose t = 0 particles differ from the checkpoint's)."""
     check_restart_case(ckpt, case)
     try:
-        return Simulation.from_checkpoint(ckpt, threads=threads, case=case)
+        sim = Simulation.from_checkpoint(ckpt, threads=threads, case=case)
     except ConfigError as exc:
         if str(ckpt.path) in str(exc):
             raise
@@ -273,6 +273,34 @@ def restored_simulation(ckpt: Checkpoint, threads: int | None, case: Case) -> Si
         raise ConfigError(
             f"checkpoint {ckpt.path} cannot be restored ({type(exc).__name__}: {exc}); the file "
             "is damaged or was written by another version"
+        ) from None
+    check_restored_lists(sim, ckpt)
+    return sim
+
+
+def check_restored_lists(sim: Simulation, ckpt: Checkpoint) -> None:
+    """What the first list builds after a restart would refuse, checked before any step: the
+    neighbour lists of the restored particles with the case's domain, skin and extra distance
+    (neighbor_list.check_next_build: a periodic axis shorter than two cells), the thermal
+    range pair set and neighbourhood spheres (thermal_terms.check_ranges,
+    check_neighbourhood_range). A changed case (a shorter domain, a larger neighbors.skin)
+    met them at the first rebuild, as a failed run (exit 1); now a ConfigError naming the key
+    (exit 2) while nothing is written. An unchanged case passes (its run passed them)."""
+    from thermodem.engine.neighbor_list import check_next_build
+
+    try:
+        check_next_build(sim)
+        th, p = sim.thermal, sim.particles
+        if th is not None and p.count:
+            r_max = float(p.radius.max())
+            if th.range_set is not None:
+                th.check_ranges(r_max)
+            if th.field_provider.neighbourhood is not None:
+                th.field_provider.check_neighbourhood_range(r_max)
+    except (SimulationError, ConfigError) as exc:
+        raise ConfigError(
+            f"{exc} (met while the restart from {ckpt.path} was set up, before any step; "
+            "nothing was changed)"
         ) from None
 
 

@@ -72,7 +72,8 @@ class Plane:
     point: np.ndarray
     normal: np.ndarray
     walls: tuple[int, ...]  # wall rows lying in it (a plane wall: itself)
-    name: str
+    name: str  # as messages name it: 'domain z lower face', 'plane walls.5 (lid)'
+    face: bool = True  # a face of the domain box (else a wall's own plane, which cuts it)
 
 
 @dataclass
@@ -101,8 +102,11 @@ def clipping_planes(sim: Simulation) -> tuple[list[Plane], list[int], np.ndarray
     above them rather than at a far domain face (columns tens of radii tall, whose faces would
     make every surface pair conduct over a whole hemisphere, and which voro++ builds slowly).
     """
+    from thermodem.engine.start_checks import wall_row_owners
+
     planes: list[Plane] = []
     kinds, rows = sim.wall_kind, sim.wall_rows
+    owners = wall_row_owners(sim.case)
     used: set[int] = set()
     lower = np.array(sim.lower, float)
     upper = np.array(sim.upper, float)
@@ -152,8 +156,7 @@ def clipping_planes(sim: Simulation) -> tuple[list[Plane], list[int], np.ndarray
         if same is not None:  # coplanar walls share one clipping plane
             same.walls = (*same.walls, w)
         else:
-            kind = "plane" if kinds[w] == wl.PLANE else "rectangle"
-            planes.append(Plane(point, normal, (w,), f"{kind} wall {w}"))
+            planes.append(Plane(point, normal, (w,), wall_name(sim, w, owners), face=False))
         used.add(w)
     hot_elsewhere = [
         w for w in range(kinds.shape[0]) if w not in used and rows[w, wl.COL_THERMAL_KIND] != 0.0
@@ -161,11 +164,24 @@ def clipping_planes(sim: Simulation) -> tuple[list[Plane], list[int], np.ndarray
     return planes, hot_elsewhere, lower, upper
 
 
+def wall_name(sim: Simulation, w: int, owners: list[int] | None = None) -> str:
+    """Wall row ``w`` as messages name it: its kind, its case key and its label
+    (``plane walls.5 (plane5)``, ``rectangle walls.0 (box0.z-)``, a ``name`` given: ``plane
+    walls.5 (lid)``). ``owners``: engine/start_checks.py's wall_row_owners of the case."""
+    from thermodem.engine.start_checks import wall_row_owners
+
+    if owners is None:
+        owners = wall_row_owners(sim.case)
+    k = owners[w] if w < len(owners) else w
+    kind = wl.KIND_NAMES[int(sim.wall_kind[w])]
+    return f"{kind} walls.{k} ({sim.wall_labels[w]})"
+
+
 def clipped_volume(lower: np.ndarray, upper: np.ndarray, planes: list[Plane],
                    inside: np.ndarray) -> float:  # fmt: skip
     """Volume of the domain box cut by the planes (``inside``: a point strictly inside)."""
     box = float(np.prod(upper - lower))
-    extra = [p for p in planes if " wall " in p.name]
+    extra = [p for p in planes if not p.face]
     if not extra:
         return box
     from scipy.spatial import ConvexHull, HalfspaceIntersection
@@ -303,9 +319,17 @@ def _column_depth(x: np.ndarray, signed: np.ndarray, normal: np.ndarray,
 
 
 def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-               periodic: np.ndarray, planes: list[Plane], method: str) -> Faces:  # fmt: skip
+               periodic: np.ndarray, planes: list[Plane], method: str,
+               global_id: np.ndarray | None = None) -> Faces:  # fmt: skip
     """The clipped Voronoi (or radical) tessellation of the spheres (see the module
-    docstring). Raises ValueError with the reason if it cannot be made."""
+    docstring). Raises ValueError with the reason if it cannot be made, naming particles by
+    ``global_id`` (as the case and the outputs do; without it by their index here)."""
+
+    def particle(k: int) -> str:
+        if global_id is None:
+            return f"particle index {k}"
+        return f"particle {int(global_id[k])}"
+
     n = position.shape[0]
     unit = float(radius.mean())
     r_max = float(radius.max()) / unit
@@ -323,8 +347,8 @@ def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, uppe
         if bad.size:
             k, q = bad[0]
             raise ValueError(
-                f"particle index {k} (centre {position[k].tolist()} m) is not on the particles' "
-                f"side of the {planes[q].name}: its cell cannot be clipped by it"
+                f"{particle(k)} (centre {position[k].tolist()} m) is not on the particles' side "
+                f"of the {planes[q].name}: its cell cannot be clipped by it"
             )
     span = hi - lo
     inside = position.mean(axis=0)
@@ -412,8 +436,9 @@ def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, uppe
     if np.any(counts > 2):
         k = int(start[np.argmax(counts > 2)])
         raise ValueError(
-            f"particles {key_i[k]} and {key_j[k]} share more than one face (a periodic domain "
-            "shorter than three cells along an axis): the pair would conduct twice"
+            f"{particle(int(key_i[k]))} and {particle(int(key_j[k]))} share more than one face "
+            "(a periodic domain shorter than three cells along an axis): the pair would "
+            "conduct twice"
         )
     sums = np.add.reduceat(face, start) if face.size else np.zeros(0)
     pair_area = sums / counts * unit**2
@@ -462,4 +487,4 @@ def wall_of_face(sim: Simulation, planes: list[Plane], particle: np.ndarray,
     return out
 
 
-__all__ = ["Faces", "Plane", "clipping_planes", "tessellate", "wall_of_face"]
+__all__ = ["Faces", "Plane", "clipping_planes", "tessellate", "wall_name", "wall_of_face"]

@@ -24,9 +24,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numba import prange
 
-from thermodem.engine.tessellation import clipping_planes, tessellate, wall_of_face
+from thermodem.engine.tessellation import clipping_planes, tessellate, wall_name, wall_of_face
 from thermodem.errors import RunNotice, SimulationError
-from thermodem.geometry import wall_layout as wl
 from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.thermal.voronoi import INPUT_FACE_AREA, INPUT_WIDTH, closure_face_area
 
@@ -153,8 +152,7 @@ class VoronoiProvider:
         planes, hot_elsewhere, lower, upper = clipping_planes(sim)
         if hot_elsewhere and not self._warned:
             self._warned = True
-            names = ", ".join(f"{w} ({wl.KIND_NAMES[int(sim.wall_kind[w])]})"
-                              for w in hot_elsewhere)  # fmt: skip
+            names = ", ".join(wall_name(sim, w) for w in hot_elsewhere)
             warnings.warn(
                 f"thermal.tessellation: fixed-temperature walls {names} are not flat walls on a "
                 "clipping plane (a non-periodic domain face or a plane wall): the Voronoi "
@@ -164,7 +162,7 @@ class VoronoiProvider:
             )
         try:
             faces = tessellate(p.position, p.radius, lower, upper, sim.periodic, planes,
-                               self.settings.method)  # fmt: skip
+                               self.settings.method, p.global_id)  # fmt: skip
         except ValueError as exc:
             raise SimulationError(
                 f"thermal.tessellation ({self.settings.method}): {exc} (step {sim.step_count}, "

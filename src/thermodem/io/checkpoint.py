@@ -300,4 +300,13 @@ def load_simulation(
         )
     sim = Simulation(case or ckpt.case(), threads=threads, insert_particles=False)
     sim.load_state(ckpt.state)
+    if case is not None and _list_geometry(case) != _list_geometry(ckpt.case()):
+        sim._needs_rebuild = True  # (the stored lists are of the old domain or cut-off)
     return sim
+
+
+def _list_geometry(case: Case) -> tuple[Any, float]:
+    """What the neighbour lists are built for besides the particles and the skin (engine/
+    restart.py: restore): the domain (its box, the periodic axes) and
+    ``neighbors.extra_distance``."""
+    return case.domain.model_dump(mode="json"), float(case.neighbors.extra_distance)

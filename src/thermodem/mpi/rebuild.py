@@ -133,9 +133,10 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     if sim.skin is None and r_max > 0:
         sim.skin = 0.2 * r_max  # the serial default (engine/neighbor_list.py: cell_size)
     cell = 2.0 * r_max + sim.extra + (sim.skin or 0.0)
+    if r_max > 0.0:  # (no particles, a restart's empty start: nothing to list)
+        check_periodic_length(sim, cell, r_max)
     if not cell > 0.0:  # no particles (a restart's empty start): one cell
         cell = float(np.max(sim.upper - sim.lower))
-    check_periodic_length(sim, cell, r_max)
     imbalance = stats[0] * size / max(total, 1) - 1.0
     if sim.decomposition is None or imbalance > sim.rebalance_threshold:
         if sim.decomposition is not None:

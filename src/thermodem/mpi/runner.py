@@ -388,7 +388,14 @@ def _build(
         case, threads, insert_particles=False, rebalance_threshold=rebalance_threshold
     )
     try:
-        sim.load_state(ckpt.state)
+        sim.load_state(ckpt.state)  # (collective: the rebuild distributes the particles)
+    except SimulationError as exc:
+        # the distributing rebuild refused the (changed) case's lists: a periodic axis too
+        # short for the restored particles, agreed by every rank (the global R_max); an input
+        # error, as serially (engine/run_checks.py: check_restored_lists)
+        raise ConfigError(
+            f"{exc} (met while the restart from {ckpt.path} was set up, before any step)"
+        ) from None
     except (KeyError, IndexError, TypeError, ValueError) as exc:
         raise ConfigError(
             f"checkpoint {ckpt.path} cannot be restored ({type(exc).__name__}: {exc}); the file "
