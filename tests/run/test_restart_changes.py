@@ -229,3 +229,24 @@ def test_changes_a_restart_applies_are_listed(tmp_path: Path) -> None:
     shown = restart_changes(read_checkpoint(ckpt), case_from_dict(many))
     assert len(shown) == 21, shown  # (21 changes: 20 lines)
     assert shown[-1] == "changed from the checkpoint's case: and 1 more", shown
+
+
+def test_restart_of_a_run_whose_list_entry_gives_velocities(tmp_path: Path) -> None:
+    """A list entry with ``velocities`` (one per position): the checkpoint's stored case holds
+    every key, the unused default ``velocity`` too, and reading it back refused 'velocity'
+    and 'velocities' together, so ``restart DIR`` of such a run stopped with exit 2 (and
+    ``run CASE --restart`` with a changed list geometry too). Both continue now, and the
+    continued run reaches the uninterrupted one's state."""
+    case = copy.deepcopy(SETTLE)
+    case["insertion"][1]["velocities"] = [[0.0, 0.0, -0.05], [0.01, 0.0, 0.0]]
+    path = _write(tmp_path / "v.yaml", case)
+    res = _cli("run", str(path), "-o", str(tmp_path / "whole"))
+    assert res.returncode == 0, res.stderr
+    res = _cli("run", str(path), "-o", str(tmp_path / "cut"), "--end-time", "1e-4")
+    assert res.returncode == 0, res.stderr
+    res = _cli("restart", str(tmp_path / "cut"), "--end-time", "2e-4")
+    assert res.returncode == 0, res.stderr
+    whole = _particles(tmp_path / "whole" / "checkpoints" / "checkpoint_000000020.h5")
+    cut = _particles(tmp_path / "cut" / "checkpoints" / "checkpoint_000000020.h5")
+    np.testing.assert_array_equal(whole["position"], cut["position"])
+    np.testing.assert_array_equal(whole["velocity"], cut["velocity"])

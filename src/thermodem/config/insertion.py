@@ -418,7 +418,11 @@ class ListInsertion(_EntryBase):
     )
 
     @model_validator(mode="after")
-    def _check(self) -> ListInsertion:
+    def _check(self, info: ValidationInfo) -> ListInsertion:
+        from thermodem.state.materials import STORED_CASE_KEY
+
+        # a checkpoint's stored case holds every key, the unused default 'velocity' too
+        stored = bool(info.context and info.context.get(STORED_CASE_KEY))
         n = len(self.positions)
         if (self.radius is None) == (self.radii is None):
             raise ValueError(
@@ -431,7 +435,7 @@ class ListInsertion(_EntryBase):
                 raise ValueError(
                     f"{key}: {len(values)} value(s) for {n} position(s); give one per position"
                 )
-        if self.velocities is not None and "velocity" in self.model_fields_set:
+        if self.velocities is not None and "velocity" in self.model_fields_set and not stored:
             raise ValueError(
                 "velocities: give 'velocity' (one for all) or 'velocities' (one per position), "
                 "not both"
