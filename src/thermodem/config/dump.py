@@ -41,11 +41,14 @@ _PLANAR_ONLY = ("thickness", "particle_shape")
 
 
 def _omitted(value: BaseModel) -> tuple[str, ...]:
+    from thermodem.config.insertion import ListInsertion
     from thermodem.config.schema import Case, SimulationSettings
     from thermodem.state.materials import Material
 
     if isinstance(value, SimulationSettings) and not value.planar:
         return _PLANAR_ONLY
+    if isinstance(value, ListInsertion) and value.velocities is not None:
+        return ("velocity",)  # (one per position given: the entry refuses both)
     if isinstance(value, Case) and value.thermal is None:
         return ("thermal",)  # absent: mechanics only (an explicit null is warned about)
     if isinstance(value, Material):  # a table's first value, filled in as the reference
