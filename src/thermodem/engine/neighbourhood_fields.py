@@ -167,7 +167,7 @@ class NeighbourhoodFields:
         make the same cells)."""
         p = self.sim.particles
         local = float(p.radius.max()) if p.count else 0.0
-        comm = getattr(self.sim, "comm", None)
+        comm = self.sim.comm
         if comm is None:
             return local
         from thermodem.mpi.exchange import allreduce_max

@@ -87,6 +87,9 @@ class Simulation(ParticleInsertion, SimulationLedger):
 
     #: the MPI communicator of a run on several ranks (``thermodem.mpi``); None here
     comm = None
+    #: the pairs whose particle i is another rank's ghost and j owned (``thermodem.mpi``);
+    #: None here: one process lists every pair in ``pairs``
+    mirror: PairBuffers | None = None
 
     def __init__(
         self, case: Case, threads: int | None = None, *, insert_particles: bool = True

@@ -319,7 +319,7 @@ class ThermalEngine(ContactConduction, TermEvaluation, ThermalLedger):
     # ------------------------------------------------------------------------------ step
     def _buffers(self) -> None:
         sim = self.sim
-        mirror = getattr(sim, "mirror", None)
+        mirror = sim.mirror
         mirror_capacity = mirror.capacity if mirror is not None else 0
         if (
             self.pair_conductance.shape[0] < sim.pairs.capacity
@@ -353,7 +353,7 @@ class ThermalEngine(ContactConduction, TermEvaluation, ThermalLedger):
             self.rhoc_w = self.density_by_type[sim.wall_material] * self._interp(
                 self.c_t, self.c_v, self.c_n, sim.wall_material, wt
             )
-        mirror = getattr(sim, "mirror", None)
+        mirror = sim.mirror
         listed = max(sim.pairs.count, sim.walls.count, mirror.count if mirror is not None else 0)
         rows = listed // kernels.CHUNK + 1
         self._scratch_rows(rows)

@@ -27,7 +27,7 @@ class ContactConduction:
         owned, mpi/simulation.py), whose heat the owned particle j needs."""
         sim = self.sim
         out = [(sim.pairs, self.pair_conductance)]
-        mirror = getattr(sim, "mirror", None)
+        mirror = sim.mirror
         if mirror is not None and mirror.count:
             out.append((mirror, self.mirror_conductance))
         return out

@@ -287,7 +287,7 @@ class TermEvaluation:
         store = frozen or self.record_conductances
         pair_h, wall_h = self._stored(index, pb.count if store else 0, wb.count if store else 0)
         lists = [(pb, pair_h)]
-        mirror = getattr(sim, "mirror", None)
+        mirror = sim.mirror
         if mirror is not None and mirror.count:
             mirror_h = self.term_mirror_conductance[index]
             if store and mirror_h.shape[0] < mirror.count:

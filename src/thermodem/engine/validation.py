@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -359,16 +360,19 @@ def with_warnings(exc: ConfigError, case: Case, told: list[str] | None = None) -
     return exc
 
 
-def built_simulation(case: Case, threads: int | None = None) -> Simulation:
-    """``Simulation(case)`` of a fresh run (``validate``, ``run``, ``etc``): a SimulationError
-    met while it is built, before step 0 (a periodic axis shorter than two neighbour cells of
-    the inserted particles, a tessellation the start positions cannot make), is an error of
-    the input, not of a run: a ConfigError with its message (exit code 2). Failures met while
-    the run steps stay SimulationErrors."""
+def built_simulation(
+    case: Case, threads: int | None = None, build: Callable[[], Simulation] | None = None
+) -> Simulation:
+    """``Simulation(case)`` of a fresh run (``validate``, ``run``, ``etc``; ``build``: another
+    constructor, the MPI runner's): a SimulationError met while it is built, before step 0
+    (a periodic axis shorter than two neighbour cells of the inserted particles, a
+    tessellation the start positions cannot make), is an error of the input, not of a run: a
+    ConfigError with its message (exit code 2). Failures met while the run steps stay
+    SimulationErrors."""
     from thermodem.engine.simulation import Simulation
 
     try:
-        return Simulation(case, threads=threads)
+        return build() if build is not None else Simulation(case, threads=threads)
     except SimulationError as exc:
         raise ConfigError(f"{exc} (met while the case was built, before any step)") from None
 

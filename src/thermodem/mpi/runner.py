@@ -41,6 +41,7 @@ from thermodem.engine.run_signals import (
     restart_not_started,
 )
 from thermodem.engine.validation import (
+    built_simulation,
     check_completeness,
     on_every_rank,
     pre_run_checks,
@@ -374,11 +375,13 @@ def _read_on_all(comm: Any, path: str | os.PathLike[str]) -> Checkpoint:
 def _build(
     case: Case, threads: int | None, rebalance_threshold: float, ckpt: Checkpoint | None
 ) -> DistributedSimulation:
-    if ckpt is None:  # (a failure while it is built is the input's: as engine/validation.py's
-        try:  # built_simulation)
-            return DistributedSimulation(case, threads, rebalance_threshold=rebalance_threshold)
-        except SimulationError as exc:
-            raise ConfigError(f"{exc} (met while the case was built, before any step)") from None
+    if ckpt is None:  # (a failure while it is built is the input's, as serially)
+        return built_simulation(
+            case,
+            build=lambda: DistributedSimulation(
+                case, threads, rebalance_threshold=rebalance_threshold
+            ),
+        )
     if ckpt.kind == "failed":
         raise ConfigError(
             f"{ckpt.path} holds the state at a failure (for inspection) and cannot be "
