@@ -306,9 +306,12 @@ def nusselt(o, st, i):
     and |v_p - u_f| (the particle's velocity before the step's motion update), Pr = mu c / k;
     the porosity is the case's global_porosity (AVERAGE_POROSITY)."""
     rho, mu, kf, cf = FLUID["rho"], FLUID["mu"], FLUID["k"], FLUID["c"]
-    a = st["v"][i] / math.sqrt(2.0)  # velocity (a, 0, -a) along the line of centres
-    u = FLUID["v"]
-    rel = math.sqrt((a - u[0]) ** 2 + u[1] ** 2 + (-a - u[2]) ** 2)
+    if "rel" in st:  # |v_p - u_f| given (tools/kratos_sphere_wall.py)
+        rel = st["rel"][i]
+    else:
+        a = st["v"][i] / math.sqrt(2.0)  # velocity (a, 0, -a) along the line of centres
+        u = FLUID["v"]
+        rel = math.sqrt((a - u[0]) ** 2 + u[1] ** 2 + (-a - u[2]) ** 2)
     re = rho * 2.0 * st["R"][i] * rel / mu
     pr = mu * cf / kf
     por = o["por"]

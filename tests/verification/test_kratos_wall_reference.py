@@ -1,0 +1,209 @@
+"""A sphere hitting a wall against Kratos ThermalDEMApplication's own regression results.
+
+Source of the reference numbers: KratosMultiphysics/Kratos,
+applications/ThermalDEMApplication/tests/colliding_sphere_wall_3d/ (testDEM.mdpa,
+testDEM_FEM_boundary.mdpa, MaterialsDEM.json, ProjectParametersDEM_<case>.json of the cases
+of CASES), the final TEMPERATURE of node 1 in reference_solutions.json at commit
+ec954286df95fce972e039c1c0a04f1d53e7e486.
+
+The Kratos case: one R = 0.5 m sphere at (-0.2, 0, 0.7) with velocity (10, 0, -10) m/s and
+ω_y = 1 rad/s, 300 K, k(T), c(T) tables, HEATFLUX 50 W/m² and HEATSOURCE -100 W/m³, hits the
+wall z = 0 (400 K, k_w = 400 W/(m K): its table at 400 K) at 0.02 s; Δt = 5e-5 s to 0.03 s,
+in the rebound (v_z ≈ +1.6 m/s, F_n still 4.6 kN). What Kratos computes is
+re-derived in tools/kratos_sphere_wall.py (its docstring: the wall is rigid in Kratos' normal
+law because its plain POISSON_RATIO is 1; R* = R, m* = m). The thermodem case:
+
+* a one-sided plane z = 0 with a fixed temperature of 400 K, of a material with k = 400 and
+  E = 1e20 Pa (rigid to round-off: E* = E_p/(1 - ν_p²));
+* the damping and GlobalDamping emulation of test_kratos_reference.py (Kratos' α = 2 sqrt(3/2) γ
+  as thermodem's restitution, ρ/1.1, c × 1.1 and α √1.1), the same for a wall (m* = m);
+* no tangential or rolling law: Kratos' tangential stiffness against this wall is 8 G* sqrt(Rδ)
+  with G* = 0.25 Pa (the wall's plain E = 1, ν = 1), which leaves v_x at 9.98 m/s; the normal
+  motion does not depend on it, and v_x enters only the convection cases' |v - u_f| (< 1e-5 of
+  T - T0: the re-derivation with v_x = 10 reproduces them to 7e-6).
+* Kratos-only, not emulated: heat every 5th step, E(T), ν(T) and thermal expansion, and
+  GlobalDamping's × 0.9 once the particle rebounds (v_z > 0 from about 0.0265 s; the emulation
+  is × 1.1 throughout); OFFSET is their effect, measured with the re-derivation
+  (`python tools/kratos_sphere_wall.py`).
+
+The re-derivation reproduces Convection_01..04 to 7e-6 of T - T0 and Radiation_01/02 (Kratos
+has no particle-wall radiation and the particle no neighbour: flux and source alone; thermodem
+without `walls: true` sees no wall and, with no neighbour, radiates to nothing either) bit for
+bit, but misses ConductionDir_01 by -0.33 % and ConductionDir_04 by -0.99 % of T - T0 (the
+overlap read back from the reference's HEATFLUX is 0.9 % larger than the re-derivation's; not
+explained, see the tool's docstring). Those two cases are held to the reference plus the OFFSET
+within the miss plus twice the thermodem-vs-re-derivation difference, i.e. they check
+thermodem's wall conduction to about 1 %, not better.
+
+Left difference (thermodem − the re-derivation without the Kratos-only settings, at the same
+Δt): first order in Δt (halved at Δt/2, measured for every case); tolerances about twice it
+(plus the re-derivation's miss for the two conduction cases).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from thermodem.config.load import case_from_dict
+from thermodem.engine.simulation import Simulation
+from thermodem.models.mechanics.normal import hertz_restitution_of_alpha
+
+KRATOS_GAMMA = 0.6668142947865054  # DAMPING_GAMMA of e = 0.2 (GammaForHertzThornton)
+GLOBAL_DAMPING = 0.1
+DT, END = 5.0e-5, 0.03
+T0 = 300.0
+WALL_TEMPERATURE = 400.0
+WALL_CONDUCTIVITY = 400.0  # the Wall material's k(T) table at the wall temperature
+
+# global_fluid_properties (as tests/verification/test_kratos_reference.py)
+FLUID = {
+    "gas": {
+        "thermal_conductivity": 10.0,
+        "density": 1.0,
+        "dynamic_viscosity": 0.1,
+        "specific_heat": 1.0,
+        "mean_free_path": 1e-7,
+    },
+    "fluid": {"temperature": 340.0, "velocity": [100.0, 100.0, 100.0]},
+}
+POROSITY = {"porosity": {"kind": "global", "value": 0.5}}  # global_porosity
+
+# case: (thermodem thermal settings, Kratos T at 0.03 s, OFFSET [K] (the Kratos-only effects,
+# tools/kratos_sphere_wall.py), tolerance / (T - T0))
+CASES = {
+    # re-derivation misses by -3.3e-3; left difference vs the re-derivation -2.3e-4
+    "ConductionDir_01": (
+        {"direct_conduction": "batchelor_obrien_simple"},
+        322.9703553967616,
+        -0.09202042,
+        3.3e-3 + 5e-4,
+    ),
+    # re-derivation misses by -9.9e-3; left difference -1.2e-4
+    "ConductionDir_04": (
+        {"direct_conduction": "thermal_pipe"},
+        310.48362717100804,
+        0.00861619,
+        9.9e-3 + 2.5e-4,
+    ),
+    "Convection_01": (
+        {"direct_conduction": "none", "convection": "ranz_marshall1952", **FLUID},
+        334.97888349023617,
+        -0.07441436,
+        1e-4,  # measured 4.7e-5
+    ),
+    "Convection_02": (
+        {"direct_conduction": "none", "convection": "whitaker1972", **FLUID},
+        332.7069267613779,
+        -0.06398554,
+        1e-4,  # measured 5.4e-5
+    ),
+    "Convection_03": (
+        {"direct_conduction": "none", "convection": "gunn1978", **FLUID, **POROSITY},
+        340.04594604175827,
+        -0.01597574,
+        1e-5,  # measured 2.7e-6
+    ),
+    "Convection_04": (
+        {
+            "direct_conduction": "none",
+            "convection": {"model": "li_mason2000", "regime": "dense"},
+            **FLUID,
+            **POROSITY,
+        },
+        323.9893852478977,
+        -0.01614929,
+        1.3e-4,  # measured 6.3e-5
+    ),
+    # no particle-wall radiation in Kratos, no neighbour: the flux and the source alone.
+    # Radiation_01 (continuum_zhou, the same reference) is left out: thermodem's zhou2009 takes
+    # T_e = T_f (340 K) for a particle without neighbours (+6.5 K here), Kratos nothing
+    "Radiation_02": (
+        {"direct_conduction": "none", "radiation": {"model": "krause2017", "radius_ratio": 4.0}},
+        300.9910452746127,
+        0.00647127,
+        1e-5,  # measured 4.1e-6
+    ),
+}
+
+pytestmark = pytest.mark.usefixtures("one_thread")
+
+
+def kratos_wall_case(thermal: dict, time_step: float = DT) -> dict:
+    factor = 1.0 + GLOBAL_DAMPING
+    alpha = 2.0 * math.sqrt(1.5) * KRATOS_GAMMA * math.sqrt(factor)
+    e = hertz_restitution_of_alpha(alpha)
+    extra = {"emissivity": 0.8} if "radiation" in thermal else {}
+    return {
+        "simulation": {"time_step": time_step, "end_time": END, "gravity": [0.0, 0.0, 0.0]},
+        "domain": {"lower": [-10.0] * 3, "upper": [10.0] * 3},
+        "materials": {
+            "particle": {
+                **extra,
+                "density": 30.0 / factor,  # ρ(T0) = 30 kg/m³
+                "youngs_modulus": 2.0e6,  # E(T0), ν(T0)
+                "poisson_ratio": 0.2,
+                "restitution": e,
+                "sliding_friction": 0.0,
+                "thermal_conductivity_table": [[300.0, 200.0], [400.0, 300.0]],
+                "specific_heat_table": [[300.0, 0.2 * factor], [400.0, 0.3 * factor]],
+            },
+            "wall": {
+                **extra,
+                "density": 30.0,
+                "youngs_modulus": 1.0e20,  # rigid (Kratos: plain POISSON_RATIO 1)
+                "poisson_ratio": 0.4,
+                "restitution": e,
+                "sliding_friction": 0.0,
+                "thermal_conductivity": WALL_CONDUCTIVITY,
+                "specific_heat": 0.4,
+            },
+        },
+        "contact": {"normal": "hertz", "tangential": "none", "rolling": "none"},
+        "walls": [
+            {
+                "kind": "plane",
+                "point": [0.0, 0.0, 0.0],
+                "normal": [0.0, 0.0, 1.0],
+                "material": "wall",
+                "thermal": {"kind": "fixed", "temperature": WALL_TEMPERATURE},
+            }
+        ],
+        "insertion": [
+            {
+                "kind": "list",
+                "material": "particle",
+                "radius": 0.5,
+                "positions": [[-0.2, 0.0, 0.7]],
+                "velocities": [[10.0, 0.0, -10.0]],
+                "temperatures": [T0],
+            }
+        ],
+        "thermal": {
+            **thermal,
+            "heat_flux": [{"select": {"material": "particle"}, "flux": 50.0}],  # W/m²
+            "volumetric_source": [
+                {"select": {"material": "particle"}, "power_density": -100.0}  # W/m³
+            ],
+        },
+    }
+
+
+def final_temperature(thermal: dict, time_step: float = DT) -> float:
+    sim = Simulation(case_from_dict(kratos_wall_case(thermal, time_step)))
+    for _ in range(round(END / time_step)):
+        sim.step()
+    return float(np.asarray(sim.particles.temperature)[0])
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_sphere_wall_follows_kratos(name):
+    """T at 0.03 s = Kratos' reference + the measured effect of its every-5th-step heat, E(T)
+    and expansion, within about twice the measured first-order difference of the heat update's
+    place in the step (plus, for the conduction cases, the re-derivation's miss) of T - T0."""
+    thermal, reference, offset, tolerance = CASES[name]
+    expected = reference + offset
+    temperature = final_temperature(thermal)
+    assert abs(temperature - expected) < tolerance * abs(expected - T0), (name, temperature)
