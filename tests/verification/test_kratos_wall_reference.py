@@ -31,18 +31,20 @@ has no particle-wall radiation and the particle no neighbour: flux and source al
 without `walls: true` sees no wall and, with no neighbour, radiates to nothing either) bit for
 bit, but misses ConductionDir_01 by -0.33 % and ConductionDir_04 by -0.99 % of T - T0 (the
 overlap read back from the reference's HEATFLUX is 0.9 % larger than the re-derivation's; not
-explained, see the tool's docstring). Those two cases are held to the reference plus the OFFSET
-within the miss plus twice the thermodem-vs-re-derivation difference, i.e. they check
-thermodem's wall conduction to about 1 %, not better.
+explained, see the tool's docstring). Those two cases are therefore not held to Kratos'
+numbers: thermodem is compared with the re-derivation itself, run here without the
+Kratos-only settings (an independent line-of-centres integration of the same collision), so
+that the unexplained miss is not hidden in a tolerance.
 
 Left difference (thermodem − the re-derivation without the Kratos-only settings, at the same
-Δt): first order in Δt (halved at Δt/2, measured for every case); tolerances about twice it
-(plus the re-derivation's miss for the two conduction cases).
+Δt): first order in Δt (halved at Δt/2, measured for every case); tolerances about twice it.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -71,23 +73,16 @@ FLUID = {
 }
 POROSITY = {"porosity": {"kind": "global", "value": 0.5}}  # global_porosity
 
+# conduction cases: (thermodem thermal settings, the re-derivation's model, tolerance /
+# (T - T0)); measured left differences -2.3e-4 and -1.2e-4
+CONDUCTION = {
+    "ConductionDir_01": ({"direct_conduction": "batchelor_obrien_simple"}, "simple", 5e-4),
+    "ConductionDir_04": ({"direct_conduction": "thermal_pipe"}, "pipe", 2.5e-4),
+}
+
 # case: (thermodem thermal settings, Kratos T at 0.03 s, OFFSET [K] (the Kratos-only effects,
 # tools/kratos_sphere_wall.py), tolerance / (T - T0))
 CASES = {
-    # re-derivation misses by -3.3e-3; left difference vs the re-derivation -2.3e-4
-    "ConductionDir_01": (
-        {"direct_conduction": "batchelor_obrien_simple"},
-        322.9703553967616,
-        -0.09202042,
-        3.3e-3 + 5e-4,
-    ),
-    # re-derivation misses by -9.9e-3; left difference -1.2e-4
-    "ConductionDir_04": (
-        {"direct_conduction": "thermal_pipe"},
-        310.48362717100804,
-        0.00861619,
-        9.9e-3 + 2.5e-4,
-    ),
     "Convection_01": (
         {"direct_conduction": "none", "convection": "ranz_marshall1952", **FLUID},
         334.97888349023617,
@@ -202,8 +197,23 @@ def final_temperature(thermal: dict, time_step: float = DT) -> float:
 def test_sphere_wall_follows_kratos(name):
     """T at 0.03 s = Kratos' reference + the measured effect of its every-5th-step heat, E(T)
     and expansion, within about twice the measured first-order difference of the heat update's
-    place in the step (plus, for the conduction cases, the re-derivation's miss) of T - T0."""
+    place in the step of T - T0."""
     thermal, reference, offset, tolerance = CASES[name]
     expected = reference + offset
+    temperature = final_temperature(thermal)
+    assert abs(temperature - expected) < tolerance * abs(expected - T0), (name, temperature)
+
+
+@pytest.mark.parametrize("name", list(CONDUCTION))
+def test_sphere_wall_conduction_follows_the_rederivation(name):
+    """ConductionDir_01/04: T at 0.03 s = the re-derivation's (tools/kratos_sphere_wall.py,
+    without the Kratos-only settings, run here) within about twice the measured first-order
+    difference of the heat update's place in the step. (The re-derivation misses Kratos'
+    own reference by -0.33 % / -0.99 % of T - T0, unexplained: see the module docstring.)"""
+    sys.path.insert(0, str(Path(__file__).parents[2] / "tools"))
+    import kratos_sphere_wall as tool
+
+    thermal, model, tolerance = CONDUCTION[name]
+    expected = tool.run(model=model, **tool.OFF)["T"]
     temperature = final_temperature(thermal)
     assert abs(temperature - expected) < tolerance * abs(expected - T0), (name, temperature)
