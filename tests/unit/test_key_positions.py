@@ -1,4 +1,4 @@
-"""The MPI rebuild's key lookup (kernels/halo.py: key_positions, mpi/rebuild.py:
+"""The MPI rebuild's key lookup (kernels/halo.py: fill_key_table, look_up_keys; mpi/rebuild.py:
 _positions_of) against a Python dict: random and structured keys (global-id pairs), absent
 keys, empty tables and one key."""
 

@@ -42,47 +42,47 @@ def unpack_moving(
             temperature[i] = buffer[k, 9]
 
 
-@njit(cache=True, error_model="numpy")
-def rows_with_history(history, pair_i, count, selected, out):
-    """The rows k < ``count`` whose history has a non-zero value and whose particle
-    ``pair_i[k]`` is ``selected``, into ``out``; returns how many (one pass: numpy's
-    ``any(history != 0, axis=1)`` made a temporary of the whole history)."""
-    m = 0
-    for k in range(count):
-        if not selected[pair_i[k]]:
-            continue
-        for c in range(history.shape[1]):
-            if history[k, c] != 0.0:
-                out[m] = k
-                m += 1
-                break
-    return m
+@njit(cache=True, error_model="numpy", inline="always")
+def _slot(key, shift):
+    return np.int64((np.uint64(key) * np.uint64(0x9E3779B97F4A7C15)) >> shift)
 
 
-@njit(cache=True, error_model="numpy")
-def key_positions(keys, wanted, table, out):
-    """``out[q]``: the index k with ``keys[k] == wanted[q]``, -1 when absent (keys unique and
-    non-negative). An open-addressing hash table (``table``: int64, a power of two >= 2 and
-    at least twice len(keys), scratch) with Fibonacci hashing and linear probing: O(n) against a
-    sort and binary searches (the MPI rebuild matches the history records of every listed
-    pair by the key of its two global ids; 10^5-10^6 keys)."""
-    size = table.shape[0]
+@njit(cache=True, error_model="numpy", inline="always")
+def _shift(size):
     bits = 0
     while (1 << bits) < size:
         bits += 1
-    shift = np.uint64(64 - bits)
+    return np.uint64(64 - bits)
+
+
+@njit(cache=True, error_model="numpy")
+def fill_key_table(keys, table):
+    """An open-addressing hash table of ``keys`` (unique, non-negative; ``table``: int64, a
+    power of two >= 2 and at least twice len(keys)) with Fibonacci hashing and linear probing,
+    built once and looked up by :func:`look_up_keys` as often as needed: O(n) against a sort
+    and binary searches (the MPI rebuild matches the history records of every listed pair by
+    the key of its two global ids; 10^5-10^6 keys)."""
+    size = table.shape[0]
+    shift = _shift(size)
     mask = np.int64(size - 1)
-    golden = np.uint64(0x9E3779B97F4A7C15)
     for s in range(size):
         table[s] = -1
     for k in range(keys.shape[0]):
-        s = np.int64((np.uint64(keys[k]) * golden) >> shift)
+        s = _slot(keys[k], shift)
         while table[s] >= 0:
             s = (s + 1) & mask
         table[s] = k
+
+
+@njit(cache=True, error_model="numpy")
+def look_up_keys(keys, table, wanted, out):
+    """``out[q]``: the index of ``wanted[q]`` in ``keys`` through their table, or -1."""
+    size = table.shape[0]
+    shift = _shift(size)
+    mask = np.int64(size - 1)
     for q in range(wanted.shape[0]):
         key = wanted[q]
-        s = np.int64((np.uint64(key) * golden) >> shift)
+        s = _slot(key, shift)
         found = -1
         while table[s] >= 0:
             if keys[table[s]] == key:
@@ -90,3 +90,61 @@ def key_positions(keys, wanted, table, out):
                 break
             s = (s + 1) & mask
         out[q] = found
+
+
+@njit(cache=True, error_model="numpy")
+def history_records(history, pair_i, pair_j, count, selected, global_id, wall, rows, owner):
+    """The history records of the rows k < ``count`` whose history has a non-zero value and
+    whose particle ``pair_i[k]`` is ``selected``, in one pass (numpy's ``any(history != 0,
+    axis=1)`` and fancy indexing made temporaries of the whole history): ``rows[m] = [gid_i,
+    gid_j (the wall index for a wall pair), history...]`` and ``owner[m] = pair_i[k]``;
+    returns how many (``rows`` and ``owner``: at least ``count`` rows, scratch beyond)."""
+    width = history.shape[1]
+    m = 0
+    for k in range(count):
+        i = pair_i[k]
+        if not selected[i]:
+            continue
+        touched = False
+        for c in range(width):
+            if history[k, c] != 0.0:
+                touched = True
+                break
+        if not touched:
+            continue
+        rows[m, 0] = global_id[i]
+        rows[m, 1] = pair_j[k] if wall else global_id[pair_j[k]]
+        for c in range(width):
+            rows[m, 2 + c] = history[k, c]
+        owner[m] = i
+        m += 1
+    return m
+
+
+@njit(cache=True, error_model="numpy")
+def record_keys(records, base, out):
+    """``out[m]``: the key gid_i × ``base`` + other of record ``m`` (its first two columns)."""
+    for m in range(records.shape[0]):
+        out[m] = np.int64(records[m, 0]) * base + np.int64(records[m, 1])
+
+
+@njit(cache=True, error_model="numpy")
+def pair_keys(global_id, pair_i, pair_j, count, base, out):
+    """``out[k]``: the key gid(pair_i[k]) × ``base`` + gid(pair_j[k]) of listed pair k."""
+    for k in range(count):
+        out[k] = np.int64(global_id[pair_i[k]]) * base + np.int64(global_id[pair_j[k]])
+
+
+@njit(cache=True, error_model="numpy")
+def history_from_records(history, count, found, records):
+    """History row k < ``count`` from record ``found[k]`` (its columns after the two ids), or
+    zero where ``found[k]`` is -1 (a new pair)."""
+    width = history.shape[1]
+    for k in range(count):
+        f = found[k]
+        if f >= 0:
+            for c in range(width):
+                history[k, c] = records[f, 2 + c]
+        else:
+            for c in range(width):
+                history[k, c] = 0.0

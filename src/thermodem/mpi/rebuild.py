@@ -30,7 +30,14 @@ from thermodem.geometry import wall_layout as WL
 from thermodem.kernels import contact as C
 from thermodem.kernels import neighbors as NB
 from thermodem.kernels import slabs as SL
-from thermodem.kernels.halo import key_positions, rows_with_history
+from thermodem.kernels.halo import (
+    fill_key_table,
+    history_from_records,
+    history_records,
+    look_up_keys,
+    pair_keys,
+    record_keys,
+)
 from thermodem.mpi import exchange as X
 from thermodem.mpi.decomposition import bisect
 from thermodem.state.pairs import PairBuffers
@@ -44,30 +51,42 @@ def pair_records(
     buf: PairBuffers, global_id: np.ndarray, selected: np.ndarray, wall: bool
 ) -> tuple[np.ndarray, np.ndarray]:
     """Rows ``[gid_i, gid_j or wall, history...]`` of the pairs with a non-zero history whose
-    particle i is ``selected`` (a mask over the particles), and the index of each one's i."""
+    particle i is ``selected`` (a mask over the particles), and the index of each one's i
+    (one pass, kernels/halo.py: history_records)."""
     c = buf.count
-    history = buf.history[:c]
-    keep = np.empty(c, np.int64)
-    keep = keep[: rows_with_history(history, buf.i, c, selected, keep)]
-    owner = buf.i[keep].astype(np.int64)
-    rows = np.empty((keep.shape[0], 2 + history.shape[1]))
-    rows[:, 0] = global_id[owner]
-    rows[:, 1] = buf.j[keep] if wall else global_id[buf.j[keep]]
-    rows[:, 2:] = history[keep]
-    return rows, owner
+    rows = np.empty((c, 2 + buf.history.shape[1]))
+    owner = np.empty(c, np.int64)
+    m = history_records(buf.history, buf.i, buf.j, c, selected, global_id, wall, rows, owner)
+    return rows[:m], owner[:m]
+
+
+def _record_keys(records: np.ndarray, base: np.int64) -> np.ndarray:
+    """The key gid_i × base + other of every record."""
+    out = np.empty(records.shape[0], np.int64)
+    record_keys(records, base, out)
+    return out
+
+
+class _KeyTable:
+    """The hash table of unique, non-negative ``keys`` (kernels/halo.py: fill_key_table; a
+    sort and binary searches took about a third of an MPI rebuild), built once and looked up
+    as often as needed."""
+
+    def __init__(self, keys: np.ndarray) -> None:
+        self.keys = np.ascontiguousarray(keys, np.int64)
+        self.table = np.empty(1 << max(int(2 * self.keys.shape[0]).bit_length(), 1), np.int64)
+        fill_key_table(self.keys, self.table)
+
+    def positions(self, wanted: np.ndarray) -> np.ndarray:
+        """Index in the keys of each of ``wanted`` (-1 when absent)."""
+        out = np.empty(wanted.shape[0], np.int64)
+        look_up_keys(self.keys, self.table, np.ascontiguousarray(wanted, np.int64), out)
+        return out
 
 
 def _positions_of(keys: np.ndarray, wanted: np.ndarray) -> np.ndarray:
-    """Index in ``keys`` (unique, non-negative) of each of ``wanted`` (-1 when absent), by a
-    hash table (kernels/halo.py: key_positions; a sort and binary searches took about a
-    third of an MPI rebuild)."""
-    out = np.empty(wanted.shape[0], np.int64)
-    size = 1 << max(int(2 * keys.shape[0]).bit_length(), 1)
-    table = np.empty(size, np.int64)
-    key_positions(
-        np.ascontiguousarray(keys, np.int64), np.ascontiguousarray(wanted, np.int64), table, out
-    )
-    return out
+    """Index in ``keys`` (unique, non-negative) of each of ``wanted`` (-1 when absent)."""
+    return _KeyTable(keys).positions(wanted)
 
 
 def _split(dest: np.ndarray, rows: np.ndarray, size: int) -> list[np.ndarray]:
@@ -80,16 +99,15 @@ def _split(dest: np.ndarray, rows: np.ndarray, size: int) -> list[np.ndarray]:
 
 
 def _take_history(
-    buf: PairBuffers, keys: np.ndarray, records: np.ndarray, record_keys: np.ndarray
+    buf: PairBuffers, keys: np.ndarray, records: np.ndarray, table: _KeyTable
 ) -> None:
-    """History rows of the listed pairs (``keys``) from the records with the same key."""
+    """History rows of the listed pairs (``keys``) from the records with the same key (zero
+    for a pair without one: new); ``table``: the records' keys."""
     count = keys.shape[0]
-    buf.history[:count] = 0.0
-    if count == 0 or record_keys.shape[0] == 0:
+    if table.keys.shape[0] == 0:
+        buf.history[:count] = 0.0
         return
-    found = _positions_of(record_keys, keys)
-    hit = np.nonzero(found >= 0)[0]
-    buf.history[hit] = records[found[hit], 2:]
+    history_from_records(buf.history, count, table.positions(keys), records)
 
 
 # ------------------------------------------------------------------------------- rebuild
@@ -283,7 +301,7 @@ def _build_lists(sim: DistributedSimulation, dims, edge, axes, axis: int, record
     j = order[sj[:count]]
     del si, sj, order
     key_base = np.int64(max(sim.next_global_id, 1))
-    record_keys = records[:, 0].astype(np.int64) * key_base + records[:, 1].astype(np.int64)
+    record_table = _KeyTable(_record_keys(records, key_base))
     nlayers = SL.layer_count(int(dims[axis]), bool(gper[axis]))
     for buf, mask in ((pb, i < own), (mb, (i >= own) & (j < own))):
         li = np.ascontiguousarray(i[mask], np.int32)
@@ -302,8 +320,9 @@ def _build_lists(sim: DistributedSimulation, dims, edge, axes, axis: int, record
             buf.allocate(PairBuffers.grown(buf.capacity, m))
         buf.i[:m], buf.j[:m] = li, lj
         buf.count, buf.group_start = m, group_start
-        keys = p.global_id[li].astype(np.int64) * key_base + p.global_id[lj].astype(np.int64)
-        _take_history(buf, keys, records, record_keys)
+        keys = np.empty(m, np.int64)
+        pair_keys(p.global_id, li, lj, m, key_base, keys)
+        _take_history(buf, keys, records, record_table)
         buf.state[:m] = C.STATE_UNSET
     # wall pairs of the owned particles
     if sim.wall_row_start.shape[0] != n + 1:
@@ -324,6 +343,6 @@ def _build_lists(sim: DistributedSimulation, dims, edge, axes, axis: int, record
     wb.i[:wcount], wb.j[:wcount], wb.count = wi[:wcount], ww[:wcount], wcount
     nwalls = np.int64(max(sim.wall_rows.shape[0], 1))
     wkeys = p.global_id[wi[:wcount]].astype(np.int64) * nwalls + ww[:wcount].astype(np.int64)
-    wrec_keys = wall_records[:, 0].astype(np.int64) * nwalls + wall_records[:, 1].astype(np.int64)
-    _take_history(wb, wkeys, wall_records, wrec_keys)
+    wrec_keys = _record_keys(wall_records, nwalls)
+    _take_history(wb, wkeys, wall_records, _KeyTable(wrec_keys))
     wb.state[:wcount] = C.STATE_UNSET
