@@ -1032,3 +1032,34 @@ def test_a_pour_batch_tries_at_most_what_half_the_region_holds():
     assert 0 < len(new) <= pourer.batch_cap
     assert pourer.inserted + pourer.skipped == 1_000_000
     assert count_overlaps(new.position, new.radius) == 0
+
+
+def test_given_particles_are_checked_across_periodic_boundaries():
+    """A list or file entry is checked by the nearest images on the periodic axes, as the run
+    sees the pairs: two particles overlapping across the boundary were accepted and the run
+    stopped at its first step. Touching across the boundary is fine, and without periodicity
+    the same positions are far apart."""
+    rng = np.random.default_rng(0)
+    domain = (np.zeros(3), np.full(3, 0.01))
+
+    def entry(*xs: float, **kw) -> ListInsertion:
+        return ListInsertion(
+            kind="list", material="m", radius=0.001, positions=[[x, 0.005, 0.005] for x in xs], **kw
+        )
+
+    def given(e: ListInsertion, periodic, existing=(None, None)) -> InsertedParticles:
+        return insert(e, rng, *existing, domain=domain, periodic=periodic, key="insertion.0")
+
+    across = (True, False, False)
+    with pytest.raises(ConfigError, match=r"positions.1: .* overlaps insertion.0.positions.0 by "
+                       r"1.7 .* across the periodic boundary of x"):  # fmt: skip
+        given(entry(0.0002, 0.0099), across)
+    assert len(given(entry(0.0002, 0.0099), (False, True, True))) == 2
+    assert len(given(entry(0.0002, 0.0099), None)) == 2
+    assert len(given(entry(0.001, 0.009), across)) == 2  # touching across x
+    with pytest.raises(ConfigError, match="same position"):  # x = 0 and x = L are one point
+        given(entry(0.0, 0.01, overlap_check=False), across)
+    earlier = (np.array([[0.0095, 0.005, 0.005]]), np.array([0.001]))
+    with pytest.raises(ConfigError, match="an earlier insertion entry .* periodic boundary of x"):
+        given(entry(0.0003), across, earlier)
+    assert len(given(entry(0.0003), None, earlier)) == 1

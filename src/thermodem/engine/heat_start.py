@@ -56,6 +56,7 @@ def _static_temperatures(sim: Simulation, count: int) -> np.ndarray:
                 entry, rng, positions, radii, key=f"insertion.{k}",
                 domain=(sim.lower, sim.upper),
                 max_overlap_ratio=case.simulation.max_overlap_ratio, planar=sim.planar,
+                periodic=case.domain.periodic,
             )  # fmt: skip
         except ConfigError as exc:
             raise ConfigError(

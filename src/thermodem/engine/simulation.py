@@ -186,6 +186,7 @@ class Simulation(ParticleInsertion, SimulationLedger):
                         domain=(self.lower, self.upper),
                         max_overlap_ratio=sim.max_overlap_ratio,
                         planar=self.planar,
+                        periodic=tuple(bool(a) for a in self.periodic),
                     )
                 )
         if case.external_force and insert_particles:

@@ -33,8 +33,11 @@ def insert_given(
     max_overlap_ratio: float,
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
+    periodic: Any = None,
 ) -> InsertedParticles:
-    """The particles of a ``file`` or ``list`` entry, checked (see the module docstring)."""
+    """The particles of a ``file`` or ``list`` entry, checked (see the module docstring).
+    ``periodic`` (three booleans, with ``domain``): pairs across a periodic boundary are
+    checked by their nearest images, as the run sees them."""
     given = _insert_file(entry, walls_ok, planar) if isinstance(entry, FileInsertion) else None
     if isinstance(entry, ListInsertion):
         given = _insert_list(entry)
@@ -42,7 +45,7 @@ def insert_given(
     if planar:
         _check_planar(given, entry)
     _check_given(entry, given, key, domain, max_overlap_ratio, existing_positions,
-                 existing_radii, planar)  # fmt: skip
+                 existing_radii, planar, periodic)  # fmt: skip
     return given.particles
 
 
@@ -126,9 +129,10 @@ def _check_given(
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
     planar: bool = False,
+    periodic: Any = None,
 ) -> None:
     """Refuse given particles outside the domain, wider than it (a radius in mm read as
-    metres), coincident or overlapping too deeply."""
+    metres), coincident or overlapping too deeply (across a periodic boundary too)."""
     p = given.particles
     sep = "." if isinstance(entry, ListInsertion) else ".path: "
 
@@ -160,6 +164,7 @@ def _check_given(
                     "metres (is the radius in mm?); give radii smaller than half the domain or "
                     "enlarge domain"
                 )
+    images = _Images(domain, periodic)
     found = _deepest_overlap(
         p.position,
         p.radius,
@@ -167,6 +172,7 @@ def _check_given(
         existing_positions,
         existing_radii,
         coincident_only=not entry.overlap_check,
+        images=images,
     )
     if found is None:
         return
@@ -179,13 +185,16 @@ def _check_given(
     else:
         other_pos, other_rad = p.position[j], float(p.radius[j])
         other = f"the particle of {given.where(j)}" if sep != "." else f"{key}.{given.where(j)}"
-    distance = float(np.linalg.norm(p.position[i] - other_pos))
+    gap = images.separation(p.position[[i]], np.reshape(other_pos, (1, 3)))[0]
+    distance = float(np.linalg.norm(gap))
+    across = not np.allclose(gap, p.position[i] - other_pos, rtol=0.0, atol=0.0)
     if distance <= COINCIDENT_DISTANCE * max(float(p.radius[i]), other_rad):
         what = f"is at the same position as {other} (a duplicate row?)"
     else:
+        wrapped = images.axes(gap, p.position[i] - other_pos) if across else ""
         what = (
             f"overlaps {other} by {ratio:.3g} of the smaller radius (centres {distance:.6g} m "
-            "apart)"
+            f"apart{' across the periodic boundary of ' + wrapped if wrapped else ''})"
         )
     rule = (
         f"given particles may overlap by at most simulation.max_overlap_ratio = {limit:g} of the "
@@ -205,26 +214,34 @@ def _deepest_overlap(
     existing_positions: np.ndarray | None,
     existing_radii: np.ndarray | None,
     coincident_only: bool = False,
+    images: _Images | None = None,
 ) -> tuple[int, int, float, bool] | None:
     """The first pair (in the order given) whose overlap exceeds ``limit`` × the smaller
     radius (``coincident_only``: whose centres are within :data:`COINCIDENT_DISTANCE` × the
     larger radius): (i, j, overlap ratio, j is an existing particle), or None.
 
-    Pairs come from a k-d tree (scipy.spatial.cKDTree) within ``r_i + r_max``: O(n log n).
+    Pairs come from a k-d tree (scipy.spatial.cKDTree) within ``r_i + r_max``: O(n log n);
+    ``images``: the periodic axes of the domain (pairs by their nearest images).
     """
-    from scipy.spatial import cKDTree
-
     n = rad.shape[0]
     if n == 0:
         return None
+    images = images if images is not None else _Images(None, None)
+
+    def _overlap_ratio(pa, ra, pb, rb):  # noqa: ANN001, ANN202
+        return overlap_ratio(pa, ra, pb, rb, images)
 
     def bad_pairs(pa, ra, pb, rb):  # noqa: ANN001, ANN202
         if coincident_only:
-            d = np.sqrt(np.einsum("ij,ij->i", pa - pb, pa - pb))
+            gap = images.separation(pa, pb)
+            d = np.sqrt(np.einsum("ij,ij->i", gap, gap))
             return d <= COINCIDENT_DISTANCE * np.maximum(ra, rb)
         return _overlap_ratio(pa, ra, pb, rb) > limit
 
-    tree = cKDTree(pos)
+    ex_rad0 = np.asarray(existing_radii if existing_radii is not None else [], np.float64)
+    reach0 = max(float(rad.max()), float(ex_rad0.max()) if ex_rad0.size else 0.0)
+    make_tree = images.tree_maker(2.0 * reach0)
+    tree = make_tree(pos)
     candidates: list[tuple[int, int, float, bool]] = []
     reach = float(rad.max())
     if n > 1:
@@ -244,7 +261,7 @@ def _deepest_overlap(
         ex_rad = np.asarray(existing_radii, dtype=np.float64).reshape(-1)
         reach = max(reach, float(ex_rad.max()))
         cut = COINCIDENT_DISTANCE * reach if coincident_only else float(rad.max() + ex_rad.max())
-        m = tree.sparse_distance_matrix(cKDTree(ex_pos), cut, output_type="ndarray")
+        m = tree.sparse_distance_matrix(make_tree(ex_pos), cut, output_type="ndarray")
         if m.size:
             a, b = m["i"].astype(np.int64), m["j"].astype(np.int64)
             bad = np.flatnonzero(bad_pairs(pos[a], rad[a], ex_pos[b], ex_rad[b]))
@@ -258,7 +275,60 @@ def _deepest_overlap(
     return min(candidates, key=lambda c: c[0])
 
 
-def _overlap_ratio(pa: np.ndarray, ra: np.ndarray, pb: np.ndarray, rb: np.ndarray) -> np.ndarray:
-    """(r_a + r_b - |x_a - x_b|) / min(r_a, r_b) for each pair (coincident: >= 2)."""
-    d = np.sqrt(np.einsum("ij,ij->i", pa - pb, pa - pb))
+def overlap_ratio(
+    pa: np.ndarray,
+    ra: np.ndarray,
+    pb: np.ndarray,
+    rb: np.ndarray,
+    images: _Images | None = None,
+) -> np.ndarray:
+    """(r_a + r_b - |x_a - x_b|) / min(r_a, r_b) for each pair (coincident: >= 2); with
+    ``images``, |x_a - x_b| between the nearest images on the periodic axes."""
+    gap = pa - pb if images is None else images.separation(pa, pb)
+    d = np.sqrt(np.einsum("ij,ij->i", gap, gap))
     return (ra + rb - d) / np.minimum(ra, rb)
+
+
+class _Images:
+    """The periodic axes of the domain for the overlap checks: separations between nearest
+    images, and k-d trees with the domain's periodic topology (scipy's ``boxsize``; a
+    non-periodic axis gets a box wider than the domain and any search, so nothing wraps)."""
+
+    def __init__(self, domain: Any, periodic: Any) -> None:
+        self.period = np.zeros(3)
+        self.lower = np.zeros(3)
+        self.extent = np.zeros(3)
+        if domain is not None and periodic is not None and any(bool(p) for p in periodic):
+            self.lower = np.asarray(domain[0], dtype=np.float64)
+            self.extent = np.asarray(domain[1], dtype=np.float64) - self.lower
+            self.period = np.where(np.asarray(periodic, dtype=bool), self.extent, 0.0)
+
+    def separation(self, pa: np.ndarray, pb: np.ndarray) -> np.ndarray:
+        gap = pa - pb
+        on = self.period > 0.0
+        if on.any():
+            gap[:, on] -= self.period[on] * np.round(gap[:, on] / self.period[on])
+        return gap
+
+    def axes(self, gap: np.ndarray, direct: np.ndarray) -> str:
+        """The axes on which the nearest image is not the direct difference ('x and z')."""
+        names = [a for k, a in enumerate("xyz") if gap[k] != direct[k]]
+        return " and ".join(names)
+
+    def tree_maker(self, cut: float) -> Callable[[np.ndarray], Any]:
+        from scipy.spatial import cKDTree
+
+        if not (self.period > 0.0).any():
+            return cKDTree
+        period, on = self.period, self.period > 0.0
+        pad = self.extent + cut
+        box = np.where(on, period, 3.0 * self.extent + 4.0 * cut)
+
+        def make(points: np.ndarray) -> Any:
+            shifted = np.asarray(points, dtype=np.float64).reshape(-1, 3) - self.lower
+            shifted[:, on] = np.mod(shifted[:, on], period[on])
+            shifted[:, on] = np.where(shifted[:, on] >= period[on], 0.0, shifted[:, on])
+            shifted[:, ~on] += pad[~on]  # (the domain's extent beyond it on either side)
+            return cKDTree(shifted, boxsize=box)
+
+        return make

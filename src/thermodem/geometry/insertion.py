@@ -270,6 +270,7 @@ def insert(
     domain: tuple[np.ndarray, np.ndarray] | None = None,
     max_overlap_ratio: float = DEFAULT_MAX_OVERLAP_RATIO,
     planar: bool = False,
+    periodic: tuple[bool, bool, bool] | None = None,
 ) -> InsertedParticles:
     """Insert the particles of one static entry (``lattice``, ``random_*``, ``file``, ``list``).
 
@@ -289,7 +290,8 @@ def insert(
     * ``file``/``list``: positions are used as given, after checks: every centre inside
       ``domain`` (``(lower, upper)``, if given), no two particles (given, or given and
       existing) coincident or overlapping by more than ``max_overlap_ratio`` of the smaller
-      radius, and ``walls_ok`` accepting every particle.
+      radius (by the nearest images across the ``periodic`` axes of ``domain``), and
+      ``walls_ok`` accepting every particle.
 
     Errors are :class:`~thermodem.errors.ConfigError` (a ValueError) whose message starts with
     ``key`` (the entry's key path, e.g. ``insertion.0``).
@@ -308,7 +310,7 @@ def insert(
             from thermodem.geometry.given_particles import insert_given  # (imports this module)
 
             return insert_given(entry, walls_ok, planar, key, domain, max_overlap_ratio,
-                                existing_positions, existing_radii)  # fmt: skip
+                                existing_positions, existing_radii, periodic)  # fmt: skip
     except ConfigError:
         raise
     except ValueError as exc:
