@@ -37,7 +37,40 @@ def suggest(name: str, choices: list[str]) -> str | None:
 
 def _hint(name: str, choices: list[str]) -> str:
     best = suggest(name, choices)
+    if best is None and ALIASES.get(str(name).casefold()) in choices:
+        best = ALIASES[str(name).casefold()]
     return f" (did you mean {best!r}?)" if best else ""
+
+
+#: A number followed by a unit ('1e-5 s', '300K', '10 MPa', '25 °C'): units are not read.
+_WITH_UNIT = re.compile(
+    r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([^\d\s.,;:+\-*()][^;]*?)\s*$"
+)
+
+
+def unit_hint(value: Any) -> str:
+    """'; ...' telling that a string such as '1e-5 s' is a number with a unit, which a case
+    does not read (SI units throughout; °C given in kelvin), or '' for any other value."""
+    m = _WITH_UNIT.match(value) if isinstance(value, str) else None
+    if m is None:
+        return ""
+    try:  # '3e2' (YAML 1.1 reads a number without a dot as a string) is a number
+        float(value)
+        return ""
+    except ValueError:
+        pass
+    number, unit = m.group(1), m.group(2).strip()
+    if unit.replace(" ", "") in ("°C", "ºC", "degC", "C", "celsius", "Celsius"):
+        kelvin = float(number) + 273.15
+        return (
+            f"; {value.strip()!r} is a temperature in °C with its unit: temperatures are "
+            f"numbers in kelvin, without a unit: {kelvin:g} ({number} °C)"
+        )
+    return (
+        f"; {value.strip()!r} is a number with a unit ({unit}): units are not read, every value "
+        "is a plain number in SI units (m, s, kg, Pa, K, W), e.g. 1.0e-5 for 10 µs, 1.0e7 for "
+        "10 MPa"
+    )
 
 
 _GAS_KEYS = "thermal_conductivity, specific_heat, dynamic_viscosity, heat_capacity_ratio, "
@@ -57,16 +90,61 @@ MOVED_KEYS: dict[tuple[str, str], str] = {
 }
 
 
+_MPI = (
+    "a run on several MPI ranks is started by the launcher, mpiexec -n P thermodem run CASE "
+    "--output DIR, and the domain is cut between the ranks automatically (docs/mpi.md): no "
+    "case key sets it"
+)
+_THREADS = "the threads are an option of the command line, thermodem run CASE --threads N"
+_OUTPUT_DIRECTORY = (
+    "the output directory is given on the command line, thermodem run CASE --output DIR"
+)
+#: Keys of other codes and of the command line, in any section -> what to write instead
+#: (the settings of a run, not of a case, and names LIGGGHTS or Lethe users bring along).
+COMMAND_LINE_KEYS: dict[str, str] = {
+    **dict.fromkeys(
+        ("processors", "nprocs", "num_procs", "mpi", "ranks", "partitions", "decomposition"),
+        _MPI,
+    ),
+    **dict.fromkeys(("threads", "num_threads", "nthreads", "omp_num_threads"), _THREADS),
+    **dict.fromkeys(
+        ("directory", "output_directory", "output_dir", "dir", "folder", "output_path"),
+        _OUTPUT_DIRECTORY,
+    ),
+}
+#: Other codes' short names of keys -> the key here (used when no spelling is close).
+ALIASES: dict[str, str] = {
+    "dt": "time_step",
+    "delta_t": "time_step",
+    "t_end": "end_time",
+    "tend": "end_time",
+    "kn": "stiffness",
+    "k_n": "stiffness",
+}
+
+
 def _moved(key: str, parent: _Where | None) -> str | None:
     from thermodem.config.schema import Case
+    from thermodem.geometry.walls import _WallBase
+    from thermodem.state.materials import Material
 
     if parent is None:
         return None
     if parent.family is not None:
+        if key in Material.model_fields:
+            return (
+                f"{key} is a material property, not a parameter of the model: give it as "
+                f"materials.NAME.{key} (the model reads it from the materials of each pair)"
+            )
         return MOVED_KEYS.get(("model", key))
     if parent.tp is Case:
         return MOVED_KEYS.get(("case", key))
-    return None
+    if key == "temperature" and isinstance(parent.tp, type) and issubclass(parent.tp, _WallBase):
+        return (
+            "a wall's temperature is its thermal condition: thermal: {kind: fixed, "
+            "temperature: T} (T in K, a table [[t, T], ...] or an expression of t)"
+        )
+    return COMMAND_LINE_KEYS.get(key.casefold()) if isinstance(key, str) else None
 
 
 # ---------------------------------------------------------------- types along a key path
@@ -333,6 +411,10 @@ def format_error(err: dict[str, Any], data: Any) -> str:
     # 0' does not: that 0 is the bound)
     quoted = re.search(r"\bgot\b", msg) is not None and repr(value) in msg
     shown = "" if isinstance(value, dict | list) or quoted else f" (got {_shown(value)})"
+    if isinstance(value, list) and kind in ("float_type", "int_type"):
+        shown = f" (got the list {_shown(value)}: one number is expected here)"
+    if kind in ("float_parsing", "int_parsing"):
+        shown += unit_hint(value)
     return f"{dotted}: {msg}{shown}" if dotted else f"{msg}{shown}"
 
 
@@ -438,6 +520,19 @@ def _collapse_unions(errors: list[dict[str, Any]], data: Any) -> list[dict[str, 
             msg = f"should be {alternatives or taken[0]}"
             out.append({**err, "loc": tuple(err["loc"])[:k], "type": "union_type", "msg": msg})
             continue
+        if isinstance(members[0][1].get("input"), int | float) and len(content) > 1:
+            # a number refused by a number member and by a name member (substeps: 2.5, an
+            # integer or 'auto'): the number member's line, with the names as alternatives
+            names = [e for _, e in content if e["type"] == "literal_error"]
+            numbers = [(k, e) for k, e in content if e["type"] != "literal_error"]
+            if names and numbers:
+                expected = re.findall(r"'([^']*)'", str((names[0].get("ctx") or {}).get(
+                    "expected", "")))  # fmt: skip
+                k, err = numbers[0]
+                loc = tuple(err["loc"])
+                alternatives = " or ".join(repr(x) for x in expected)
+                out.append({**err, "loc": loc[:k] + loc[k + 1 :], "or_list": alternatives})
+                continue
         for k, err in content:
             loc = tuple(err["loc"])
             tag = str(loc[k])

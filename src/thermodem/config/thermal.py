@@ -512,6 +512,11 @@ class WallThermal(StrictModel):
                 number = None
             if number is not None and not math.isfinite(number):
                 raise ValueError(f"Input should be a finite number (got {v!r})")
+            from thermodem.config.messages import unit_hint
+
+            unit = unit_hint(v)
+            if unit:  # '300K', '25 °C': read as an expression of t, refused as bad syntax
+                raise ValueError(f"should be a number in K (got {v!r}){unit}")
             from thermodem.engine.expressions import compile_expression
 
             compile_expression(v, ("t",))

@@ -124,6 +124,21 @@ class InteractionOverride(StrictModel):
         default=None, gt=0, description="equivalent RMS asperity slope τ of the pair [-]"
     )
 
+    @model_validator(mode="after")
+    def _some_coefficient(self, info: ValidationInfo) -> InteractionOverride:
+        # an entry naming the pair and nothing else changes nothing (a coefficient left out
+        # or misplaced); a checkpoint's stored case is read as it was written
+        if self.model_fields_set - {"materials"} or (
+            info.context and info.context.get(STORED_CASE_KEY)
+        ):
+            return self
+        keys = ", ".join(k for k in type(self).model_fields if k != "materials")
+        a, b = self.materials
+        raise ValueError(
+            f"names the pair {a}-{b} but gives no coefficient, so it would change nothing; "
+            f"allowed: one or more of {keys}, or remove the entry"
+        )
+
 
 def effective_youngs_modulus(mi: Material, mj: Material, real: bool = False) -> float:
     """E* = [(1 - nu_i^2)/E_i + (1 - nu_j^2)/E_j]^-1 (spec, appendix A)."""
