@@ -36,6 +36,7 @@ from thermodem.engine.case_warnings import (
     temperature_warnings,
     time_table_warnings,
 )
+from thermodem.engine.ignored_settings import case_ignored_warnings, condition_overlap_warnings
 from thermodem.engine.resources import (  # noqa: F401 (re-exported: the run layer imports them here)
     BASELINE_BYTES,
     BYTES_PER_PARTICLE,
@@ -329,7 +330,8 @@ def pre_run_checks(sim: Simulation) -> list[str]:
         notes += check_walls_in_domain(sim) + periodic_wall_warnings(case) + skin_warnings(sim)
         notes += section_warnings(case) + check_thermal_selections(sim)
         notes += insertion_warnings(case) + time_table_warnings(case) + property_warnings(case)
-        notes += parameter_warnings(case)
+        notes += parameter_warnings(case) + case_ignored_warnings(case)
+        notes += condition_overlap_warnings(sim)
         notes += temperature_warnings(sim) + step_interval_warnings(sim)
         return notes + list(on_every_rank(sim, check_simulation_time_step))
     except ConfigError as exc:
@@ -346,6 +348,7 @@ def case_level_warnings(case: Case) -> list[str]:
         + time_table_warnings(case)
         + property_warnings(case)
         + parameter_warnings(case)
+        + case_ignored_warnings(case)
     )
 
 
