@@ -281,6 +281,23 @@ def deposit_pair(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def deposit_particle(energy, i, select, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
+    """Add one particle's shares of dissipated energy [J] to its accumulators of the selected
+    mechanisms (the particle pair pass: j's share of each pair at once, i's shares summed
+    over its run of pairs in the list and added when i changes)."""
+    if select[G_SLIDING_FRICTION] != 0.0:
+        energy[i, G_SLIDING_FRICTION] += e_slip
+    if select[G_ROLLING_FRICTION] != 0.0:
+        energy[i, G_ROLLING_FRICTION] += e_roll
+    if select[G_NORMAL_DAMPING] != 0.0:
+        energy[i, G_NORMAL_DAMPING] += e_ndamp
+    if select[G_TANGENTIAL_DAMPING] != 0.0:
+        energy[i, G_TANGENTIAL_DAMPING] += e_tdamp
+    if select[G_PLASTIC_DEFORMATION] != 0.0:
+        energy[i, G_PLASTIC_DEFORMATION] += e_plastic
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _deposit_wall(energy, i, g, e, psi, ledger_row):
     share = psi * e
     energy[i, g] += share

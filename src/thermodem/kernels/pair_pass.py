@@ -42,6 +42,7 @@ from thermodem.kernels.contact import (
     collision_loss,
     contact_response,
     deposit_pair,
+    deposit_particle,
     deposit_wall,
     kinetic_energy,
 )
@@ -197,9 +198,19 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                 row = chunk_ledger[g]
                 for q in range(row.shape[0]):
                     row[q] = 0.0
+                # heat generation: i's shares summed over its run of pairs (the list holds
+                # each i's pairs together) and added when i changes, j's share at once
+                owner = -1
+                a_ndamp = a_tdamp = a_slip = a_roll = a_plastic = 0.0
                 for k in range(group_start[g], group_start[g + 1]):
                     i = pair_i[k]
                     j = pair_j[k]
+                    if GENERATION and i != owner:
+                        if owner >= 0:
+                            deposit_particle(gen_energy, owner, gen_select, a_ndamp, a_tdamp,
+                                             a_slip, a_roll, a_plastic)  # fmt: skip
+                        owner = i
+                        a_ndamp = a_tdamp = a_slip = a_roll = a_plastic = 0.0
                     dx, dy, dz, dist = pair_separation(position, i, j, length, periodic)
                     ri = radius[i]
                     rj = radius[j]
@@ -304,10 +315,21 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             row,
                         )
                         if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
-                            deposit_pair(
-                                gen_energy, i, j, gen_select, gen_partition[ti, tj, 0],
-                                gen_partition[ti, tj, 1], e_ndamp, e_tdamp, e_slip, e_roll,
-                                e_plastic,
+                            psi_f = gen_partition[ti, tj, 0]
+                            psi_o = gen_partition[ti, tj, 1]
+                            s_ndamp = psi_o * e_ndamp
+                            s_tdamp = psi_o * e_tdamp
+                            s_slip = psi_f * e_slip
+                            s_roll = psi_f * e_roll
+                            s_plastic = psi_o * e_plastic
+                            a_ndamp += s_ndamp
+                            a_tdamp += s_tdamp
+                            a_slip += s_slip
+                            a_roll += s_roll
+                            a_plastic += s_plastic
+                            deposit_particle(
+                                gen_energy, j, gen_select, e_ndamp - s_ndamp, e_tdamp - s_tdamp,
+                                e_slip - s_slip, e_roll - s_roll, e_plastic - s_plastic,
                             )  # fmt: skip
                         # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
                         fx = -f_n * nx + ftx
@@ -346,6 +368,9 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                         by_mechanism[M_DIRECT, j] -= q_ij
                         conductance_sum[i] += h
                         conductance_sum[j] += h
+                if GENERATION and owner >= 0:
+                    deposit_particle(gen_energy, owner, gen_select, a_ndamp, a_tdamp, a_slip,
+                                     a_roll, a_plastic)  # fmt: skip
 
     return particle_pair_pass
 

@@ -242,7 +242,7 @@ def finish_heat(source, heat_rate, by_mechanism, columns):
         heat_rate[i] = q
 
 
-EULER_CHUNK = 4096
+EULER_CHUNK = 1024  # (50,000 particles: 49 chunks, 25 and 24 on two threads; 4096 gave 7 and 6)
 #: Columns of the per-chunk partial results of :func:`euler_step` before the per-mechanism sums.
 EULER_FIXED = 4
 
