@@ -660,3 +660,26 @@ def test_the_registry_refuses_a_null_name() -> None:
 
     with pytest.raises(KeyError, match=r"convection model: null is not a model name; allowed: "):
         registry.get("convection", None)  # type: ignore[arg-type]
+
+
+def test_a_particle_file_column_beside_the_entrys_value_is_told(tmp_path: Path) -> None:
+    """A particle file's temperature (velocity) columns set every particle's value, so the
+    entry's `temperature` (a non-zero `velocity`) beside them was silently unused (a list
+    entry refuses the same pair); told by validate, and not told without the columns."""
+    rows = "x y z radius vx vy vz temperature\n0.003 0.003 0.003 0.001 0 0 0 350\n"
+    (tmp_path / "bed.txt").write_text(rows)
+    (tmp_path / "plain.txt").write_text("x y z radius\n0.003 0.003 0.003 0.001\n")
+
+    def entry(name: str) -> dict:
+        return {"kind": "file", "path": str(tmp_path / name), "material": "glass",
+                "temperature": 300.0, "velocity": [0.0, 0.0, -0.1]}  # fmt: skip
+
+    thermal = {"direct_conduction": "none"}
+    result = _cli("validate", _write(tmp_path, insertion=[entry("bed.txt")], thermal=thermal))
+    assert result.exit_code == 0, result.output
+    assert "has a temperature column" in result.output
+    assert "the entry's temperature = 300 K is not used" in result.output
+    assert "the entry's velocity [0.0, 0.0, -0.1] m/s is not used" in result.output
+    result = _cli("validate", _write(tmp_path, insertion=[entry("plain.txt")], thermal=thermal))
+    assert result.exit_code == 0, result.output
+    assert "is not used" not in result.output

@@ -7,6 +7,7 @@ the entry, the row or file line and the particle). Called by
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -78,8 +79,24 @@ def _insert_file(entry: FileInsertion, walls_ok: WallsOk | None, planar: bool = 
     n = len(p)
     if not parsed.has_velocity:
         p.velocity = np.tile(np.asarray(entry.velocity, dtype=np.float64), (n, 1))
+    elif any(v != 0.0 for v in entry.velocity):
+        warnings.warn(
+            f"particle file {str(entry.path)!r} has velocity columns, which set every "
+            f"particle's velocity: the entry's velocity {list(entry.velocity)} m/s is not used; "
+            "leave one of them out",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     if not parsed.has_temperature and entry.temperature is not None:
         p.temperature = np.full(n, float(entry.temperature))
+    elif parsed.has_temperature and entry.temperature is not None:
+        warnings.warn(
+            f"particle file {str(entry.path)!r} has a temperature column, which sets every "
+            f"particle's initial temperature: the entry's temperature = {entry.temperature:g} "
+            "K is not used; leave one of them out",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     if walls_ok is not None and n:
         ok = np.asarray(walls_ok(p.position, p.radius), dtype=np.bool_)
         bad = np.flatnonzero(~ok)
