@@ -110,6 +110,11 @@ def global_thermal_summary(sim: DistributedSimulation) -> dict[str, float]:
     range_pairs = 0
     if th.range_set is not None:
         rs = th.range_set
+        if not rs.valid or rs.reference.shape[0] != p.count:
+            # stale since a rebuild renumbered the particles (a restart's first row, or a row
+            # between a rebuild and the next thermal step): its indices are the old ones. Built
+            # now, on these positions, as the next heat evaluation would (local to the rank)
+            rs.build(sim, *th._range_gaps())
         range_pairs = int(np.count_nonzero(rs.i[: rs.count] < n))  # once: i, the lower id
     gen_keys: list[str] = []
     pending: list[float] = []
