@@ -122,6 +122,9 @@ def _assert_same_ledgers(serial_dir: Path, parallel_dir: Path) -> None:
         "energy_balance_error": np.abs(a["gravitational"]).max(),
         "heat_balance_error": np.abs(a["thermal_energy"]).max(),
     }
+    generated = [np.abs(a[k]).max() for k in a if k.startswith("generated_")]
+    if generated:  # (relative to the heat generated, as the other balance errors)
+        scale["generation_balance_error"] = max(generated)
     for name in a:
         finite = np.isfinite(a[name])
         np.testing.assert_array_equal(finite, np.isfinite(b[name]), err_msg=name)

@@ -1,12 +1,12 @@
 """``mpiexec -n 2 thermodem run CASE --restart CKPT`` with a changed case, as the serial run
-(tests/run/test_restart_changes.py): heat that starts at the restart of a run settled without
-heat agrees with the serial run to round-off (its line in the log, the heat columns from zero,
-the balance closed), and a case whose walls or t = 0 particles differ from the checkpoint's
-is refused before anything is written (mpi/runner.py: run_distributed calls
-run_checks.check_restart_start; before, the run went on with the checkpoint's walls). A
-periodic case continues on 2 ranks, and one whose changed domain is too short for the
-restored particles' lists is refused while the ranks set up; a run that starts without
-particles (all poured) runs on 2 ranks as serially."""
+(tests/run/test_restart_changes.py): heat (also heat generation) that starts at the restart of a
+run settled without heat agrees with the serial run to round-off (its line in the log, the heat
+columns from zero, the balance closed), and a case whose walls or t = 0 particles differ from
+the checkpoint's is refused before anything is written (mpi/runner.py: run_distributed calls
+run_checks.check_restart_start; before, the run went on with the checkpoint's walls). A periodic
+case continues on 2 ranks, and one whose changed domain is too short for the restored particles'
+lists is refused while the ranks set up; a run that starts without particles (all poured) runs
+on 2 ranks as serially."""
 
 from __future__ import annotations
 
@@ -55,6 +55,28 @@ def test_heat_starts_at_a_restart_on_2_ranks_as_serially(tmp_path: Path) -> None
     assert serial["temperature"][0] > 300.001
     np.testing.assert_allclose(parallel["temperature"], serial["temperature"], rtol=1e-12)
     _assert_same_ledgers(tmp_path / "h1", tmp_path / "h2")
+
+    # heat generation starting at the restart too: the energy dissipated from the restart on
+    # becomes heat on 2 ranks as serially (its columns from zero, the ledgers equal)
+    generating = copy.deepcopy(heat)
+    generating["thermal"]["heat_generation"] = {"model": "mechanical_dissipation"}
+    case = _write(tmp_path / "generation.yaml", generating)
+    for ranks in (1, 2):
+        res = _run(["run", str(case), "--restart", str(ckpt), "-o", str(tmp_path / f"g{ranks}"),
+                    "--no-progress"], ranks)  # fmt: skip
+        assert res.returncode == 0, res.stderr
+    from thermodem.io.run_files import read_timeseries
+
+    # (the generation ledger counts from the heat's start: it counted the settle's damping,
+    # never turned into heat, so generated - in - walls - pending was off by that energy)
+    series = read_timeseries(tmp_path / "g1" / "timeseries.csv")
+    generated = series["generated_normal_damping"]
+    assert generated[0] == 0.0 and generated[-1] > 0.0
+    assert np.abs(series["generation_balance_error"]).max() <= 1e-12 * generated[-1]
+    _assert_same_ledgers(tmp_path / "g1", tmp_path / "g2")
+    serial = _particles(tmp_path / "g1" / "checkpoints" / "checkpoint_000000060.h5")
+    parallel = _particles(tmp_path / "g2" / "checkpoints" / "checkpoint_000000060.h5")
+    np.testing.assert_allclose(parallel["temperature"], serial["temperature"], rtol=1e-12)
 
     # a moved wall, another static entry: refused on 2 ranks as serially, nothing written
     moved = copy.deepcopy(heat)

@@ -40,8 +40,9 @@ def clear(engine: ThermalEngine) -> None:
 def ledger(engine: ThermalEngine) -> dict[str, float]:
     """The heat generation ledger [J] per selected mechanism g: χ × the energy the mechanics
     dissipated (``generated_<g>``: the mechanical ledger's ``dissipated_<g>``, or the kinetic
-    energy lost in collisions), the heat that went to walls with a fixed temperature
-    (``heat_to_walls_generation_<g>``), the heat accumulated in the particles but not yet
+    energy lost in collisions; counted from the heat's start when it started at a restart),
+    the heat that went to walls with a fixed temperature (``heat_to_walls_generation_<g>``),
+    the heat accumulated in the particles but not yet
     applied by a thermal step (``heat_pending_generation_<g>``); with the heat into the
     particles (``heat_in_generation_<g>``, the heat ledger) they close:
     ``generation_balance_error`` = Σ_g generated - in - walls - pending, round-off."""
@@ -76,8 +77,10 @@ def ledger_of(
     for g in gen.mechanisms:
         name = heat.GENERATION[g]
         source = "collision_energy_loss" if g == heat.G_COLLISION else name
-        generated = chi * cum[source]
-        walls = chi * cum[f"wall_generation_{name}"]
+        wall_key = f"wall_generation_{name}"
+        base = engine.generation_baseline  # (heat started at a restart: from there)
+        generated = chi * (cum[source] - base.get(source, 0.0))
+        walls = chi * (cum[wall_key] - base.get(wall_key, 0.0))
         waiting = chi * float(pending[g])
         out[f"generated_{name}"] = generated
         out[f"heat_to_walls_generation_{name}"] = walls

@@ -156,6 +156,10 @@ def start_heat(sim: Simulation, ledger: dict[str, float]) -> str:
     p.temperature = temperature
     # keys of a heat generation model the mechanics-only ledger did not have
     sim.ledger_cumulative = {**dict.fromkeys(ledger, 0.0), **sim.ledger_cumulative}
+    if th.generation.active:  # the energy dissipated before the heat started is no heat
+        from thermodem.engine.generation import ledger_keys
+
+        th.generation_baseline = {k: float(sim.ledger_cumulative[k]) for k in ledger_keys(th)}
     th.next_step = sim.step_count  # a thermal step at the first step after the restart
     th.particles_reordered()
     th.compute_rates(sim.time)

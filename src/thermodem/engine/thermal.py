@@ -151,6 +151,9 @@ class ThermalEngine(ContactConduction, TermEvaluation, ThermalLedger):
         #: fixed particles, heat of inserted particles, resets of newly fixed particles
         self.cumulative = {f"heat_in_{m.name}": 0.0 for m in heat.MECHANISMS if m.boundary}
         self.cumulative.update(fixed_absorbed=0.0, inserted_heat=0.0, fixed_reset=0.0)
+        #: the mechanical ledger's generation sources when the heat started at a restart of a
+        #: run without heat (engine/heat_start.py): the generation ledger counts from there
+        self.generation_baseline: dict[str, float] = {}
         self.limit = math.inf
         self.limit_particle = -1
         self.substeps = 1 if settings.substeps == "auto" else int(settings.substeps)
