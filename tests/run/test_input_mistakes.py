@@ -13,34 +13,12 @@ from pathlib import Path
 
 import pytest
 import yaml
+from run_cases import base_case
 from typer.testing import CliRunner
 
 from thermodem.cli import app
 
-CASE = {
-    "simulation": {"time_step": 1.0e-5, "end_time": 0.001},
-    "domain": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]},
-    "materials": {
-        "glass": {
-            "density": 2500,
-            "youngs_modulus": 1.0e7,
-            "poisson_ratio": 0.3,
-            "thermal_conductivity": 1.0,
-            "specific_heat": 800,
-        }
-    },
-    "walls": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "glass"}],
-    "insertion": [
-        {
-            "kind": "lattice",
-            "material": "glass",
-            "distribution": {"kind": "mono", "radius": 0.001},
-            "lower": [0, 0, 0],
-            "upper": [0.006, 0.006, 0.006],
-            "count": [2, 2, 2],
-        }
-    ],
-}
+CASE = base_case()
 
 POUR = {
     "kind": "pour",
