@@ -48,30 +48,21 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_kratos_reference import (  # DAMPING_GAMMA of e = 0.2, global_fluid_properties
+    FLUID,
+    GLOBAL_DAMPING,
+    KRATOS_GAMMA,
+    POROSITY,
+)
 
 from thermodem.config.load import case_from_dict
 from thermodem.engine.simulation import Simulation
 from thermodem.models.mechanics.normal import hertz_restitution_of_alpha
 
-KRATOS_GAMMA = 0.6668142947865054  # DAMPING_GAMMA of e = 0.2 (GammaForHertzThornton)
-GLOBAL_DAMPING = 0.1
 DT, END = 5.0e-5, 0.03
 T0 = 300.0
 WALL_TEMPERATURE = 400.0
 WALL_CONDUCTIVITY = 400.0  # the Wall material's k(T) table at the wall temperature
-
-# global_fluid_properties (as tests/verification/test_kratos_reference.py)
-FLUID = {
-    "gas": {
-        "thermal_conductivity": 10.0,
-        "density": 1.0,
-        "dynamic_viscosity": 0.1,
-        "specific_heat": 1.0,
-        "mean_free_path": 1e-7,
-    },
-    "fluid": {"temperature": 340.0, "velocity": [100.0, 100.0, 100.0]},
-}
-POROSITY = {"porosity": {"kind": "global", "value": 0.5}}  # global_porosity
 
 # conduction cases: (thermodem thermal settings, the re-derivation's model, tolerance /
 # (T - T0)); measured left differences -2.3e-4 and -1.2e-4
