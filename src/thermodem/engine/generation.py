@@ -72,13 +72,13 @@ def ledger_of(
     ``cumulative`` (the sums over the ranks on several MPI ranks)."""
     gen = engine.generation
     chi = gen.conversion_fraction
+    base = engine.generation_baseline  # (heat started at a restart: counted from there)
     out: dict[str, float] = {}
     error = 0.0
     for g in gen.mechanisms:
         name = heat.GENERATION[g]
         source = "collision_energy_loss" if g == heat.G_COLLISION else name
         wall_key = f"wall_generation_{name}"
-        base = engine.generation_baseline  # (heat started at a restart: from there)
         generated = chi * (cum[source] - base.get(source, 0.0))
         walls = chi * (cum[wall_key] - base.get(wall_key, 0.0))
         waiting = chi * float(pending[g])

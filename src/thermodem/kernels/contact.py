@@ -254,13 +254,6 @@ def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, led
 
 # ------------------------------------------------------------------- heat generation deposits
 @njit(cache=True, inline="always", error_model="numpy")
-def _deposit(energy, i, j, g, e, psi):
-    share = psi * e
-    energy[i, g] += share
-    energy[j, g] += e - share
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def deposit_pair(
     energy, i, j, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
 ):
@@ -268,16 +261,14 @@ def deposit_pair(
     accumulators of the selected mechanisms (``select[g]`` != 0): ψ e to i, the rest to j
     (``psi_*``: i's share of the friction heat and of the other heat, the heat generation
     row's partition; models/thermal/heat_generation.py)."""
-    if select[G_SLIDING_FRICTION] != 0.0:
-        _deposit(energy, i, j, G_SLIDING_FRICTION, e_slip, psi_friction)
-    if select[G_ROLLING_FRICTION] != 0.0:
-        _deposit(energy, i, j, G_ROLLING_FRICTION, e_roll, psi_friction)
-    if select[G_NORMAL_DAMPING] != 0.0:
-        _deposit(energy, i, j, G_NORMAL_DAMPING, e_ndamp, psi_other)
-    if select[G_TANGENTIAL_DAMPING] != 0.0:
-        _deposit(energy, i, j, G_TANGENTIAL_DAMPING, e_tdamp, psi_other)
-    if select[G_PLASTIC_DEFORMATION] != 0.0:
-        _deposit(energy, i, j, G_PLASTIC_DEFORMATION, e_plastic, psi_other)
+    s_ndamp = psi_other * e_ndamp
+    s_tdamp = psi_other * e_tdamp
+    s_slip = psi_friction * e_slip
+    s_roll = psi_friction * e_roll
+    s_plastic = psi_other * e_plastic
+    deposit_particle(energy, i, select, s_ndamp, s_tdamp, s_slip, s_roll, s_plastic)
+    deposit_particle(energy, j, select, e_ndamp - s_ndamp, e_tdamp - s_tdamp, e_slip - s_slip,
+                     e_roll - s_roll, e_plastic - s_plastic)  # fmt: skip
 
 
 @njit(cache=True, inline="always", error_model="numpy")
