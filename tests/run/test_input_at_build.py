@@ -1,19 +1,18 @@
-"""Inputs whose fault shows only once the case is built, through the installed command in a
-subprocess as a user runs it: a failure met while the simulation is built (before step 0) is an
-input error (exit 2, the key named), not a failed run (exit 1), and so is a restart whose
+"""Inputs whose fault shows only once the case is built, through the command line
+(run_cases.cli) as a user runs it: a failure met while the simulation is built (before step 0)
+is an input error (exit 2, the key named), not a failed run (exit 1), and so is a restart whose
 (changed) case the restored particles' lists cannot be built with; a heat generation mechanism
 that the material values switch off for every pair that can meet is warned about."""
 
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 import h5py
 import yaml
-from run_cases import base_case
+from run_cases import base_case, cli
 
 from thermodem.io.checkpoint import read_checkpoint
 
@@ -30,12 +29,7 @@ def _write(tmp_path: Path, name: str = "case", **sections) -> Path:  # noqa: ANN
     return path
 
 
-def _cli(*args: object) -> subprocess.CompletedProcess:
-    res = subprocess.run(
-        [EXE, *[str(a) for a in args]], capture_output=True, text=True, timeout=300
-    )
-    assert "Traceback" not in res.stdout + res.stderr, res.stdout + res.stderr
-    return res
+_cli = cli  # the command line in this process (run_cases.cli)
 
 
 def _glass(**changes: float) -> dict:

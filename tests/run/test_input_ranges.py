@@ -1,15 +1,15 @@
 """Inputs of a demanding user (third round): thermal parameters out of their physical range,
 property and time tables, restarts with a changed case, output settings that contradict each
-other. Each through the installed command in a subprocess, as a user runs it."""
+other. Each through the command line (run_cases.cli), as a user runs it."""
 
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 import yaml
+from run_cases import cli
 
 EXE = str(Path(sys.executable).with_name("thermodem"))
 
@@ -62,12 +62,7 @@ def _glass(**changes) -> dict:  # noqa: ANN003
     return {"glass": {k: v for k, v in glass.items() if v != "-"}}
 
 
-def _cli(*args: object) -> subprocess.CompletedProcess:
-    res = subprocess.run(
-        [EXE, *[str(a) for a in args]], capture_output=True, text=True, timeout=300
-    )
-    assert "Traceback" not in res.stdout + res.stderr, res.stdout + res.stderr
-    return res
+_cli = cli  # the command line in this process (run_cases.cli)
 
 
 def test_an_explicit_null_constant_beside_a_table_is_the_table_alone(tmp_path: Path) -> None:

@@ -1,7 +1,7 @@
-"""What a run reports and writes, through the CLI in a subprocess: the warnings said while a
-case is built reach run.log, the last line names only files that were written, export leaves
-out what a run never computed, warnings come with (before) the refusal they explain, and
-implausible model parameters are told."""
+"""What a run reports and writes, through the command line (run_cases.cli): the warnings
+said while a case is built reach run.log, the last line names only files that were written,
+export leaves out what a run never computed, warnings come with (before) the refusal they
+explain, and implausible model parameters are told."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from run_cases import cli
 
 EXE = Path(sys.executable).with_name("thermodem")
 
@@ -48,10 +49,7 @@ def _write(tmp_path: Path, name: str = "case.yaml", **sections) -> Path:  # noqa
     return path
 
 
-def _cli(*args: object) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [str(EXE), *(str(a) for a in args)], capture_output=True, text=True, timeout=600
-    )
+_cli = cli  # the command line in this process (run_cases.cli)
 
 
 def _run(case: Path, out: Path) -> subprocess.CompletedProcess:

@@ -1,4 +1,4 @@
-"""Restarts with a changed case, through the CLI in a subprocess (as a user runs them):
+"""Restarts with a changed case, through the command line (run_cases.cli, as a user runs them):
 heat that starts at a restart (a mechanics-only run settled, then ``run CASE --restart CKPT``
 with a ``thermal`` section; engine/heat_start.py), the reverse refused, a run directory whose
 run never started, and the list of the changes a restart applies."""
@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from run_cases import cli
 
 from thermodem.io.checkpoint import read_checkpoint
 from thermodem.io.run_files import read_timeseries
@@ -62,8 +63,7 @@ SETTLE = {
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([str(THERMODEM), *args, "--no-progress"], capture_output=True,
-                          text=True, timeout=600)  # fmt: skip
+    return cli(*args, "--no-progress")  # the command line in this process (run_cases.cli)
 
 
 def _write(path: Path, case: dict) -> Path:

@@ -8,7 +8,13 @@ bit-identical. The bed below has more than 4096 particles and many slab groups, 
 parallel loop is split between the threads. A second run adds heat (resistance network with
 the conductance reuse, whose per-pair state sits after the rolling model's history columns,
 and heat generation, whose per-particle accumulators receive every contact's dissipation, heat
-every third step), a third gap conduction on the range pair set.
+every third step), a third gap conduction on the range pair set, a fourth liquid bridges on
+the contact lists. Each parallel loop is checked once per template: the range and
+contact-list passes hold one model each as a compile-time constant (kernels/heat_terms.py),
+and the loops, which decide the order of the sums, are the same for every model (each
+indirect model runs single-threaded in tests/verification/test_thermal_registry.py; the
+separated part of batchelor_obrien_complete runs on the same range pass). A
+parametrisation per model cost ~15-35 s of compilation each with an empty cache.
 
 Without a request the thread count is chosen from the work (engine/threads.py): 1 thread for
 small systems, every thread Numba has for large ones.
@@ -53,8 +59,8 @@ HEAT = {  # the resistance network with the conductance reuse (state in the pair
 }
 
 
-def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulation, list[int]]:
-    numba.set_num_threads(1 if threads > 1 else 2)  # the simulation sets its own count
+def case_dict(path: Path, heat: str = "") -> dict:
+    """The bed in its box; ``heat`` adds the thermal models of one parametrisation."""
     upper = [SHAPE[0] * SPACING, SHAPE[1] * SPACING, 0.3]
     case = {
         "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0.0, 0.0, -9.81]},
@@ -94,13 +100,6 @@ def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulatio
         case["thermal"]["heat_generation"] = {"model": "mechanical_dissipation",
                                               "partition": "effusivity"}  # fmt: skip
         case["thermal"]["substeps"] = 3
-    if heat == "range":  # gap conduction on the range pair set, rebuilt while the bed moves
-        case["neighbors"]["extra_distance"] = 0.0
-        case["thermal"].update(
-            direct_conduction={"model": "batchelor_obrien_complete", "cutoff_gap_ratio": 0.4},
-            conductance_force_tolerance=0.0,
-            range_skin=0.01 * R0,
-        )
     if heat in INDIRECT:  # an indirect_conduction model next to the contact conduction
         case["neighbors"]["extra_distance"] = 0.0
         case["thermal"].update(
@@ -109,20 +108,25 @@ def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulatio
             conductance_force_tolerance=0.0,
             range_skin=0.01 * R0,
         )
-    sim = Simulation(case_from_dict(case), threads=threads)
+    return case
+
+
+def run(path: Path, threads: int, steps: int, heat: str = "") -> tuple[Simulation, list[int]]:
+    numba.set_num_threads(1 if threads > 1 else 2)  # the simulation sets its own count
+    sim = Simulation(case_from_dict(case_dict(path, heat)), threads=threads)
     assert sim.threads == threads and sim.threads_reason == "as requested"
     seen: list[int] = []
     sim.run(steps=steps, callback=lambda s: seen.append(numba.get_num_threads()), every=10)
     return sim, seen
 
 
-#: every indirect_conduction model that runs on the range set or the contact lists
+#: an indirect_conduction model on each pair set: the range set (gap conduction, rebuilt
+#: while the bed moves) and the contact lists (liquid bridges)
 INDIRECT = {
-    "bob-separated": {"model": "batchelor_obrien_separated", "cutoff_gap_ratio": 0.4},
-    "rong-horio": {"model": "rong_horio1999", "layer_thickness_ratio": 0.2},
-    "musser": {"model": "musser2011", "layer_thickness_ratio": 0.2},
-    "vargas": {"model": "vargas_mccarthy2002", "filling_angle": 0.3, "liquid_conductivity": 0.6},
-}
+    "range-set": {"model": "batchelor_obrien_separated", "cutoff_gap_ratio": 0.4},
+    "contact-term": {"model": "vargas_mccarthy2002", "filling_angle": 0.3,
+                     "liquid_conductivity": 0.6},
+}  # fmt: skip
 
 
 def by_gid(sim: Simulation, name: str) -> np.ndarray:
@@ -133,8 +137,8 @@ def by_gid(sim: Simulation, name: str) -> np.ndarray:
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="Numba has fewer than 2 threads")
 @pytest.mark.parametrize(
     "heat",
-    ["", "reuse", "range", *INDIRECT],
-    ids=["mechanics", "conductance-reuse", "range-set", *INDIRECT],
+    ["", "reuse", *INDIRECT],
+    ids=["mechanics", "conductance-reuse", *INDIRECT],
 )
 def test_one_and_two_threads_bit_identical(tmp_path, heat):
     path = tmp_path / "bed.txt"
@@ -159,10 +163,10 @@ def test_one_and_two_threads_bit_identical(tmp_path, heat):
         names += ["generation_energy"]
         assert one.report()["heat_in_generation_sliding_friction"] > 0.0
         assert one.report() == two.report()
-    if heat == "range" or (heat in INDIRECT and heat != "vargas"):
+    if heat == "range-set":
         rs = one.thermal.range_set
         assert rs.count > 2 * C.CHUNK and rs.ngroups >= 8 and rs.builds > 1
-    if heat in INDIRECT:  # the gas carries heat
+    if heat in INDIRECT:  # the gas or the liquid carries heat
         assert np.abs(one.particles.heat_rate_by_mechanism[:, M_INDIRECT]).max() > 0.0
     for name in names:
         a = by_gid(one, name)
@@ -189,16 +193,8 @@ def test_simulation_sets_its_thread_count(tmp_path):
     path = tmp_path / "bed.txt"
     write_bed(path)
     numba.set_num_threads(2)
-    case = case_from_dict(
-        {
-            "simulation": {"time_step": 1e-5, "end_time": 1.0},
-            "domain": {"lower": [-0.01] * 3, "upper": [0.2, 0.2, 0.3]},
-            "materials": {
-                "grain": {"density": 2500.0, "youngs_modulus": 1e7, "poisson_ratio": 0.3}
-            },
-            "insertion": [{"kind": "file", "material": "grain", "path": str(path)}],
-        }
-    )
+    # the case of the mechanics run above: the same compiled passes
+    case = case_from_dict(case_dict(path))
     from thermodem.engine import threads as T
 
     sim = Simulation(case)  # 4624 particles
@@ -230,8 +226,9 @@ def test_frozen_implicit_schemes_one_and_two_threads_bit_identical(tmp_path, sch
                 "simulation": {"time_step": 1e-5, "end_time": 1.0, "gravity": [0.0, 0.0, -9.81]},
                 "domain": {"lower": [-0.01, -0.01, -0.01],
                            "upper": [SHAPE[0] * SPACING + 0.01, SHAPE[1] * SPACING + 0.01, 0.31]},
-                "materials": {"grain": {"density": 2500.0, "youngs_modulus": 1e7,
-                                        "poisson_ratio": 0.3, "restitution": 0.5, **HEAT}},
+                "materials": {"grain": {**case_dict(path)["materials"]["grain"], **HEAT}},
+                # (the contact laws of the runs above: their compiled force pass)
+                "contact": case_dict(path)["contact"],
                 "walls": [{"kind": "box", "material": "grain", "lower": [0.0, 0.0, 0.0],
                            "upper": [SHAPE[0] * SPACING, SHAPE[1] * SPACING, 0.3],
                            "open_top": True, "thermal": {"kind": "fixed", "temperature": 400.0}}],

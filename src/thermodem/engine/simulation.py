@@ -331,7 +331,11 @@ class Simulation(ParticleInsertion, SimulationLedger):
         fused = heat_due and th.contact.active
         if heat_due:
             th.prepare(self.time)
-        pair_pass, wall_pass = self._contact_passes(th is not None and th.contact.active)
+        # frozen mechanics: the contact conduction is a pass of its own (thermal_contacts.py),
+        # so the force evaluation takes the mechanics-only variant (no compile of the fused one)
+        pair_pass, wall_pass = self._contact_passes(
+            th is not None and th.contact.active and not th.settings.frozen_mechanics
+        )
         if not fused:
             pair_heat = self._no_heat
         if self.generation:
