@@ -375,7 +375,8 @@ def test_a_wall_wholly_outside_the_domain_is_refused_or_told(tmp_path: Path) -> 
 
 def test_a_wall_closing_a_periodic_axis_is_told(tmp_path: Path) -> None:
     """Planes on both x faces of a domain periodic along x gave no word: the particles by the
-    two walls interact across the periodic boundary, through the walls."""
+    two walls interact across the periodic boundary, through the walls. So did a drum across
+    x and a plate spanning the whole cross-section."""
     x_walls = [
         {"kind": "plane", "point": [0, 0, 0], "normal": [1, 0, 0], "material": "glass"},
         {"kind": "plane", "point": [0.01, 0, 0], "normal": [-1, 0, 0], "material": "glass"},
@@ -398,6 +399,29 @@ def test_a_wall_closing_a_periodic_axis_is_told(tmp_path: Path) -> None:
     )
     result = _cli("validate", _write(tmp_path, domain=domain))  # the floor only: fine
     assert result.exit_code == 0 and "domain.periodic" not in result.output, result.output
+    # a drum across x closes it; along x it is the periodic slice of a drum: fine
+    drum = {"kind": "cylinder", "center": [0.005, 0.005, 0.005], "radius": 0.01,
+            "material": "glass"}  # fmt: skip
+    result = _cli("validate", _write(tmp_path, domain=domain, walls=[{**drum, "axis": [0, 1, 0]}]))
+    assert result.exit_code == 0, result.output
+    assert "walls.0 (cylinder0) is a cylinder around the axis [0.0, 1.0, 0.0] that closes x" in (
+        result.output
+    )
+    for axis, inside in (([1, 0, 0], True), ([0, 1, 0], False)):  # along x; an obstacle
+        walls = [{**drum, "axis": axis, "inside": inside, "radius": 0.0005}]
+        result = _cli("validate", _write(tmp_path, domain=domain, walls=walls))
+        assert "domain.periodic" not in result.output, (axis, result.output)
+    # a plate across the whole cross-section (tilted: still every corner) closes x; a plate
+    # with a way around it does not
+    plate = {"kind": "rectangle", "center": [0.008, 0.005, 0.005], "normal": [1, 0, 0.2],
+             "u_axis": [0, 1, 0], "half_extents": [0.005, 0.0052], "material": "glass"}  # fmt: skip
+    result = _cli("validate", _write(tmp_path, domain=domain, walls=CASE["walls"] + [plate]))
+    assert "walls.1 (rectangle1) is a rectangle with normal [1.0, 0.0, 0.2] spanning the " in (
+        result.output
+    )
+    narrow = {**plate, "half_extents": [0.004, 0.0052]}
+    result = _cli("validate", _write(tmp_path, domain=domain, walls=CASE["walls"] + [narrow]))
+    assert "domain.periodic" not in result.output, result.output
 
 
 MPIEXEC = Path(sys.executable).parent / "mpiexec"

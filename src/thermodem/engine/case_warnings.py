@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermodem.engine.start_checks import largest_radius
+from thermodem.geometry.walls import rectangle_separates
 
 if TYPE_CHECKING:
     from thermodem.config.schema import Case
@@ -343,9 +344,12 @@ def skin_warnings(sim: Simulation) -> list[str]:
 
 def periodic_wall_warnings(case: Case) -> list[str]:
     """A periodic axis that a wall closes: a plane whose normal has a component along it, a box
-    (its faces close every axis). Particles are wrapped across the periodic boundary, so the
-    particles on either side of such a wall interact through the domain's faces: the wall does
-    not separate them. A warning each, naming ``domain.periodic`` and the wall."""
+    (its faces close every axis), a cylinder holding the particles inside (its mantle closes
+    every axis across its own; along the axis is the periodic drum slice), a rectangle that
+    spans the domain's whole cross-section (a plate with a way around it closes nothing).
+    Particles are wrapped across the periodic boundary, so the particles on either side of
+    such a wall interact through the domain's faces: the wall does not separate them. A
+    warning each, naming ``domain.periodic`` and the wall."""
     periodic = case.domain.periodic
     axes = "xy" if case.simulation.planar else "xyz"
     shown = "[" + ", ".join("true" if p else "false" for p in periodic[: len(axes)]) + "]"
@@ -360,6 +364,21 @@ def periodic_wall_warnings(case: Case) -> list[str]:
         elif wall.kind == "box":
             closed = [a for a in range(len(axes)) if periodic[a]]
             what = "a box (its faces close every axis)"
+        elif wall.kind == "cylinder" and wall.inside:  # the mantle closes the axes across it
+            a = np.asarray(wall.axis, float)
+            a = a / np.linalg.norm(a)
+            closed = [b for b in range(len(axes)) if periodic[b] and abs(a[b]) < 1.0 - 1e-9]
+            what = f"a cylinder around the axis {[float(c) for c in wall.axis]}"
+        elif wall.kind == "rectangle":
+            lower, upper = case.domain.lower, case.domain.upper
+            closed = [
+                b for b in range(len(axes))
+                if periodic[b] and rectangle_separates(wall, b, lower, upper, len(axes) == 2)
+            ]  # fmt: skip
+            what = (
+                f"a rectangle with normal {[float(c) for c in wall.normal]} spanning the domain's "
+                "whole cross-section"
+            )
         else:
             continue
         if not closed:

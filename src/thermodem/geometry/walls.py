@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
@@ -104,6 +104,43 @@ class CylinderWall(_WallBase):
 
 
 Wall = Annotated[PlaneWall | RectangleWall | BoxWall | CylinderWall, Field(discriminator="kind")]
+
+
+def rectangle_separates(
+    wall: RectangleWall, b: int, lower: Any, upper: Any, planar: bool = False
+) -> bool:
+    """Whether the rectangle ``wall`` separates the box ``lower``-``upper`` along axis ``b``:
+    its normal has a component along ``b`` and its projection along ``b`` covers the box's
+    cross-section (every corner of it; ``planar``: the segment covers the other in-plane
+    axis, z is unbounded)."""
+    n = np.asarray(wall.normal, float)
+    n = n / np.linalg.norm(n)
+    if abs(n[b]) <= 1e-9:
+        return False
+    u = np.asarray(wall.u_axis, float)
+    u = u / np.linalg.norm(u)
+    half_u = wall.half_extents[0] * u
+    half_v = wall.half_extents[1] * np.cross(n, u)
+    centre = np.asarray(wall.center, float)
+    lower = np.asarray(lower, float)
+    upper = np.asarray(upper, float)
+    others = [c for c in range(2 if planar else 3) if c != b]
+    tol = 1e-9 * float(np.max(upper - lower))
+    if planar:  # a segment across the plane
+        c = others[0]
+        reach = abs(half_u[c]) + abs(half_v[c])
+        return centre[c] - reach <= lower[c] + tol and centre[c] + reach >= upper[c] - tol
+    # the parallelogram the rectangle projects to along b holds every corner
+    edges = np.array([[2.0 * half_u[c] for c in others], [2.0 * half_v[c] for c in others]]).T
+    origin = np.array([centre[c] - half_u[c] - half_v[c] for c in others])
+    if abs(np.linalg.det(edges)) < 1e-300:
+        return False
+    for x in (lower[others[0]], upper[others[0]]):
+        for y in (lower[others[1]], upper[others[1]]):
+            s = np.linalg.solve(edges, np.array([x, y]) - origin)
+            if (s < -1e-9).any() or (s > 1.0 + 1e-9).any():
+                return False
+    return True
 
 
 def row_count(wall: _WallBase, planar: bool = False) -> int:
