@@ -685,3 +685,23 @@ def test_a_particle_file_column_beside_the_entrys_value_is_told(tmp_path: Path) 
     result = _cli("validate", _write(tmp_path, insertion=[entry("plain.txt")], thermal=thermal))
     assert result.exit_code == 0, result.output
     assert "is not used" not in result.output
+
+
+def test_one_particle_written_without_its_outer_brackets_is_one_message(tmp_path: Path) -> None:
+    """``positions: [x, y, z]`` for one particle gave three lines 'should be a list of 3
+    values (got 0.005)'; one line says what was meant. Two particles in the plane too."""
+    entry = {"kind": "list", "material": "glass", "positions": [0.005, 0.005, 0.005],
+             "radius": 0.001}  # fmt: skip
+    result = _cli("validate", _write(tmp_path, insertion=[entry]))
+    assert result.exit_code == 2
+    assert (
+        "insertion.0.positions: a list of vectors, one [x, y, z] per particle; got the numbers "
+        "[0.005, 0.005, 0.005]: for one particle write [[0.005, 0.005, 0.005]]"
+    ) in result.output
+    assert result.output.count("insertion.0.positions") == 1, result.output
+    entry = {**entry, "positions": [[0.005, 0.005, 0.005]], "velocities": [0.0, 0.0, -1.0]}
+    result = _cli("validate", _write(tmp_path, insertion=[entry]))
+    assert result.exit_code == 2
+    assert "insertion.0.velocities: a list of vectors, one [x, y, z] per particle" in result.output
+    entry = {**entry, "velocities": [[0.0, 0.0, -1.0]]}
+    assert _cli("validate", _write(tmp_path, insertion=[entry])).exit_code == 0

@@ -417,6 +417,19 @@ class ListInsertion(_EntryBase):
         "particles and centres outside the domain are refused regardless",
     )
 
+    @field_validator("positions", "velocities", mode="before")
+    @classmethod
+    def _one_flat_vector(cls, value: Any) -> Any:
+        """``positions: [x, y, z]`` (one particle written without its outer brackets) gave
+        one message per number; one message, with the list it meant."""
+        flat = isinstance(value, list) and 2 <= len(value) <= 3
+        if flat and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
+            raise ValueError(
+                f"a list of vectors, one [x, y, z] per particle; got the numbers {value}: for "
+                f"one particle write [{value}]"
+            )
+        return value
+
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> ListInsertion:
         from thermodem.state.materials import STORED_CASE_KEY
