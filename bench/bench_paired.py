@@ -15,7 +15,7 @@ per-pair block ratios (median, lower and upper quartile) says how far to trust i
 
 ``--indirect MODEL [--indirect-param KEY=VALUE ...]`` (issue 10 §3): a third case, the heat
 case with that indirect conduction model on the range set (e.g. ``--indirect
-rong_horio1999 --indirect-param layer_thickness_ratio=0.25``: a gap cut-off of 0.5 R̄),
+rong_horio1999 --indirect-param layer_thickness_ratio=0.5``: a gap cut-off of 0.5 R̄),
 timed in the same rotation; its overhead over mechanics and the gap term's own cost (its
 time over the heat case's, in units of the mechanics time) are printed too.
 
