@@ -142,9 +142,11 @@ def take_joined(a: Particles, a_rows: np.ndarray, b: Particles, b_rows: np.ndarr
         x, y = getattr(a, f.name), getattr(b, f.name)
         order = "F" if _fortran(x) else "C"
         out = np.empty((na + nb, *x.shape[1:]), x.dtype, order=order)
-        if order == "F":  # (the heat rates by mechanism: row blocks through the transpose)
-            out.T[:, :na] = x.T[:, a_rows]
-            out.T[:, na:] = y.T[:, b_rows]
+        if order == "F":  # (the heat rates by mechanism: column by column, each contiguous;
+            # fancy indexing through the transpose was 3x slower)
+            for c in range(x.shape[1]):
+                np.take(x[:, c], a_rows, out=out[:na, c], mode="clip")
+                np.take(y[:, c], b_rows, out=out[na:, c], mode="clip")
         else:
             np.take(x, a_rows, axis=0, out=out[:na], mode="clip")
             np.take(y, b_rows, axis=0, out=out[na:], mode="clip")
