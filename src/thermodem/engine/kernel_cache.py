@@ -23,9 +23,9 @@ from pathlib import Path
 from typing import Any
 
 #: Seconds to compile the kernels of a mechanics-only case with an empty cache (2-core VM).
-COMPILE_SECONDS_MECHANICS = 60.0
+COMPILE_SECONDS_MECHANICS = 20.0
 #: Extra seconds for the thermal kernels of a case with heat.
-COMPILE_SECONDS_HEAT = 30.0
+COMPILE_SECONDS_HEAT = 10.0
 
 
 def cache_directory() -> Path | None:
