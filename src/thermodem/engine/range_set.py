@@ -127,7 +127,7 @@ class RangePairSet:
             self.group_start = np.zeros(2, np.int64)
             self.wall_row_start = np.zeros(1, np.int64)
             return
-        r_max = float(p.radius.max())
+        r_max = sim.radius_max()  # (every rank's: the check below agrees on all ranks)
         cell = 2.0 * r_max + self.gap + self.skin
         length = sim.upper - sim.lower
         for a in range(3):

@@ -277,6 +277,12 @@ class Simulation(ParticleInsertion, SimulationLedger):
         """``value`` summed over the MPI ranks (itself here)."""
         return value
 
+    def radius_max(self) -> float:
+        """R_max of the whole simulation [m], 0 without particles (on several MPI ranks the
+        value every rank agreed at the last distributing rebuild: a rank's own particles may
+        all be smaller, and a check against it would refuse on one rank only)."""
+        return float(self.particles.radius.max()) if self.particles.count else 0.0
+
     #: whether this process says the run's warnings (on several MPI ranks: rank 0 only)
     says_warnings = True
 

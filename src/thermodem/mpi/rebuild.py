@@ -148,6 +148,7 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     stats = X.allreduce_max(comm, np.array([float(owned.count), local_r]))
     total = int(X.allreduce_sum(comm, np.array([owned.count], np.int64))[0])
     r_max = float(stats[1])
+    sim._radius_max = r_max
     if sim.skin is None and r_max > 0:
         sim.skin = 0.2 * r_max  # the serial default (engine/neighbor_list.py: cell_size)
     cell = 2.0 * r_max + sim.extra + (sim.skin or 0.0)

@@ -108,6 +108,7 @@ class DistributedSimulation(Simulation):
         self._global_contacts = 0
         #: particles poured on rank 0 waiting for the next rebuild (add_particles)
         self.poured: list[Particles] = []
+        self._radius_max = 0.0  # agreed at the last distributing rebuild (radius_max)
         super().__init__(case, threads, insert_particles=insert_particles)
         if self.thermal is not None:
             check_thermal(self.thermal)
@@ -138,6 +139,13 @@ class DistributedSimulation(Simulation):
 
     def grid_box(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self._grid if self._grid is not None else (self.lower, self.upper, self.periodic)
+
+    def radius_max(self) -> float:
+        """The R_max agreed by every rank at the last distributing rebuild (no reduction
+        here: the range sets are rebuilt by each rank on its own schedule); the local one
+        before the first (every rank then holds every particle)."""
+        local = super().radius_max()
+        return max(local, self._radius_max) if self._distributed else local
 
     def set_threads(self, threads: int | None = None) -> int:
         """One Numba thread per rank unless asked (``--threads``): the ranks share the cores."""
