@@ -58,6 +58,9 @@ def _main(
 def _threads(requested: int | None) -> int | None:
     """``--threads`` above the cores this process may use is clamped, with a message (Numba
     refuses more threads than ``NUMBA_NUM_THREADS``, which defaults to the core count)."""
+    from thermodem.engine.threads import note_lowered
+
+    note_lowered(None, None)
     if requested is None:
         return None
     import os
@@ -75,6 +78,7 @@ def _threads(requested: int | None) -> int | None:
             f"use; using {limit}",
             err=True,
         )
+        note_lowered(requested, limit)
         return limit
     return requested
 

@@ -74,6 +74,26 @@ class CaseChecks:
                     )
                 seen[name] = k
 
+    def _check_interaction_pairs(self) -> None:
+        """Every pair of materials is named by one ``interactions`` entry at most: with two,
+        the later replaced the earlier whole, so the earlier entry's coefficients were lost
+        without a word (``[a, b]`` and ``[b, a]`` are the same pair)."""
+        seen: dict[frozenset, int] = {}
+        for k, entry in enumerate(self.interactions):
+            pair = frozenset(entry.materials)
+            if pair in seen:
+                j = seen[pair]
+                a, b = entry.materials
+                keys = lambda e: sorted(e.model_fields_set - {"materials"})  # noqa: E731
+                raise ValueError(
+                    f"interactions.{k}.materials: names the pair {a}-{b} again (got "
+                    f"{list(entry.materials)}; interactions.{j} names it too, with "
+                    f"{', '.join(keys(self.interactions[j]))}; this entry gives "
+                    f"{', '.join(keys(entry))}): one entry would replace the other; allowed: "
+                    "one entry per pair of materials, with all of its coefficients"
+                )
+            seen[pair] = k
+
     def _region_misses_domain(self, region: Any) -> str | None:
         """The axis on which a box region lies wholly outside the domain (no particle can ever
         be in it: particles leaving the domain stop the run, periodic ones are wrapped), or

@@ -222,7 +222,12 @@ class SimulationSettings(StrictModel):
     @model_validator(mode="before")
     @classmethod
     def _gravity_2d(cls, data: Any) -> Any:
-        """Default gravity of a 2D case: -9.81 m/s² along y."""
+        """Default gravity of a 2D case: -9.81 m/s² along y. A dimension written as a string
+        (``dimension: "2"``) is the number, as every other number written as a string is
+        (pydantic refused it with the misleading ``Input should be 2 or 3 (got '2')``)."""
+        dim = data.get("dimension") if isinstance(data, dict) else None
+        if isinstance(dim, str) and dim.strip() in ("2", "3"):
+            data = {**data, "dimension": int(dim.strip())}
         if isinstance(data, dict) and data.get("dimension") == 2 and "gravity" not in data:
             data = {**data, "gravity": DEFAULT_GRAVITY_2D}
         return data
@@ -358,6 +363,17 @@ class Case(CaseChecks, StrictModel):
     #: file's own ``simulation.end_time``), so that messages about the end of the run name
     #: the option, not the case's key (:func:`thermodem.engine.case_warnings.end_time_text`)
     _shortened: tuple[str, float] | None = PrivateAttr(default=None)
+
+    @model_validator(mode="after")
+    def _pairs_once(self, info: ValidationInfo) -> Case:
+        # a pair named by two interactions entries: the last replaced the first whole, and
+        # the first entry's coefficients were lost silently (a checkpoint's stored case is
+        # read as an earlier version wrote it)
+        from thermodem.state.materials import STORED_CASE_KEY
+
+        if not (info.context and info.context.get(STORED_CASE_KEY)):
+            self._check_interaction_pairs()
+        return self
 
     @model_validator(mode="after")
     def _names(self) -> Case:

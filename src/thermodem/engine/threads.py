@@ -121,10 +121,26 @@ def available_threads() -> int:
     return int(numba.config.NUMBA_NUM_THREADS)
 
 
+#: (the --threads given, the count it was lowered to) when the command line lowered it to
+#: the cores the process can use, so that run.log does not say "as requested" of a count the
+#: user did not request (set by :func:`note_lowered`, for the next simulation built).
+_lowered: tuple[int, int] | None = None
+
+
+def note_lowered(given: int | None, used: int | None) -> None:
+    """Remember that the command line's ``--threads given`` became ``used`` (None: as given)."""
+    global _lowered
+    _lowered = (given, used) if given is not None and used is not None and given != used else None
+
+
 def choose_threads(particles: float, pairs: int, requested: int | None = None) -> tuple[int, str]:
     """(thread count, why) for a simulation with ``particles`` particles (mean over the run)
     and ``pairs`` listed pairs; ``requested`` (a user's choice) wins."""
     if requested is not None:
+        if _lowered is not None and _lowered[1] == int(requested):
+            return int(requested), (
+                f"--threads {_lowered[0]} lowered to the {_lowered[1]} core(s) this process can use"
+            )
         return int(requested), "as requested"
     most = available_threads()
     n = int(round(particles))

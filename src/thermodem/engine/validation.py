@@ -25,6 +25,7 @@ import numpy as np
 from pydantic import BaseModel
 
 from thermodem.engine.case_warnings import (
+    end_time_text,
     insertion_warnings,
     output_interval_warnings,
     parameter_warnings,
@@ -37,6 +38,7 @@ from thermodem.engine.case_warnings import (
     time_table_warnings,
 )
 from thermodem.engine.ignored_settings import case_ignored_warnings, condition_overlap_warnings
+from thermodem.engine.input_warnings import case_input_warnings, extra_distance_warnings
 from thermodem.engine.resources import (  # noqa: F401 (re-exported: the run layer imports them here)
     BASELINE_BYTES,
     BYTES_PER_PARTICLE,
@@ -215,10 +217,25 @@ def check_thermal_selections(sim: Simulation) -> list[str]:
     return warnings
 
 
+#: The most steps a run may make (2^53: the step count and t = n Δt stay exact below it).
+MAX_STEPS = 2**53
+
+
 def check_step_count(sim: Simulation) -> None:
     """``thermodem run`` makes ``round(end_time / time_step)`` steps (thermal steps with frozen
     mechanics): refuse an end time that gives none (the run said 'done: 0 steps')."""
-    if total_steps(sim) - sim.step_count >= 1:
+    steps = total_steps(sim) - sim.step_count
+    if steps > MAX_STEPS:
+        frozen = sim.thermal is not None and sim.thermal.settings.frozen_mechanics
+        key = "thermal.time_step" if frozen else "simulation.time_step"
+        dt = sim.thermal.settings.time_step if frozen else sim.dt
+        raise ConfigError(
+            f"{key}: {dt:g} s gives {float(steps):.3g} steps until {end_time_text(sim.case)} "
+            f"(got {key} = {dt!r}); allowed: at most {MAX_STEPS:.3g} steps (2^53, beyond which "
+            "the step count is not exact in floating point; no run makes that many): is the "
+            "exponent of the time step mistyped?"
+        )
+    if steps >= 1:
         return
     th = sim.thermal
     frozen = th is not None and th.settings.frozen_mechanics
@@ -331,6 +348,7 @@ def pre_run_checks(sim: Simulation) -> list[str]:
         notes += section_warnings(case) + check_thermal_selections(sim)
         notes += insertion_warnings(case) + time_table_warnings(case) + property_warnings(case)
         notes += parameter_warnings(case) + case_ignored_warnings(case)
+        notes += case_input_warnings(case) + extra_distance_warnings(sim)
         notes += condition_overlap_warnings(sim)
         notes += temperature_warnings(sim) + step_interval_warnings(sim)
         return notes + list(on_every_rank(sim, check_simulation_time_step))
@@ -349,6 +367,7 @@ def case_level_warnings(case: Case) -> list[str]:
         + property_warnings(case)
         + parameter_warnings(case)
         + case_ignored_warnings(case)
+        + case_input_warnings(case)
     )
 
 

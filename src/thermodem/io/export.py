@@ -280,4 +280,39 @@ def export_particles(
         return write_csv(table, default, given=False)
     if str(out) == "-":
         return write_csv(table, None)
+    _refuse_run_file(directory, Path(out))
     return write_csv(table, Path(out), overwrite)
+
+
+#: The files of a run that ``export --out`` never replaces, even with ``--overwrite``: the
+#: run's record (its restart, ``info``, ``plot`` and ParaView read them).
+RUN_FILES = (
+    "timeseries.csv",
+    "case.resolved.yaml",
+    "status.json",
+    "run.log",
+    "particles.pvd",
+    "walls.pvd",
+    "contacts.pvd",
+)
+
+
+def _refuse_run_file(directory: Path, out: Path) -> None:
+    """``--out`` naming a file of the run being exported (its time series, its case, a
+    frame or a checkpoint): ``--overwrite`` replaced it with the CSV, and the run lost it."""
+    try:
+        inside = out.resolve().relative_to(directory.resolve())
+    except ValueError:
+        return
+    if not out.exists():
+        return
+    parts = inside.parts
+    if (len(parts) == 1 and parts[0] in RUN_FILES) or (
+        len(parts) > 1 and parts[0] in ("vtk", "checkpoints")
+    ):
+        raise ConfigError(
+            f"--out {out}: is a file of the run in {directory} ({inside}), which its restart, "
+            "info, plot or ParaView read; it is never replaced (not even with --overwrite); "
+            "allowed: another file name, e.g. the default (leave --out out) or "
+            f"{directory / 'particles.csv'}"
+        )

@@ -263,14 +263,27 @@ class TimeseriesWriter:
 
 
 def read_timeseries(path: Path) -> dict[str, np.ndarray]:
-    """Columns of a ``timeseries.csv`` as float arrays (empty cells are NaN)."""
+    """Columns of a ``timeseries.csv`` as float arrays (empty cells are NaN). A cell that is
+    not a number (another file written over it: a CSV of particles, a text) is a ConfigError
+    naming the file, the line and the column, not a ValueError traceback."""
     with Path(path).open(newline="") as f:
         reader = csv.reader(f)
         header = next(reader, [])
-        rows = [r for r in reader if r]
+        rows = [(reader.line_num, r) for r in reader if r]
     out = {}
     for k, name in enumerate(header):
-        out[name] = np.array([float(r[k]) if k < len(r) and r[k] != "" else math.nan for r in rows])
+        values = []
+        for line, r in rows:
+            cell = r[k] if k < len(r) else ""
+            try:
+                values.append(float(cell) if cell != "" else math.nan)
+            except ValueError:
+                raise ConfigError(
+                    f"{path}, line {line}, column {name!r}: {cell[:40]!r} is not a number; "
+                    "it is not a time series thermodem wrote (every cell is a number): was "
+                    "another file written over it?"
+                ) from None
+        out[name] = np.array(values)
     return out
 
 

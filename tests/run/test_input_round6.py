@@ -1,0 +1,203 @@
+"""Inputs of a demanding user (sixth round): numbers in another unit that earlier rounds did
+not look at (a Young's modulus in GPa, a friction angle, gravity in mm/s²), settings the case
+leaves unused (temperatures without heat, a gas no model reads, a zero load), a pair of
+materials named twice, a time step that gives more steps than any run makes, and an
+``export --out`` onto the run's own files. Each through the command line (run_cases.cli), as
+a user runs it."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import yaml
+from run_cases import BASE_CASE, base_case, cli
+
+GLASS = BASE_CASE["materials"]["glass"]
+SIM = BASE_CASE["simulation"]
+FLOOR = BASE_CASE["walls"][0]
+LATTICE = BASE_CASE["insertion"][0]
+
+
+def _write(tmp_path: Path, case: dict, name: str = "case") -> Path:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(case, sort_keys=False))
+    return path
+
+
+def _validate(tmp_path: Path, **sections: object):  # noqa: ANN202
+    return cli("validate", _write(tmp_path, base_case(**sections)))
+
+
+def _warnings(res) -> list[str]:  # noqa: ANN001
+    return [line for line in (res.stdout + res.stderr).splitlines() if line.startswith("warning")]
+
+
+def test_a_pair_of_materials_named_twice_is_refused(tmp_path: Path) -> None:
+    """Two ``interactions`` entries of one pair: the later replaced the earlier whole, so the
+    earlier's coefficients were lost without a word (also written [a, b] and [b, a])."""
+    steel = {**GLASS, "density": 7800}
+    res = _validate(
+        tmp_path,
+        materials={"glass": GLASS, "steel": steel},
+        interactions=[
+            {"materials": ["glass", "steel"], "restitution": 0.9},
+            {"materials": ["steel", "glass"], "sliding_friction": 0.3},
+        ],
+    )
+    assert res.returncode == 2, res.stdout
+    assert "interactions.1.materials: names the pair steel-glass again" in res.stderr
+    assert "interactions.0 names it too, with restitution" in res.stderr
+    assert "this entry gives sliding_friction" in res.stderr
+    # one entry per pair (and a pair of a material with itself) is fine
+    res = _validate(
+        tmp_path,
+        materials={"glass": GLASS, "steel": steel},
+        interactions=[
+            {"materials": ["glass", "steel"], "restitution": 0.9, "sliding_friction": 0.3},
+            {"materials": ["glass", "glass"], "restitution": 0.8},
+        ],
+    )
+    assert res.returncode == 0, res.stderr
+
+
+def test_a_dimension_written_as_a_string_is_the_number(tmp_path: Path) -> None:
+    """``dimension: "2"`` was refused with ``Input should be 2 or 3 (got '2')``, a message
+    that names the allowed value as the one given; every other number may be a string."""
+    sim = {**SIM, "dimension": "3"}
+    res = _validate(tmp_path, simulation=sim)
+    assert res.returncode == 0, res.stderr
+    sim = {**SIM, "dimension": "2"}
+    res = _validate(tmp_path, simulation=sim)
+    assert res.returncode == 2
+    assert "should be 2 or 3" not in res.stderr
+    assert "walls.0.normal: [0, 0, 1] has a z component; in a 2D case" in res.stderr
+
+
+def test_a_time_step_that_gives_more_steps_than_any_run_is_refused(tmp_path: Path) -> None:
+    """``time_step: 1e-300`` (an exponent mistyped) was valid, with an estimate of 1e290 hours,
+    and ``run`` started a run that never ends."""
+    sim = {**SIM, "time_step": 1.0e-300}
+    res = _validate(tmp_path, simulation=sim)
+    assert res.returncode == 2, res.stdout
+    assert "simulation.time_step: 1e-300 s gives 1e+297 steps" in res.stderr
+    assert "allowed: at most 9.01e+15 steps" in res.stderr
+    res = cli("run", _write(tmp_path, base_case(simulation=sim)), "--output", tmp_path / "out")
+    assert res.returncode == 2
+    assert "gives 1e+297 steps" in res.stderr
+    assert not (tmp_path / "out" / "checkpoints").exists()
+
+
+def test_values_in_another_unit_of_the_mechanics_are_warned_about(tmp_path: Path) -> None:
+    """A Young's modulus of 70 (GPa), a friction of 30 (an angle in degrees) and gravity of
+    9810 (mm/s²) ran without a word."""
+    glass = {**GLASS, "youngs_modulus": 70.0, "sliding_friction": 30.0, "rolling_friction": 8.0}
+    sim = {**SIM, "gravity": [0, 0, -9810.0], "time_step_check": {"allow_unstable": True}}
+    res = _validate(tmp_path, materials={"glass": glass}, simulation=sim)
+    assert res.returncode == 0, res.stderr
+    text = "\n".join(_warnings(res))
+    assert "materials.glass.youngs_modulus: 70 Pa is below 1000 Pa" in text
+    assert "is it in GPa or MPa?" in text
+    assert "materials.glass.sliding_friction: 30 is above 5" in text
+    assert "tan 30° = 0.577" in text
+    assert "materials.glass.rolling_friction: 8 is above 5" in text
+    assert "simulation.gravity: [0.0, 0.0, -9810.0] has the magnitude 9810 m/s²" in text
+    # an interactions entry's friction too
+    res = _validate(
+        tmp_path, interactions=[{"materials": ["glass", "glass"], "sliding_friction": 45.0}]
+    )
+    assert "interactions.0.sliding_friction: 45 is above 5" in res.stdout + res.stderr
+    # the base case's values are not warned about
+    res = _validate(tmp_path)
+    assert not [w for w in _warnings(res) if "above 5" in w or "gravity" in w], res.stderr
+
+
+def test_temperatures_in_a_case_without_heat_are_told(tmp_path: Path) -> None:
+    """``simulation.initial_temperature`` and an entry's ``temperature`` / ``temperatures``
+    in a case without a thermal section (mechanics only) were never used, silently (a wall's
+    fixed temperature already was told)."""
+    sim = {**SIM, "initial_temperature": 400.0}
+    listed = {
+        "kind": "list",
+        "material": "glass",
+        "radius": 0.001,
+        "positions": [[0.008, 0.008, 0.008]],
+        "temperatures": [350.0],
+    }
+    res = _validate(tmp_path, simulation=sim, insertion=[{**LATTICE, "temperature": 300.0}, listed])
+    assert res.returncode == 0, res.stderr
+    text = "\n".join(_warnings(res))
+    assert "simulation.initial_temperature: 400 K is given, but the case has no thermal" in text
+    assert "insertion.0.temperature: 300 K is given" in text
+    assert "insertion.1.temperatures: [350] K are given" in text
+    assert "add thermal: {}" in text
+    # with heat they are used, and not told
+    res = _validate(tmp_path, simulation=sim, thermal={})
+    assert not [w for w in _warnings(res) if "is given, but the case has no thermal" in w]
+
+
+def test_a_gas_that_no_selected_model_reads_is_told(tmp_path: Path) -> None:
+    """``thermal.gas`` with the default conduction (batchelor_obrien_simple reads no gas):
+    a pressure or a gas conductivity typed there changed nothing, silently."""
+    res = _validate(tmp_path, thermal={"gas": {"pressure": 1.0}})
+    assert res.returncode == 0, res.stderr
+    text = "\n".join(_warnings(res))
+    assert "thermal.gas is given but no selected model reads it" in text
+    assert "direct_conduction = 'batchelor_obrien_simple'" in text
+    # the default gas (no key) is not told
+    res = _validate(tmp_path, thermal={})
+    assert not [w for w in _warnings(res) if "thermal.gas" in w]
+
+
+def test_zero_loads_and_a_huge_extra_distance_are_told(tmp_path: Path) -> None:
+    """An external force and torque of zero, a heat flux of 0 W/m² (each does nothing), and an
+    ``extra_distance`` of a domain's size (every pair listed) ran without a word."""
+    res = _validate(
+        tmp_path,
+        external_force=[{"select": {"ids": [0]}, "force": [0, 0, 0]}],
+        neighbors={"extra_distance": 1.0},
+        thermal={"heat_flux": [{"select": {"ids": [0]}, "flux": 0.0}]},
+    )
+    assert res.returncode == 0, res.stderr
+    text = "\n".join(_warnings(res))
+    assert "external_force.0: force [0.0, 0.0, 0.0] and torque [0.0, 0.0, 0.0] are both zero" in text
+    assert "thermal.heat_flux.0.flux: 0 W/m² gives no heat" in text
+    assert "neighbors.extra_distance = 1 m is 500 times the largest particle diameter" in text
+
+
+def test_export_never_replaces_the_runs_own_files(tmp_path: Path) -> None:
+    """``export DIR --out DIR/timeseries.csv --overwrite`` replaced the run's time series with
+    particles (and ``plot`` then failed with a ValueError traceback); a time series that is
+    not one is now named by plot with its line and column."""
+    out = tmp_path / "out"
+    res = cli("run", _write(tmp_path, base_case()), "--output", out, "--steps", 2, "--no-progress")
+    assert res.returncode == 0, res.stderr
+    series = (out / "timeseries.csv").read_text()
+    for name in ("timeseries.csv", "case.resolved.yaml", "particles.pvd"):
+        res = cli("export", out, "--out", out / name, "--overwrite")
+        assert res.returncode == 2, res.stdout
+        assert f"--out {out / name}: is a file of the run in {out}" in res.stderr
+        assert "never replaced (not even with --overwrite)" in res.stderr
+    assert (out / "timeseries.csv").read_text() == series
+    res = cli("export", out, "--out", out / "mine.csv")
+    assert res.returncode == 0, res.stderr
+    # a time series written over by another file: plot names it, without a traceback
+    damaged = tmp_path / "damaged"
+    shutil.copytree(out, damaged)
+    shutil.copy(out / "mine.csv", damaged / "timeseries.csv")
+    res = cli("plot", damaged)
+    assert res.returncode == 2
+    assert f"{damaged / 'timeseries.csv'}, line 2, column" in res.stderr
+    assert "is not a number" in res.stderr
+
+
+def test_threads_lowered_to_the_cores_are_not_logged_as_requested(tmp_path: Path) -> None:
+    """``--threads 4096`` is lowered to the cores with a warning, but run.log said
+    ``threads: 2 (as requested)``."""
+    out = tmp_path / "out"
+    case = _write(tmp_path, base_case())
+    res = cli("run", case, "--output", out, "--steps", 2, "--no-progress", "--threads", 4096)
+    assert res.returncode == 0, res.stderr
+    log = (out / "run.log").read_text()
+    assert "(--threads 4096 lowered to the" in log
+    assert "as requested" not in log
