@@ -160,7 +160,9 @@ def test_zero_loads_and_a_huge_extra_distance_are_told(tmp_path: Path) -> None:
     )
     assert res.returncode == 0, res.stderr
     text = "\n".join(_warnings(res))
-    assert "external_force.0: force [0.0, 0.0, 0.0] and torque [0.0, 0.0, 0.0] are both zero" in text
+    assert (
+        "external_force.0: force [0.0, 0.0, 0.0] and torque [0.0, 0.0, 0.0] are both zero" in text
+    )
     assert "thermal.heat_flux.0.flux: 0 W/m² gives no heat" in text
     assert "neighbors.extra_distance = 1 m is 500 times the largest particle diameter" in text
 
@@ -201,3 +203,56 @@ def test_threads_lowered_to_the_cores_are_not_logged_as_requested(tmp_path: Path
     log = (out / "run.log").read_text()
     assert "(--threads 4096 lowered to the" in log
     assert "as requested" not in log
+
+
+def test_particles_vanishing_for_the_domain_are_an_input_error(tmp_path: Path) -> None:
+    """A lognormal of sigma 50 without min_radius draws radii of 1e-9 m and less: the
+    neighbour grid of the first build asked NumPy for 1e18 cells, a ValueError traceback."""
+    lognormal = {"kind": "lognormal", "sigma": 50.0, "median": 0.0008, "max_radius": 0.001}
+    res = _validate(tmp_path, insertion=[{**LATTICE, "distribution": lognormal}])
+    assert res.returncode == 2, res.stdout
+    assert "the neighbour grid would have" in res.stderr
+    assert "a lognormal of a large sigma: give min_radius" in res.stderr
+    assert "before any step" in res.stderr
+
+
+def test_friction_coefficients_the_contact_laws_do_not_read_are_told(tmp_path: Path) -> None:
+    """``rolling_friction: 0.1`` with the default ``rolling: none`` (LIGGGHTS and EDEM switch
+    rolling resistance on by the coefficient) and ``sliding_friction`` with ``tangential:
+    none`` were not read, silently; a rolling model with every coefficient 0 gives no torque.
+    (The laws other than the base case's are checked on a case refused before it is built,
+    its warnings told with the refusal: no kernel of a new combination is compiled.)"""
+    unbuilt = {k: v for k, v in GLASS.items() if k != "specific_heat"}
+
+    def told(glass: dict, contact: dict, **sections: object) -> str:
+        res = _validate(tmp_path, materials={"glass": glass}, contact=contact, thermal={},
+                        **sections)  # fmt: skip
+        assert res.returncode == 2 and "specific_heat: missing" in res.stderr, res.stderr
+        return res.stderr
+
+    text = told({**unbuilt, "sliding_friction": 0.8}, {"tangential": "none"})
+    assert "materials.glass.sliding_friction = 0.8 given, but contact.tangential is 'none'" in text
+    text = told(unbuilt, {"rolling": "constant_torque"})
+    assert "contact.rolling = 'constant_torque', but every material's rolling_friction is 0" in text
+    # a rolling law with a coefficient (here of the pair) is not told
+    pair = [{"materials": ["glass", "glass"], "rolling_friction": 0.05}]
+    text = told(unbuilt, {"rolling": "constant_torque"}, interactions=pair)
+    assert "rolling" not in text
+    # the base case's laws, built
+    res = _validate(tmp_path, materials={"glass": {**GLASS, "rolling_friction": 0.1}})
+    assert res.returncode == 0, res.stderr
+    assert (
+        "materials.glass.rolling_friction = 0.1 given, but contact.rolling is 'none' (the "
+        "default)" in "\n".join(_warnings(res))
+    )
+
+
+def test_a_material_name_with_outer_spaces_is_refused_by_name(tmp_path: Path) -> None:
+    """``'glass ':`` as the material's key: the walls naming ``glass`` were refused with
+    ``unknown material 'glass'; allowed: glass`` (the space unseen)."""
+    res = _validate(tmp_path, materials={"glass ": GLASS})
+    assert res.returncode == 2
+    assert "a material name with a space at its start or end, or empty (got 'glass ')" in (
+        res.stderr
+    )
+    assert "unknown material" not in res.stderr

@@ -379,6 +379,15 @@ class Case(CaseChecks, StrictModel):
     def _names(self) -> Case:
         if not self.materials:
             raise ValueError("materials: at least one material is needed")
+        for name in self.materials:
+            if name != name.strip() or not name:
+                # ('glass ' is not 'glass': the walls and entries naming it were refused
+                # with "unknown material 'glass'; allowed: glass ", the space unseen)
+                raise ValueError(
+                    f"materials.{name}: a material name with a space at its start or end, or "
+                    f"empty (got {name!r}); allowed: a name without outer spaces, e.g. "
+                    f"{name.strip() or 'glass'!r}"
+                )
         if self.simulation.planar:
             from thermodem.config.planar_case import check_planar_case
 

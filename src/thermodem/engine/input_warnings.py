@@ -152,10 +152,48 @@ def zero_load_warnings(case: Case) -> list[str]:
     return out
 
 
+def friction_law_warnings(case: Case) -> list[str]:
+    """Friction coefficients the contact laws leave unread, and a law with nothing to read:
+    a ``rolling_friction`` given while ``contact.rolling`` is ``none`` (the default: other
+    codes switch rolling resistance on by the coefficient alone), a ``sliding_friction`` given
+    while ``contact.tangential`` is ``none``, and a rolling model whose every coefficient is 0
+    (it gives no torque)."""
+    out = []
+    families = (
+        ("rolling_friction", case.contact.rolling, "rolling", "constant_torque or epsd"),
+        ("sliding_friction", case.contact.tangential, "tangential", "mindlin or linear"),
+    )
+    entries = [(f"materials.{n}", m) for n, m in case.materials.items()]
+    entries += [(f"interactions.{k}", o) for k, o in enumerate(case.interactions)]
+    for prop, choice, family, models in families:
+        model = getattr(choice, "model", choice)
+        given = [
+            f"{key}.{prop} = {getattr(e, prop):g}"
+            for key, e in entries
+            if prop in e.model_fields_set and getattr(e, prop)
+        ]
+        if model == "none" and given:
+            default = " (the default)" if family not in case.contact.model_fields_set else ""
+            out.append(
+                f"{', '.join(given)} given, but contact.{family} is 'none'{default}: the "
+                f"coefficient is not read and there is no {family} resistance; allowed: "
+                f"contact.{family}: {models}, or leave {prop} out"
+            )
+    rolling = getattr(case.contact.rolling, "model", case.contact.rolling)
+    if rolling != "none" and not any((e.rolling_friction or 0.0) > 0.0 for _, e in entries):
+        out.append(
+            f"contact.rolling = {rolling!r}, but every material's rolling_friction is 0 (the "
+            "default) and no interactions entry gives one: the model gives no torque; give "
+            "materials.NAME.rolling_friction (e.g. 0.05), or rolling: none"
+        )
+    return out
+
+
 def case_input_warnings(case: Case) -> list[str]:
     """The warnings of this module that need the case alone."""
     return (
-        mechanics_only_temperature_warnings(case)
+        friction_law_warnings(case)
+        + mechanics_only_temperature_warnings(case)
         + unread_gas_warnings(case)
         + mechanical_value_warnings(case)
         + zero_load_warnings(case)

@@ -82,6 +82,33 @@ def check_next_build(sim: Simulation) -> None:
     check_periodic_length(sim, 2.0 * r_max + sim.extra + skin, r_max, skin)
 
 
+#: The most cells of the neighbour grid (its cell_start array: 8 bytes each, 1.6 GB).
+MAX_CELLS = 2.0e8
+
+
+def check_cell_count(sim: Simulation, cell: float, r_max: float) -> None:
+    """SimulationError when the neighbour grid of cells of edge ``cell`` (2 R_max + extra
+    distance + skin) would have more than :data:`MAX_CELLS` cells: particles vanishingly small
+    for the domain (a lognormal distribution of a huge sigma draws radii of 1e-20 m), which
+    ended in a NumPy "array is too big" traceback. At the first build (validate, run) it is an
+    input error."""
+    length = np.asarray(sim.upper, float) - np.asarray(sim.lower, float)
+    per_axis = np.maximum(np.floor(length / max(cell, 1e-300)), 1.0)
+    if sim.planar:
+        per_axis[2] = 1.0
+    cells = float(np.prod(per_axis))
+    if cells <= MAX_CELLS:
+        return
+    raise SimulationError(
+        f"the neighbour grid would have {cells:.3g} cells (more than {MAX_CELLS:.3g}): its cell "
+        f"edge is {cell:.3g} m (2 R_max + neighbors.extra_distance + skin, the largest particle "
+        f"radius R_max being {r_max:.3g} m) in a domain of {length[0]:.3g} × {length[1]:.3g} × "
+        f"{length[2]:.3g} m; particles that small for the domain come from a radius "
+        "distribution drawing vanishing radii (a lognormal of a large sigma: give min_radius, "
+        "or a sigma of 0.05-1) or radii in another unit"
+    )
+
+
 def rebuild_lists(sim: Simulation) -> None:
     """Sort particles by cell, list pairs and wall pairs, carry the history by identity."""
     p = sim.particles
@@ -96,6 +123,7 @@ def rebuild_lists(sim: Simulation) -> None:
         sim.reference = p.position.copy()
         return
     check_periodic_length(sim, cell, float(p.radius.max()))
+    check_cell_count(sim, cell, float(p.radius.max()))
     dims, edge = cell_grid(sim, cell)
     axis = int(SL.choose_axis(p.position, sim.lower, edge, dims))
     sim.slab_axis = axis  # the particles' memory order is by layers along it (range set)
