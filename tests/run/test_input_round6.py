@@ -256,3 +256,32 @@ def test_a_material_name_with_outer_spaces_is_refused_by_name(tmp_path: Path) ->
         res.stderr
     )
     assert "unknown material" not in res.stderr
+
+
+def test_yaml_11_numbers_read_silently_as_others_are_refused(tmp_path: Path) -> None:
+    """YAML 1.1 reads ``end_time: 1:30`` as 90 (base 60: a run 90 000 times longer) and
+    ``seed: 010`` as 8 (octal); a list as a key (``? [a, b]``) ended in a TypeError
+    traceback."""
+    text = yaml.safe_dump(base_case(), sort_keys=False)
+    cases = {
+        "sexagesimal": text.replace("end_time: 0.001", "end_time: 1:30"),
+        "octal": text.replace("time_step: 1.0e-05", "time_step: 1.0e-05\n  seed: 010"),
+        "list_key": text + "? [a, b]\n: 3\n",
+    }
+    expected = {
+        "sexagesimal": "'1:30' is read by YAML as the base-60 number 90",
+        "octal": "'010' is read by YAML as the octal number 8 (a leading zero); allowed: the "
+        "number without its leading zero, 10",
+        "list_key": "a key that is a list ('? [...]' or '? {...}'); allowed: keys that are names",
+    }
+    for name, body in cases.items():
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(body)
+        res = cli("validate", path)
+        assert res.returncode == 2, (name, res.stdout)
+        assert expected[name] in res.stderr, res.stderr
+        assert "line " in res.stderr
+    # the decimal, exponent, hexadecimal and '_' forms are read as before
+    path = tmp_path / "plain.yaml"
+    path.write_text(text.replace("density: 2500", "density: 2_500").replace("0.001", "1e-3"))
+    assert cli("validate", path).returncode == 0

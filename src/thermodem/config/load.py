@@ -34,6 +34,16 @@ def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: b
         if key_node.tag == MERGE_TAG:  # '<<' (no constructor of its own: merged below)
             continue
         key = loader.construct_object(key_node, deep=deep)
+        try:
+            hash(key)
+        except TypeError:  # ('? [a, b]': a list as a key ended in a TypeError traceback)
+            shape = "list" if isinstance(key_node, yaml.SequenceNode) else "mapping"
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"a key that is a {shape} ('? [...]' or '? {{...}}'); allowed: keys that are names",
+                key_node.start_mark,
+            ) from None
         if key in seen:
             mark = key_node.start_mark
             raise yaml.constructor.ConstructorError(
@@ -44,6 +54,44 @@ def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: b
 
 
 _UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def _number_of_yaml_11(loader: _UniqueKeyLoader, node: yaml.ScalarNode, kind: str) -> Any:
+    """YAML 1.1's sexagesimal (``1:30`` = 90) and octal (``010`` = 8) numbers are refused:
+    ``end_time: 1:30`` ran 90 s and ``count: [010, 10, 10]`` made 8 layers, silently. The
+    decimal, exponent, hexadecimal (``0x``) and ``_`` forms are read as before."""
+    text = str(node.value).replace("_", "")
+    digits = text.lstrip("+-")
+    if ":" in text:
+        value = (
+            loader.construct_yaml_int(node) if kind == "int" else loader.construct_yaml_float(node)
+        )
+        raise yaml.constructor.ConstructorError(
+            None,
+            None,
+            f"{node.value!r} is read by YAML as the base-60 number {value:g} (a clock time "
+            "h:m:s or m:s); allowed: a plain number in SI units (seconds for a time), e.g. "
+            f"{value:g}, or quote it if it is a name",
+            node.start_mark,
+        )
+    if kind == "int" and len(digits) > 1 and digits[0] == "0" and digits[1:].isdigit():
+        value = loader.construct_yaml_int(node)
+        raise yaml.constructor.ConstructorError(
+            None,
+            None,
+            f"{node.value!r} is read by YAML as the octal number {value} (a leading zero); "
+            f"allowed: the number without its leading zero, {int(digits):d}",
+            node.start_mark,
+        )
+    return loader.construct_yaml_int(node) if kind == "int" else loader.construct_yaml_float(node)
+
+
+_UniqueKeyLoader.add_constructor(
+    "tag:yaml.org,2002:int", lambda loader, node: _number_of_yaml_11(loader, node, "int")
+)
+_UniqueKeyLoader.add_constructor(
+    "tag:yaml.org,2002:float", lambda loader, node: _number_of_yaml_11(loader, node, "float")
+)
 
 #: Largest case file read [bytes]: a case is a few kilobytes; particles beyond a few
 #: thousand belong in a particle file (``insertion: kind: file``), which has no such limit.
