@@ -285,3 +285,18 @@ def test_yaml_11_numbers_read_silently_as_others_are_refused(tmp_path: Path) -> 
     path = tmp_path / "plain.yaml"
     path.write_text(text.replace("density: 2500", "density: 2_500").replace("0.001", "1e-3"))
     assert cli("validate", path).returncode == 0
+
+
+def test_a_run_directory_given_as_the_checkpoint_is_named_as_one(tmp_path: Path) -> None:
+    """``run --restart DIR`` (the run's directory, not its checkpoint) said the checkpoint
+    ``does not exist or is not a file``, though it exists."""
+    out = tmp_path / "out"
+    res = cli("run", _write(tmp_path, base_case()), "--output", out, "--steps", 2, "--no-progress")
+    assert res.returncode == 0, res.stderr
+    res = cli("run", "--restart", out, "--output", tmp_path / "next", "--steps", 2)
+    assert res.returncode == 2
+    assert f"checkpoint '{out}' is a directory; allowed: a checkpoint file (e.g. its newest, " in (
+        res.stderr
+    )
+    assert "does not exist" not in res.stderr
+    assert not (tmp_path / "next").exists()

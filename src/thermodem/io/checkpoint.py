@@ -207,6 +207,13 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
     import h5py
 
     path = Path(path)
+    if path.is_dir():  # (a run's directory given as the checkpoint: "does not exist" misled)
+        found = list_checkpoints(path / "checkpoints") or list_checkpoints(path)
+        hint = f"e.g. its newest, {found[-1]}" if found else "none is in it"
+        raise ConfigError(
+            f"checkpoint {str(path)!r} is a directory; allowed: a checkpoint file ({hint}), or "
+            f"thermodem restart {path} to continue a run in its own directory"
+        )
     if not path.is_file():
         raise ConfigError(f"checkpoint {str(path)!r} does not exist or is not a file")
     try:
