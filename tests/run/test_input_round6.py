@@ -300,3 +300,39 @@ def test_a_run_directory_given_as_the_checkpoint_is_named_as_one(tmp_path: Path)
     )
     assert "does not exist" not in res.stderr
     assert not (tmp_path / "next").exists()
+
+
+def test_simulation_initial_temperature_beside_a_rule_is_told(tmp_path: Path) -> None:
+    """``simulation.initial_temperature: 350`` with ``thermal.initial_temperature: {kind:
+    per_material, values: {}}``: every particle started at the rule's default 293.15 K, the
+    350 K given was not used, silently."""
+    sim = {**SIM, "initial_temperature": 350.0}
+    rule = {"kind": "per_material", "values": {}}
+    res = _validate(tmp_path, simulation=sim, thermal={"initial_temperature": rule})
+    assert res.returncode == 0, res.stderr
+    assert (
+        "simulation.initial_temperature: 350 K is given, but thermal.initial_temperature (kind "
+        "per_material) gives every particle its temperature (its default, 293.15 K, for the "
+        "particles it does not name), so it is not used" in "\n".join(_warnings(res))
+    )
+    # a rule alone is not told
+    res = _validate(tmp_path, thermal={"initial_temperature": rule})
+    assert not [w for w in _warnings(res) if "initial_temperature" in w]
+
+
+def test_particle_file_paths_empty_or_from_home(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    """``path: ''`` was read as the case's directory (``... is a directory``); ``path:
+    ~/beds/bed.txt`` was joined to the case's directory; ``$HOME/...`` is told unexpanded."""
+    home = tmp_path / "home"
+    (home / "beds").mkdir(parents=True)
+    (home / "beds" / "bed.txt").write_text("x y z radius\n0.005 0.005 0.005 0.001\n")
+    entry = {"kind": "file", "material": "glass"}
+    res = _validate(tmp_path, insertion=[{**entry, "path": ""}])
+    assert res.returncode == 2
+    assert "insertion.0.path: an empty path (got '')" in res.stderr
+    monkeypatch.setenv("HOME", str(home))
+    res = _validate(tmp_path, insertion=[{**entry, "path": "~/beds/bed.txt"}])
+    assert res.returncode == 0, res.stderr
+    res = _validate(tmp_path, insertion=[{**entry, "path": "$HOME/beds/bed.txt"}])
+    assert res.returncode == 2
+    assert "environment variables such as $HOME are not expanded" in res.stderr

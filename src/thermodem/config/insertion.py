@@ -385,6 +385,21 @@ class FileInsertion(_EntryBase):
         "particles and centres outside the domain are refused regardless",
     )
 
+    @field_validator("path", mode="before")
+    @classmethod
+    def _given_path(cls, v: Any) -> Any:
+        # '' was read as '.', the case's directory ("... is a directory"); '~/beds/bed.txt'
+        # was joined to the case's directory ('/case/dir/~/beds/...': "does not exist")
+        if isinstance(v, str):
+            if not v.strip():
+                raise ValueError(
+                    f"an empty path (got {v!r}); allowed: the path of a particle file, "
+                    "absolute or relative to the case file's directory"
+                )
+            if v.startswith("~"):
+                return str(Path(v).expanduser())
+        return v
+
 
 PositiveTemperature = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 """A strictly positive, finite temperature [K]."""

@@ -52,6 +52,32 @@ def mechanics_only_temperature_warnings(case: Case) -> list[str]:
     return out
 
 
+def initial_temperature_rule_warnings(case: Case) -> list[str]:
+    """``simulation.initial_temperature`` beside a ``thermal.initial_temperature`` rule: the
+    rule gives every particle a temperature (``per_material`` and ``regions`` their
+    ``default``, 293.15 K, to the particles they do not name), so the simulation's value is
+    never used (docs/thermal-engine.md, section 6)."""
+    th = case.thermal
+    sim = case.simulation
+    if th is None or th.initial_temperature is None:
+        return []
+    if "initial_temperature" not in sim.model_fields_set:
+        return []
+    rule = th.initial_temperature
+    default = getattr(rule, "default", None)
+    rest = (
+        f" (its default, {default:g} K, for the particles it does not name)"
+        if default is not None
+        else ""
+    )
+    return [
+        f"simulation.initial_temperature: {sim.initial_temperature:g} K is given, but "
+        f"thermal.initial_temperature (kind {rule.kind}) gives every particle its temperature"
+        f"{rest}, so it is not used; allowed: the temperature in the rule (e.g. its default), "
+        "or leave simulation.initial_temperature out"
+    ]
+
+
 def unread_gas_warnings(case: Case) -> list[str]:
     """A ``thermal.gas`` section that no selected model reads (the default conduction
     ``batchelor_obrien_simple`` reads none): its values change nothing."""
@@ -194,6 +220,7 @@ def case_input_warnings(case: Case) -> list[str]:
     return (
         friction_law_warnings(case)
         + mechanics_only_temperature_warnings(case)
+        + initial_temperature_rule_warnings(case)
         + unread_gas_warnings(case)
         + mechanical_value_warnings(case)
         + zero_load_warnings(case)

@@ -229,7 +229,10 @@ def _assemble(
 def _read_text(path: Path) -> str:
     where = f"particle file {str(path)!r}"
     if not path.exists():
-        raise ValueError(f"{where} does not exist")
+        hint = ""
+        if "$" in str(path):
+            hint = " (environment variables such as $HOME are not expanded: write the path)"
+        raise ValueError(f"{where} does not exist{hint}")
     if path.is_dir():
         raise ValueError(f"{where} is a directory, expected a text file")
     try:
