@@ -336,3 +336,25 @@ def test_particle_file_paths_empty_or_from_home(tmp_path: Path, monkeypatch) -> 
     res = _validate(tmp_path, insertion=[{**entry, "path": "$HOME/beds/bed.txt"}])
     assert res.returncode == 2
     assert "environment variables such as $HOME are not expanded" in res.stderr
+
+
+def test_thermal_inputs_nothing_reads_are_told(tmp_path: Path) -> None:
+    """``contact_radius: none`` (R_c = 0) under batchelor_obrien_simple (Q = 4 k R_c ΔT)
+    conducted nothing, and an ``interactions`` entry's ``surface_roughness`` without the
+    resistance network was not read, both silently."""
+    pair = [{"materials": ["glass", "glass"], "surface_roughness": 1.0e-6}]
+    # (refused before it is built, the warnings told with the refusal: no kernel of the
+    # contact_radius none combination is compiled)
+    unbuilt = {k: v for k, v in GLASS.items() if k != "specific_heat"}
+    res = _validate(tmp_path, materials={"glass": unbuilt}, thermal={"contact_radius": "none"},
+                    interactions=pair)  # fmt: skip
+    assert res.returncode == 2 and "specific_heat: missing" in res.stderr, res.stderr
+    text = res.stderr
+    assert (
+        "thermal.contact_radius = 'none' gives the contact radius R_c = 0, so "
+        "thermal.direct_conduction = 'batchelor_obrien_simple'" in text
+    )
+    assert (
+        "interactions.0: surface_roughness = 1e-06 given, but only thermal.direct_conduction "
+        "= 'resistance_network' reads them (selected: 'batchelor_obrien_simple')" in text
+    )

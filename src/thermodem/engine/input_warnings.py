@@ -78,6 +78,43 @@ def initial_temperature_rule_warnings(case: Case) -> list[str]:
     ]
 
 
+#: Direct conduction models whose heat rate is proportional to a power of the contact radius
+#: (batchelor_obrien_simple: Q = 4 k R_c ΔT; thermal_pipe: A_p = π R_c²).
+RADIUS_PROPORTIONAL = ("batchelor_obrien_simple", "thermal_pipe")
+
+
+def thermal_choice_warnings(case: Case) -> list[str]:
+    """A ``contact_radius: none`` (R_c = 0) under a direct conduction proportional to the
+    contact radius (it conducts nothing), and an ``interactions`` entry's ``surface_roughness``
+    / ``surface_slope`` without the resistance network, their only reader."""
+    th = case.thermal
+    out = []
+    radius = getattr(th.contact_radius, "model", None) if th is not None else None
+    direct = getattr(th.direct_conduction, "model", None) if th is not None else None
+    if radius == "none" and direct in RADIUS_PROPORTIONAL:
+        out.append(
+            f"thermal.contact_radius = 'none' gives the contact radius R_c = 0, so "
+            f"thermal.direct_conduction = {direct!r} (a heat rate proportional to R_c) conducts "
+            "nothing between touching particles; allowed: a contact_radius model (geometric, "
+            "the default), or direct_conduction: none"
+        )
+    if direct != "resistance_network":
+        for k, o in enumerate(case.interactions):
+            given = [
+                f"{key} = {getattr(o, key):g}"
+                for key in ("surface_roughness", "surface_slope")
+                if getattr(o, key) is not None
+            ]
+            if given:
+                out.append(
+                    f"interactions.{k}: {' and '.join(given)} given, but only "
+                    "thermal.direct_conduction = 'resistance_network' reads them (selected: "
+                    f"{'no thermal section' if th is None else repr(direct)}): not used; "
+                    "allowed: direct_conduction: resistance_network, or leave them out"
+                )
+    return out
+
+
 def unread_gas_warnings(case: Case) -> list[str]:
     """A ``thermal.gas`` section that no selected model reads (the default conduction
     ``batchelor_obrien_simple`` reads none): its values change nothing."""
@@ -221,6 +258,7 @@ def case_input_warnings(case: Case) -> list[str]:
         friction_law_warnings(case)
         + mechanics_only_temperature_warnings(case)
         + initial_temperature_rule_warnings(case)
+        + thermal_choice_warnings(case)
         + unread_gas_warnings(case)
         + mechanical_value_warnings(case)
         + zero_load_warnings(case)
