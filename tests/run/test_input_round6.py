@@ -214,6 +214,12 @@ def test_particles_vanishing_for_the_domain_are_an_input_error(tmp_path: Path) -
     assert "the neighbour grid would have" in res.stderr
     assert "a lognormal of a large sigma: give min_radius" in res.stderr
     assert "before any step" in res.stderr
+    # a radius in another unit in a list entry: 1e-300 m
+    tiny = {"kind": "list", "material": "glass", "radius": 1e-300, "positions": [[0.005] * 3]}
+    res = _validate(tmp_path, insertion=[tiny])
+    assert res.returncode == 2
+    assert "the neighbour grid would have more than 1e308 cells" in res.stderr
+    assert "radii in another unit (a particle file's or a list's)" in res.stderr
 
 
 def test_friction_coefficients_the_contact_laws_do_not_read_are_told(tmp_path: Path) -> None:

@@ -12,6 +12,7 @@ build.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -82,13 +83,22 @@ def check_next_build(sim: Simulation) -> None:
     check_periodic_length(sim, 2.0 * r_max + sim.extra + skin, r_max, skin)
 
 
-#: The most cells of the neighbour grid (its cell_start array: 8 bytes each, 1.6 GB).
-MAX_CELLS = 2.0e8
+#: Bytes per cell of the neighbour grid (its cell_start array, int64).
+CELL_BYTES = 8.0
+
+
+def max_cells() -> float:
+    """The most cells of the neighbour grid: those whose cell_start array fits in the
+    machine's physical memory (1e9, 8 GB, where it is unknown)."""
+    from thermodem.engine.resources import physical_memory
+
+    total = physical_memory()[0]
+    return total / CELL_BYTES if math.isfinite(total) and total > 0 else 1.0e9
 
 
 def check_cell_count(sim: Simulation, cell: float, r_max: float) -> None:
     """SimulationError when the neighbour grid of cells of edge ``cell`` (2 R_max + extra
-    distance + skin) would have more than :data:`MAX_CELLS` cells: particles vanishingly small
+    distance + skin) would have more than :func:`max_cells` cells: particles vanishingly small
     for the domain (a lognormal distribution of a huge sigma draws radii of 1e-20 m), which
     ended in a NumPy "array is too big" traceback. At the first build (validate, run) it is an
     input error."""
@@ -96,16 +106,21 @@ def check_cell_count(sim: Simulation, cell: float, r_max: float) -> None:
     per_axis = np.maximum(np.floor(length / max(cell, 1e-300)), 1.0)
     if sim.planar:
         per_axis[2] = 1.0
-    cells = float(np.prod(per_axis))
-    if cells <= MAX_CELLS:
+    cells = math.prod(float(c) for c in per_axis)  # (inf beyond 1e308, without a warning)
+    if cells <= 1.0e8:  # (0.8 GB: fine on any machine; the memory is not read each build)
         return
+    most = max_cells()
+    if cells <= most:
+        return
+    count = f"{cells:.3g}" if np.isfinite(cells) else "more than 1e308"
     raise SimulationError(
-        f"the neighbour grid would have {cells:.3g} cells (more than {MAX_CELLS:.3g}): its cell "
+        f"the neighbour grid would have {count} cells (more than {most:.3g}, "
+        "whose index alone fills the physical memory): its cell "
         f"edge is {cell:.3g} m (2 R_max + neighbors.extra_distance + skin, the largest particle "
         f"radius R_max being {r_max:.3g} m) in a domain of {length[0]:.3g} × {length[1]:.3g} × "
-        f"{length[2]:.3g} m; particles that small for the domain come from a radius "
-        "distribution drawing vanishing radii (a lognormal of a large sigma: give min_radius, "
-        "or a sigma of 0.05-1) or radii in another unit"
+        f"{length[2]:.3g} m; particles that small for the domain come from radii in another "
+        "unit (a particle file's or a list's) or from a radius distribution drawing vanishing "
+        "radii (a lognormal of a large sigma: give min_radius, or a sigma of 0.05-1)"
     )
 
 
