@@ -364,3 +364,20 @@ def test_thermal_inputs_nothing_reads_are_told(tmp_path: Path) -> None:
         "interactions.0: surface_roughness = 1e-06 given, but only thermal.direct_conduction "
         "= 'resistance_network' reads them (selected: 'batchelor_obrien_simple')" in text
     )
+
+
+def test_pour_warnings_write_the_time_as_a_number(tmp_path: Path) -> None:
+    """A full pour region was told at ``t=3.0000000000000004e-05 s`` (the float's repr)."""
+    pour = {
+        "kind": "pour",
+        "material": "glass",
+        "distribution": {"kind": "mono", "radius": 0.001},
+        "region": {"kind": "box", "lower": [0, 0, 0.007], "upper": [0.01, 0.01, 0.01]},
+        "rate": 1.0e6,
+        "interval": 1.0e-5,
+    }
+    case = _write(tmp_path, base_case(insertion=[pour]))
+    res = cli("run", case, "--output", tmp_path / "out", "--steps", 4, "--no-progress")
+    assert res.returncode == 0, res.stderr
+    assert "pour insertion at t=3e-05 s placed" in res.stdout + res.stderr
+    assert "t=3.0000000000000004e-05" not in res.stdout + res.stderr

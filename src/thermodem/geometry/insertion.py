@@ -431,7 +431,7 @@ class Pourer:
         if n_placed < n:
             self.skipped += n - n_placed
             warnings.warn(
-                f"pour insertion at t={time!r} s placed {n_placed} of {n} particles (the region "
+                f"pour insertion at t={time:.6g} s placed {n_placed} of {n} particles (the region "
                 f"is too full; {self.skipped} skipped so far); use a larger region or a lower rate",
                 RuntimeWarning,
                 stacklevel=2,
