@@ -381,3 +381,21 @@ def test_pour_warnings_write_the_time_as_a_number(tmp_path: Path) -> None:
     assert res.returncode == 0, res.stderr
     assert "pour insertion at t=3e-05 s placed" in res.stdout + res.stderr
     assert "t=3.0000000000000004e-05" not in res.stdout + res.stderr
+
+
+def test_etc_of_a_poured_bed_names_the_pour(tmp_path: Path) -> None:
+    """``etc`` of a case whose particles are all poured said ``the case has no particles``,
+    which the case file seems to contradict."""
+    pour = {
+        "kind": "pour",
+        "material": "glass",
+        "distribution": {"kind": "mono", "radius": 0.001},
+        "region": {"kind": "box", "lower": [0, 0, 0.007], "upper": [0.01, 0.01, 0.01]},
+        "rate": 1.0e4,
+        "interval": 1.0e-4,
+    }
+    res = cli("etc", _write(tmp_path, base_case(insertion=[pour], thermal={})))
+    assert res.returncode == 2
+    assert "the case has no particles at t = 0: insertion.0 pour(s) them during a run" in (
+        res.stderr
+    )

@@ -48,6 +48,7 @@ the disc thickness b (docs/two-dimensional.md).
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
@@ -119,7 +120,7 @@ def effective_conductivity(
         )
     p = sim.particles
     if p.count == 0:
-        raise ConfigError("effective conductivity: the case has no particles")
+        raise ConfigError(no_particles_text(sim))
     diameter = 2.0 * float(p.radius.mean())
     layers = layers or (diameter, 2.0 * diameter)
     solver = ImplicitSolver(sim.thermal)
@@ -228,7 +229,7 @@ def periodic_gradient(
         )
     p = sim.particles
     if p.count == 0:
-        raise ConfigError("effective conductivity: the case has no particles")
+        raise ConfigError(no_particles_text(sim))
     eng = sim.thermal
     solver = ImplicitSolver(eng)
     solver._rates(sim.time)  # the engine's passes store every term's conductances
@@ -291,3 +292,17 @@ def effective_conductivity_of_case(case, axes: str = "xyz", **options) -> list[A
     if options.pop("periodic", False):
         return periodic_gradient(built_simulation(case), axes)
     return effective_conductivity(built_simulation(case), axes, **options)
+
+
+def no_particles_text(sim: Any) -> str:
+    """The refusal of a case with no particle at t = 0, naming its pour entries (they insert
+    during a run; etc measures the packing at the start)."""
+    pours = [f"insertion.{k}" for k, e in enumerate(sim.case.insertion) if e.kind == "pour"]
+    if not pours:
+        return "effective conductivity: the case has no particles"
+    return (
+        f"effective conductivity: the case has no particles at t = 0: {', '.join(pours)} "
+        "pour(s) them during a run, and etc measures the packing at the start; allowed: an "
+        "entry that places the packing at t = 0 (lattice, random_box, random_cylinder, file "
+        "or list)"
+    )
