@@ -220,6 +220,11 @@ def test_particles_vanishing_for_the_domain_are_an_input_error(tmp_path: Path) -
     assert res.returncode == 2
     assert "the neighbour grid would have more than 1e308 cells" in res.stderr
     assert "radii in another unit (a particle file's or a list's)" in res.stderr
+    # a domain of 10 km for 1 mm particles (lengths in mm?): NumPy could not allocate the grid
+    res = _validate(tmp_path, domain={"lower": [0, 0, 0], "upper": [1.0e4, 1.0e4, 1.0e4]})
+    assert res.returncode == 2
+    assert "allowed: a domain (domain.lower, domain.upper) at most about" in res.stderr
+    assert "a domain in another unit (mm: 10 for 10 mm)" in res.stderr
 
 
 def test_friction_coefficients_the_contact_laws_do_not_read_are_told(tmp_path: Path) -> None:

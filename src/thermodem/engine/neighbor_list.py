@@ -118,9 +118,11 @@ def check_cell_count(sim: Simulation, cell: float, r_max: float) -> None:
         "whose index alone fills the physical memory): its cell "
         f"edge is {cell:.3g} m (2 R_max + neighbors.extra_distance + skin, the largest particle "
         f"radius R_max being {r_max:.3g} m) in a domain of {length[0]:.3g} × {length[1]:.3g} × "
-        f"{length[2]:.3g} m; particles that small for the domain come from radii in another "
-        "unit (a particle file's or a list's) or from a radius distribution drawing vanishing "
-        "radii (a lognormal of a large sigma: give min_radius, or a sigma of 0.05-1)"
+        f"{length[2]:.3g} m; allowed: a domain (domain.lower, domain.upper) at most about "
+        f"{(most ** (1.0 / (2 if sim.planar else 3))) * cell:.3g} m wide for these particles. "
+        "The usual causes: a domain in another unit (mm: 10 for 10 mm), radii in another unit "
+        "(a particle file's or a list's), or a radius distribution drawing vanishing radii (a "
+        "lognormal of a large sigma: give min_radius, or a sigma of 0.05-1)"
     )
 
 
