@@ -28,6 +28,16 @@ GRAVITY_SUSPECT_ABOVE = 1000.0
 EXTRA_DISTANCE_WARN_DIAMETERS = 2.0
 
 
+def _given(model: object, key: str) -> bool:
+    """``key`` written in the case with another value than its default: case.resolved.yaml
+    writes every default (``initial_temperature: 293.15``, ``sliding_friction: 0.5``), and
+    running it again must not warn about values the user never wrote."""
+    if key not in model.model_fields_set:  # type: ignore[attr-defined]
+        return False
+    field = type(model).model_fields[key]  # type: ignore[attr-defined]
+    return getattr(model, key) != field.default
+
+
 def mechanics_only_temperature_warnings(case: Case) -> list[str]:
     """Start temperatures in a case without a thermal section (mechanics only): a
     ``simulation.initial_temperature`` or an insertion entry's ``temperature`` /
@@ -40,7 +50,7 @@ def mechanics_only_temperature_warnings(case: Case) -> list[str]:
     )
     out = []
     sim = case.simulation
-    if "initial_temperature" in sim.model_fields_set:
+    if _given(sim, "initial_temperature"):
         out.append(f"simulation.initial_temperature: {sim.initial_temperature:g} K is given, {why}")
     for k, e in enumerate(case.insertion):
         if getattr(e, "temperature", None) is not None:
@@ -61,7 +71,7 @@ def initial_temperature_rule_warnings(case: Case) -> list[str]:
     sim = case.simulation
     if th is None or th.initial_temperature is None:
         return []
-    if "initial_temperature" not in sim.model_fields_set:
+    if not _given(sim, "initial_temperature"):
         return []
     rule = th.initial_temperature
     default = getattr(rule, "default", None)
@@ -123,6 +133,8 @@ def unread_gas_warnings(case: Case) -> list[str]:
     th = case.thermal
     if th is None or "gas" not in th.model_fields_set:
         return []
+    if th.gas.model_dump() == type(th.gas)().model_dump():
+        return []  # (the default air, as case.resolved.yaml writes it)
     if any(c.spec.uses_gas for _, c in model_choices(case)):
         return []
     return [
@@ -233,7 +245,7 @@ def friction_law_warnings(case: Case) -> list[str]:
         given = [
             f"{key}.{prop} = {getattr(e, prop):g}"
             for key, e in entries
-            if prop in e.model_fields_set and getattr(e, prop)
+            if _given(e, prop) and getattr(e, prop)
         ]
         if model == "none" and given:
             default = " (the default)" if family not in case.contact.model_fields_set else ""
