@@ -425,3 +425,17 @@ def test_the_resolved_case_gets_none_of_these_warnings(tmp_path: Path) -> None:
                     contact={"tangential": "none"}, thermal={})  # fmt: skip
     assert res.returncode == 2 and "specific_heat: missing" in res.stderr, res.stderr
     assert "given, but contact." not in res.stderr
+
+
+def test_several_particles_written_as_one_flat_list_is_one_message(tmp_path: Path) -> None:
+    """``positions: [x1, y1, z1, x2, y2, z2]`` gave one message per number (a single flat
+    [x, y, z] already had one)."""
+    flat = [0.002, 0.002, 0.002, 0.005, 0.005, 0.005]
+    entry = {"kind": "list", "material": "glass", "radius": 0.001, "positions": flat}
+    res = _validate(tmp_path, insertion=[entry])
+    assert res.returncode == 2
+    assert "insertion.0.positions: a list of vectors, one [x, y, z] per particle; got 6 numbers" in (
+        res.stderr
+    )
+    assert "e.g. [[0.002, 0.002, 0.002], [0.005, 0.005, 0.005]]" in res.stderr
+    assert "positions.1" not in res.stderr

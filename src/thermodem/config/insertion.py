@@ -437,11 +437,24 @@ class ListInsertion(_EntryBase):
     def _one_flat_vector(cls, value: Any) -> Any:
         """``positions: [x, y, z]`` (one particle written without its outer brackets) gave
         one message per number; one message, with the list it meant."""
-        flat = isinstance(value, list) and 2 <= len(value) <= 3
-        if flat and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
+        numbers = (
+            isinstance(value, list)
+            and len(value) >= 2
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+        )
+        if numbers and len(value) <= 3:
             raise ValueError(
                 f"a list of vectors, one [x, y, z] per particle; got the numbers {value}: for "
                 f"one particle write [{value}]"
+            )
+        if numbers:  # (several particles written as one flat list: one message per number)
+            size = 3 if len(value) % 3 == 0 else 2 if len(value) % 2 == 0 else 3
+            rows = [value[k : k + size] for k in range(0, len(value), size)]
+            shown = ", ".join(str(r) for r in rows[:3]) + (", ..." if len(rows) > 3 else "")
+            raise ValueError(
+                f"a list of vectors, one [x, y, z] per particle; got {len(value)} numbers in one "
+                f"flat list (got {value[:6]}{' ...' if len(value) > 6 else ''}): write one "
+                f"bracketed vector per particle, e.g. [{shown}]"
             )
         return value
 
