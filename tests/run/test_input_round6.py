@@ -434,8 +434,7 @@ def test_several_particles_written_as_one_flat_list_is_one_message(tmp_path: Pat
     entry = {"kind": "list", "material": "glass", "radius": 0.001, "positions": flat}
     res = _validate(tmp_path, insertion=[entry])
     assert res.returncode == 2
-    assert "insertion.0.positions: a list of vectors, one [x, y, z] per particle; got 6 numbers" in (
-        res.stderr
-    )
+    told = "insertion.0.positions: a list of vectors, one [x, y, z] per particle; got 6 numbers"
+    assert told in res.stderr
     assert "e.g. [[0.002, 0.002, 0.002], [0.005, 0.005, 0.005]]" in res.stderr
     assert "positions.1" not in res.stderr
