@@ -438,3 +438,16 @@ def test_several_particles_written_as_one_flat_list_is_one_message(tmp_path: Pat
     assert told in res.stderr
     assert "e.g. [[0.002, 0.002, 0.002], [0.005, 0.005, 0.005]]" in res.stderr
     assert "positions.1" not in res.stderr
+
+
+def test_a_lattice_over_an_earlier_entry_is_told(tmp_path: Path) -> None:
+    """A lattice entry given twice (a copied entry): every site of the second overlapped the
+    first's particles and was skipped, so it inserted nothing, silently."""
+    res = _validate(tmp_path, insertion=[LATTICE, LATTICE])
+    assert res.returncode == 0, res.stderr
+    assert (
+        "insertion.1: 8 of 8 lattice sites overlap particles of earlier insertion entries and "
+        "are skipped (the entry inserts 0)" in "\n".join(_warnings(res))
+    )
+    # a single entry is not told
+    assert not [w for w in _warnings(_validate(tmp_path)) if "lattice sites" in w]

@@ -182,6 +182,7 @@ def _insert_lattice(
     existing_radii: np.ndarray | None,
     walls_ok: WallsOk | None,
     planar: bool = False,
+    key: str = "insertion",
 ) -> InsertedParticles:
     sites = lattice_sites(entry, planar)
     radii = sample_radii(entry.distribution, sites.shape[0], rng)
@@ -200,6 +201,18 @@ def _insert_lattice(
             lower, upper, float(radii.max()), existing_positions, existing_radii, 0
         )
         keep &= ~obstacles.overlapping(sites, radii)
+        overlapped = int(radii.size - np.count_nonzero(keep))
+        if overlapped and existing_radii is not None and len(existing_radii):
+            # (an entry repeated, or a box over an earlier entry's: its sites were skipped
+            # and the entry inserted fewer particles, or none, without a word)
+            warnings.warn(
+                f"{key}: {overlapped} of {radii.size} lattice sites overlap particles of earlier "
+                f"insertion entries and are skipped (the entry inserts "
+                f"{radii.size - overlapped}); move its box, or remove the entry if it repeats "
+                "another",
+                RuntimeWarning,
+                stacklevel=2,
+            )
         if walls_ok is not None:
             keep &= np.asarray(walls_ok(sites, radii), dtype=np.bool_)
     return _assemble(sites[keep], radii[keep], entry.velocity, entry.temperature, entry.material)
@@ -303,7 +316,7 @@ def insert(
     try:
         existing = (existing_positions, existing_radii, walls_ok, planar)
         if isinstance(entry, LatticeInsertion):
-            return _insert_lattice(entry, rng, *existing)
+            return _insert_lattice(entry, rng, *existing, key=key)
         if isinstance(entry, RandomBoxInsertion | RandomCylinderInsertion):
             return _insert_random(entry, rng, *existing)
         if isinstance(entry, FileInsertion | ListInsertion):
