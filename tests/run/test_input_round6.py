@@ -156,7 +156,12 @@ def test_zero_loads_and_a_huge_extra_distance_are_told(tmp_path: Path) -> None:
         tmp_path,
         external_force=[{"select": {"ids": [0]}, "force": [0, 0, 0]}],
         neighbors={"extra_distance": 1.0},
-        thermal={"heat_flux": [{"select": {"ids": [0]}, "flux": 0.0}]},
+        thermal={
+            "heat_flux": [{"select": {"ids": [0]}, "flux": 0.0}],
+            "external_source": [
+                {"region": {"lower": [0, 0, 0], "upper": [0.01, 0.01, 0.01]}, "power": 0.0}
+            ],
+        },
     )
     assert res.returncode == 0, res.stderr
     text = "\n".join(_warnings(res))
@@ -164,6 +169,7 @@ def test_zero_loads_and_a_huge_extra_distance_are_told(tmp_path: Path) -> None:
         "external_force.0: force [0.0, 0.0, 0.0] and torque [0.0, 0.0, 0.0] are both zero" in text
     )
     assert "thermal.heat_flux.0.flux: 0 W/m² gives no heat" in text
+    assert "thermal.external_source.0.power: 0 W gives no heat" in text
     assert "neighbors.extra_distance = 1 m is 500 times the largest particle diameter" in text
 
 

@@ -203,7 +203,8 @@ def mechanical_value_warnings(case: Case) -> list[str]:
 
 def zero_load_warnings(case: Case) -> list[str]:
     """An ``external_force`` entry whose force and torque are both zero, a ``heat_flux`` of
-    0 W/m² or a ``volumetric_source`` of 0 W/m³ (a constant): each does nothing."""
+    0 W/m², a ``volumetric_source`` of 0 W/m³ (a constant) or an ``external_source`` of 0 W:
+    each does nothing."""
     out = []
     for k, e in enumerate(case.external_force):
         if not any(e.force) and not any(e.torque):
@@ -224,6 +225,12 @@ def zero_load_warnings(case: Case) -> list[str]:
                         f"thermal.{key}.{k}.{value_key}: 0 {unit} gives no heat, so the entry "
                         "does nothing; give a non-zero value, or remove it"
                     )
+        for k, e in enumerate(th.external_source):
+            if e.power == 0:
+                out.append(
+                    f"thermal.external_source.{k}.power: 0 W gives no heat, so the source does "
+                    "nothing; give a non-zero power, or remove it"
+                )
     return out
 
 
