@@ -457,3 +457,20 @@ def test_a_lattice_over_an_earlier_entry_is_told(tmp_path: Path) -> None:
     )
     # a single entry is not told
     assert not [w for w in _warnings(_validate(tmp_path)) if "lattice sites" in w]
+
+
+def test_keys_yaml_reads_as_booleans_or_numbers_are_named(tmp_path: Path) -> None:
+    """A material named ``on`` (or ``1``): YAML 1.1 reads the key as True (1), and the message
+    was ``materials.1.[key]: Input should be a valid string (got True)``."""
+    text = yaml.safe_dump(base_case(), sort_keys=False).replace("glass", "placeholder")
+    for name, told in (("on", "the boolean True"), ("1", "the number 1")):
+        path = tmp_path / f"key_{name}.yaml"
+        path.write_text(text.replace("placeholder", name))
+        res = cli("validate", path)
+        assert res.returncode == 2
+        assert f"the key '{name}' is read by YAML as {told}, not a name; allowed: a name, " in (
+            res.stderr
+        )
+        assert "[key]" not in res.stderr
+        path.write_text(text.replace("placeholder", f"'{name}'"))  # quoted: a name
+        assert cli("validate", path).returncode == 0

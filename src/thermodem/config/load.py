@@ -28,6 +28,12 @@ class _UniqueKeyLoader(yaml.SafeLoader):
 MERGE_TAG = "tag:yaml.org,2002:merge"
 
 
+def _kind_of(key: Any) -> str:
+    if key is None:
+        return "null (no name)"
+    return f"the {'boolean' if isinstance(key, bool) else 'number'} {key!r}"
+
+
 def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False):  # noqa: ANN202
     seen: dict[Any, Any] = {}
     for key_node, _ in node.value:
@@ -44,6 +50,19 @@ def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: b
                 f"a key that is a {shape} ('? [...]' or '? {{...}}'); allowed: keys that are names",
                 key_node.start_mark,
             ) from None
+        if (key is None or isinstance(key, bool | int | float)) and isinstance(
+            key_node, yaml.ScalarNode
+        ):
+            # (a material named on, yes, no or 1: YAML 1.1 reads the key as a boolean or a
+            # number, and the message said "materials.1.[key]: ... (got True)")
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"the key {key_node.value!r} is read by YAML as "
+                f"{_kind_of(key)}, not a name; "
+                f"allowed: a name, quoted: '{key_node.value}':",
+                key_node.start_mark,
+            )
         if key in seen:
             mark = key_node.start_mark
             raise yaml.constructor.ConstructorError(
