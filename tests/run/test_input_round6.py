@@ -474,3 +474,14 @@ def test_keys_yaml_reads_as_booleans_or_numbers_are_named(tmp_path: Path) -> Non
         assert "[key]" not in res.stderr
         path.write_text(text.replace("placeholder", f"'{name}'"))  # quoted: a name
         assert cli("validate", path).returncode == 0
+
+
+def test_a_material_nothing_uses_is_told(tmp_path: Path) -> None:
+    """``steel`` defined for the walls while the walls still name ``glass``: the walls ran with
+    glass's values, silently."""
+    res = _validate(tmp_path, materials={"glass": GLASS, "steel": {**GLASS, "density": 7800}})
+    assert res.returncode == 0, res.stderr
+    assert (
+        "materials.steel: defined, but no wall and no insertion entry uses it, so its values "
+        "take part in nothing (the walls and entries use glass)" in "\n".join(_warnings(res))
+    )

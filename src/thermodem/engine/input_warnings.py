@@ -271,10 +271,26 @@ def friction_law_warnings(case: Case) -> list[str]:
     return out
 
 
+def unused_material_warnings(case: Case) -> list[str]:
+    """A material that no wall and no insertion entry uses: its values take part in nothing
+    (a ``steel`` defined for the walls while the walls still name ``glass``)."""
+    used = {w.material for w in case.walls} | {e.material for e in case.insertion}
+    unused = [name for name in case.materials if name not in used]
+    if not unused or not used:
+        return []
+    return [
+        f"materials.{name}: defined, but no wall and no insertion entry uses it, so its values "
+        f"take part in nothing (the walls and entries use {', '.join(sorted(used))}); give "
+        "it as a wall's or an entry's material, or remove it"
+        for name in unused
+    ]
+
+
 def case_input_warnings(case: Case) -> list[str]:
     """The warnings of this module that need the case alone."""
     return (
         friction_law_warnings(case)
+        + unused_material_warnings(case)
         + mechanics_only_temperature_warnings(case)
         + initial_temperature_rule_warnings(case)
         + thermal_choice_warnings(case)
