@@ -48,11 +48,10 @@ import math
 
 import numpy as np
 import pytest
+from test_kratos_reference import CASES as SPHERE_CASES
 from test_kratos_reference import (  # DAMPING_GAMMA of e = 0.2, global_fluid_properties
-    FLUID,
     GLOBAL_DAMPING,
     KRATOS_GAMMA,
-    POROSITY,
 )
 
 from thermodem.config.load import case_from_dict
@@ -64,140 +63,36 @@ T0 = 300.0
 WALL_TEMPERATURE = 400.0
 WALL_CONDUCTIVITY = 400.0  # the Wall material's k(T) table at the wall temperature
 
-GAS = {"gas": {"thermal_conductivity": 10.0}}  # fluid_thermal_conductivity
-BOB = {"cylinder_radius": 1.0, "cutoff_gap_ratio": 1.0}  # conduction_radius, max_conduction_dist.
-KP_MEAN = {"conductivity_mean": "arithmetic"}  # Kratos' k_p = (k_p + k_w)/2
-
-# case: (thermodem thermal settings, Kratos T at 0.03 s, OFFSET [K] (the Kratos-only effects
-# and, where named, Kratos' other reading; tools/kratos_sphere_wall.py), tolerance / (T - T0))
+# case: (Kratos T at 0.03 s, OFFSET [K] (the Kratos-only effects and, where named, Kratos'
+# other reading; tools/kratos_sphere_wall.py), tolerance / (T - T0)); the thermodem thermal
+# settings are those of the same case between two spheres (test_kratos_reference.CASES)
 CASES = {
-    "ConductionDir_01": (
-        {"direct_conduction": "batchelor_obrien_simple"},
-        322.9703553967616,
-        -0.16798135,
-        5e-4,  # measured 2.3e-4
-    ),
-    "ConductionDir_02": (
-        {"direct_conduction": {"model": "batchelor_obrien_complete", **BOB, **KP_MEAN}, **GAS},
-        370.50095465826786,
-        -1.08173704,
-        4e-4,  # measured 1.8e-4
-    ),
+    "ConductionDir_01": (322.9703553967616, -0.16798135, 0.0005),  # measured 2.3e-4
+    "ConductionDir_02": (370.50095465826786, -1.08173704, 0.0004),  # measured 1.8e-4
     # the inner resistance: Kratos R π r̄²/k (as written in C++), thermodem R/(k π r̄²) (OFFSET)
-    "ConductionDir_03": (
-        {"direct_conduction": {"model": "batchelor_obrien_modified", **BOB, **KP_MEAN}, **GAS},
-        357.6311276648615,
-        -5.62574830,
-        3.5e-4,  # measured 1.7e-4
-    ),
-    "ConductionDir_04": (
-        {"direct_conduction": "thermal_pipe"},
-        310.48362717100804,
-        -0.09495318,
-        2.5e-4,  # measured 1.2e-4
-    ),
+    "ConductionDir_03": (357.6311276648615, -5.6257483, 0.00035),  # measured 1.7e-4
+    "ConductionDir_04": (310.48362717100804, -0.09495318, 0.00025),  # measured 1.2e-4
     # collisional: Kratos' E* takes the wall's E(400 K), ν(400 K) (4e6 Pa, 0.4) and its C the
     # particle's own fit; thermodem the simulation's (rigid-wall) E*, the mean of both fits and
     # the emulation's m/1.1 (in the OFFSET)
-    "ConductionDir_05": (
-        {"direct_conduction": "zhou2008"},
-        315.3010968244975,
-        -0.77874334,
-        3e-4,  # measured 1.5e-4
-    ),
+    "ConductionDir_05": (315.3010968244975, -0.77874334, 0.0003),  # measured 1.5e-4
     # Kratos' surrounding_layer: its analytic particle-wall solution
-    "ConductionIndir_01": (
-        {
-            "direct_conduction": "none",
-            "indirect_conduction": {
-                "model": "rong_horio1999",
-                "layer_thickness_ratio": 0.4,  # fluid_layer_thickness
-                "min_separation": 2.75e-8,  # min_conduction_distance
-            },
-            **GAS,
-        },
-        376.06270482468074,
-        -0.72815693,
-        4.5e-4,  # measured 2.2e-4
-    ),
+    "ConductionIndir_01": (376.06270482468074, -0.72815693, 0.00045),  # measured 2.2e-4
     # voronoi_method porosity, global_porosity 0.5: Kratos r_ij = 0.56 R (1 - ε)^(-1/3) at a
     # wall, thermodem A_n = 0.985 R² (1 - ε)^(-2/3) (in the OFFSET)
-    "ConductionIndir_02": (
-        {
-            "direct_conduction": "none",
-            "indirect_conduction": {"model": "voronoi_a", "geometry": "porosity"},
-            **POROSITY,
-            **GAS,
-        },
-        326.4291943017667,
-        -0.04573301,
-        2.5e-4,  # measured 1.15e-4
-    ),
-    "ConductionIndir_03": (
-        {
-            "direct_conduction": "none",
-            "indirect_conduction": {
-                "model": "voronoi_b",
-                "geometry": "porosity",
-                "core_radius_ratio": 0.5,  # isothermal_core_radius
-            },
-            **POROSITY,
-            **GAS,
-        },
-        322.91314450953814,
-        -0.02351870,
-        2e-4,  # measured 0.92e-4
-    ),
+    "ConductionIndir_02": (326.4291943017667, -0.04573301, 0.00025),  # measured 1.15e-4
+    "ConductionIndir_03": (322.91314450953814, -0.0235187, 0.0002),  # measured 0.92e-4
     # Kratos' vargas_mccarthy (gas only, no M: mean free path 1e-30 m) takes the wall as a
     # particle of the same radius (R_p = R), thermodem R_p = 2R̄ = 2R (in the OFFSET)
-    "ConductionIndir_04": (
-        {
-            "direct_conduction": "none",
-            "indirect_conduction": "vargas_mccarthy2002",
-            "gas": {"thermal_conductivity": 10.0, "mean_free_path": 1e-30},
-        },
-        325.3907485650992,
-        24.71557270,
-        7e-4,  # measured 3.5e-4
-    ),
-    "Convection_01": (
-        {"direct_conduction": "none", "convection": "ranz_marshall1952", **FLUID},
-        334.97888349023617,
-        -0.07460287,
-        1e-4,  # measured 4.1e-5
-    ),
-    "Convection_02": (
-        {"direct_conduction": "none", "convection": "whitaker1972", **FLUID},
-        332.7069267613779,
-        -0.06415550,
-        1e-4,  # measured 4.9e-5
-    ),
-    "Convection_03": (
-        {"direct_conduction": "none", "convection": "gunn1978", **FLUID, **POROSITY},
-        340.04594604175827,
-        -0.01597917,
-        1e-5,  # measured 2.6e-6
-    ),
-    "Convection_04": (
-        {
-            "direct_conduction": "none",
-            "convection": {"model": "li_mason2000", "regime": "dense"},
-            **FLUID,
-            **POROSITY,
-        },
-        323.9893852478977,
-        -0.01624665,
-        1.3e-4,  # measured 5.9e-5
-    ),
+    "ConductionIndir_04": (325.3907485650992, 24.7155727, 0.0007),  # measured 3.5e-4
+    "Convection_01": (334.97888349023617, -0.07460287, 0.0001),  # measured 4.1e-5
+    "Convection_02": (332.7069267613779, -0.0641555, 0.0001),  # measured 4.9e-5
+    "Convection_03": (340.04594604175827, -0.01597917, 1e-05),  # measured 2.6e-6
+    "Convection_04": (323.9893852478977, -0.01624665, 0.00013),  # measured 5.9e-5
     # no particle-wall radiation in Kratos, no neighbour: the flux and the source alone.
     # Radiation_01 (continuum_zhou, the same reference) is left out: thermodem's zhou2009 takes
     # T_e = T_f (340 K) for a particle without neighbours (+6.5 K here), Kratos nothing
-    "Radiation_02": (
-        {"direct_conduction": "none", "radiation": {"model": "krause2017", "radius_ratio": 4.0}},
-        300.9910452746127,
-        0.00647127,
-        1e-5,  # measured 4.1e-6
-    ),
+    "Radiation_02": (300.9910452746127, 0.00647127, 1e-05),  # measured 4.1e-6
 }
 
 pytestmark = pytest.mark.usefixtures("one_thread")
@@ -277,7 +172,8 @@ def test_sphere_wall_follows_kratos(name):
     """T at 0.03 s = Kratos' reference + the measured effect of its every-5th-step heat, E(T),
     expansion, wall search (and of its other reading, where named), within about twice the
     measured first-order difference of the heat update's place in the step of T - T0."""
-    thermal, reference, offset, tolerance = CASES[name]
+    thermal = SPHERE_CASES[name][0]
+    reference, offset, tolerance = CASES[name]
     expected = reference + offset
     temperature = final_temperature(thermal)
     assert abs(temperature - expected) < tolerance * abs(expected - T0), (name, temperature)
