@@ -7,7 +7,6 @@ that the material values switch off for every pair that can meet is warned about
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import h5py
@@ -15,8 +14,6 @@ import yaml
 from run_cases import base_case, cli
 
 from thermodem.io.checkpoint import read_checkpoint
-
-EXE = str(Path(sys.executable).with_name("thermodem"))
 
 CASE = base_case()
 
@@ -27,9 +24,6 @@ def _write(tmp_path: Path, name: str = "case", **sections) -> Path:  # noqa: ANN
     path = tmp_path / f"{name}.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
-
-
-_cli = cli  # the command line in this process (run_cases.cli)
 
 
 def _glass(**changes: float) -> dict:
@@ -52,12 +46,12 @@ def test_a_failure_while_the_case_is_built_is_an_input_error(tmp_path: Path) -> 
         "periodic axis, smaller particles or a smaller neighbors.skin (met while the case was "
         "built, before any step)"
     )
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 2, res.stdout + res.stderr
     assert message in res.stderr
     out = tmp_path / "out"
     for _ in range(2):  # (the refusal's record counts as empty: the same error again)
-        res = _cli("run", case, "--output", out, "--no-progress")
+        res = cli("run", case, "--output", out, "--no-progress")
         assert res.returncode == 2, res.stdout + res.stderr
         assert message in res.stderr
     status = json.loads((out / "status.json").read_text())
@@ -68,8 +62,8 @@ def test_a_failure_while_the_case_is_built_is_an_input_error(tmp_path: Path) -> 
     given = {"kind": "list", "material": "glass", "radius": 0.001, "overlap_check": False,
              "positions": [[0.005, 0.005, 0.005], [0.0055, 0.005, 0.005]]}  # fmt: skip
     case = _write(tmp_path, "overlapping", insertion=[given])
-    assert _cli("validate", case).returncode == 0
-    res = _cli("run", case, "--output", tmp_path / "o2", "--no-progress")
+    assert cli("validate", case).returncode == 0
+    res = cli("run", case, "--output", tmp_path / "o2", "--no-progress")
     assert res.returncode == 1, res.stdout + res.stderr
     assert "error: overlap of 1.41 × the smaller radius (particle 0 and particle 1) at step 1" in (
         res.stderr
@@ -87,7 +81,7 @@ def test_a_tessellation_the_start_cannot_make_is_an_input_error(tmp_path: Path) 
                           "material": "steel", "name": "lid"})  # fmt: skip
     case = tmp_path / "voronoi.yaml"
     case.write_text(yaml.safe_dump(data))
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 2, res.stdout + res.stderr
     assert "error: thermal.tessellation (plain): particle 50 (centre [0.0018999999" in res.stderr
     assert (
@@ -97,7 +91,7 @@ def test_a_tessellation_the_start_cannot_make_is_an_input_error(tmp_path: Path) 
     ) in res.stderr
     del data["walls"][1]["name"]  # (without a name: its kind and index, as the other messages)
     case.write_text(yaml.safe_dump(data))
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 2, res.stdout + res.stderr
     assert "is not on the particles' side of the plane walls.1 (plane1): its cell" in res.stderr
 
@@ -138,12 +132,12 @@ def test_a_restart_whose_lists_cannot_be_built_is_refused_before_any_step(tmp_pa
     stores such a case (continued before this check) is refused, the directory unchanged."""
     base = tmp_path / "base.yaml"
     base.write_text(yaml.safe_dump(PERIODIC))
-    res = _cli("run", base, "--output", tmp_path / "out", "--no-progress")
+    res = cli("run", base, "--output", tmp_path / "out", "--no-progress")
     assert res.returncode == 0, res.stdout + res.stderr
     ckpt = tmp_path / "out" / "checkpoints" / "checkpoint_000000020.h5"
     set_up = f"(met while the restart from {ckpt} was set up, before any step; nothing was changed)"
     short = _periodic(tmp_path, "short", upper_x=0.004)
-    res = _cli("run", short, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    res = cli("run", short, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "error: domain.periodic: axis x is periodic, but the domain is 0.004 m long along it "
@@ -153,7 +147,7 @@ def test_a_restart_whose_lists_cannot_be_built_is_refused_before_any_step(tmp_pa
     ) in res.stderr
     assert not (tmp_path / "new").exists()
     wide = _periodic(tmp_path, "wide", skin=0.002)
-    res = _cli("run", wide, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    res = cli("run", wide, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "error: domain.periodic: axis x is periodic, but the domain is 0.006 m long along it "
@@ -164,7 +158,7 @@ def test_a_restart_whose_lists_cannot_be_built_is_refused_before_any_step(tmp_pa
     assert not (tmp_path / "new").exists()
     # a skin that fits: run, and the lists built with it at the first step
     fits = _periodic(tmp_path, "fits", skin=0.0003)
-    res = _cli("run", fits, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    res = cli("run", fits, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
     assert res.returncode == 0, res.stdout + res.stderr
     assert "changed from the checkpoint's case: neighbors.skin (none) -> 0.0003" in res.stdout
     assert read_checkpoint(ckpt).state["scalars"]["skin"] == 0.0002  # (the default 0.2 R)
@@ -184,7 +178,7 @@ def test_a_restart_whose_lists_cannot_be_built_is_refused_before_any_step(tmp_pa
         f.create_dataset("case_yaml", data=text, dtype=h5py.string_dtype("utf-8"))
     (out / "case.resolved.yaml").write_text(text)
     before = _files(out)
-    res = _cli("restart", out, "--end-time", "0.0004", "--no-progress")
+    res = cli("restart", out, "--end-time", "0.0004", "--no-progress")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "error: domain.periodic: axis x is periodic, but the domain is 0.004 m long along it "
@@ -207,11 +201,11 @@ def test_a_generation_mechanism_the_material_values_switch_off_is_told(tmp_path:
         "(the Coulomb cap μ F_n holds no tangential force): materials.glass.sliding_friction = "
         "0; remove it, or give values that dissipate that way"
     )
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 0, res.stdout + res.stderr
     assert res.stderr.count(told) == 1, res.stderr
     out = tmp_path / "out"
-    res = _cli("run", case, "--output", out, "--steps", "2", "--no-progress")
+    res = cli("run", case, "--output", out, "--steps", "2", "--no-progress")
     assert res.returncode == 0, res.stdout + res.stderr
     assert (res.stdout + res.stderr).count(told) == 1
     assert (out / "run.log").read_text().count(told[len("warning: ") :]) == 1
@@ -220,14 +214,14 @@ def test_a_generation_mechanism_the_material_values_switch_off_is_told(tmp_path:
     wall = {**CASE["walls"][0], "material": "steel"}
     case = _write(tmp_path, "steel", materials={**glass, "steel": steel}, walls=[wall],
                   thermal={"heat_generation": "rojek2014"})  # fmt: skip
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 0, res.stdout + res.stderr
     assert "gives zero heat" not in res.stderr
     # ... unless an interactions entry sets that pair's friction to 0
     override = [{"materials": ["glass", "steel"], "sliding_friction": 0.0}]
     case = _write(tmp_path, "override", materials={**glass, "steel": steel}, walls=[wall],
                   interactions=override, thermal={"heat_generation": "rojek2014"})  # fmt: skip
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "sliding friction 0 (the Coulomb cap μ F_n holds no tangential force): "
@@ -238,7 +232,7 @@ def test_a_generation_mechanism_the_material_values_switch_off_is_told(tmp_path:
     generation = {"model": "mechanical_dissipation", "mechanisms": listed}
     case = _write(tmp_path, "elastic", materials=_glass(restitution=1.0),
                   contact={"rolling": "epsd"}, thermal={"heat_generation": generation})  # fmt: skip
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "warning: thermal.heat_generation.mechanisms: 'normal_damping' gives zero heat with "
@@ -253,7 +247,7 @@ def test_a_generation_mechanism_the_material_values_switch_off_is_told(tmp_path:
     assert "'sliding_friction' gives zero" not in res.stderr  # (the default 0.5)
     case = _write(tmp_path, "richard", materials=_glass(restitution=1.0),
                   thermal={"heat_generation": "richard2008"})  # fmt: skip
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert "thermal.heat_generation = 'richard2008': 'normal_damping' gives zero heat" in (
         res.stderr
     )
@@ -295,14 +289,14 @@ def test_a_restart_whose_range_set_cannot_be_built_is_refused(tmp_path: Path) ->
             "thermal": {"indirect_conduction": "batchelor_obrien_separated"}}  # fmt: skip
     base = tmp_path / "base.yaml"
     base.write_text(yaml.safe_dump(data))
-    res = _cli("run", base, "--output", tmp_path / "out", "--no-progress")
+    res = cli("run", base, "--output", tmp_path / "out", "--no-progress")
     assert res.returncode == 0, res.stdout + res.stderr
     ckpt = tmp_path / "out" / "checkpoints" / "checkpoint_000000020.h5"
     data["simulation"]["end_time"] = 4.0e-4
     data["domain"]["upper"][0] = 0.005  # (the contact lists need 0.0044 m, the range set 0.0054)
     short = tmp_path / "short.yaml"
     short.write_text(yaml.safe_dump(data))
-    res = _cli("run", short, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
+    res = cli("run", short, "--restart", ckpt, "--output", tmp_path / "new", "--no-progress")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "error: thermal.indirect_conduction.cutoff_gap_ratio = 1.0: periodic axis x of length "

@@ -5,13 +5,10 @@ other. Each through the command line (run_cases.cli), as a user runs it."""
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import yaml
 from run_cases import cli
-
-EXE = str(Path(sys.executable).with_name("thermodem"))
 
 CASE = {
     "simulation": {"time_step": 1.0e-5, "end_time": 1.0e-4},
@@ -62,21 +59,18 @@ def _glass(**changes) -> dict:  # noqa: ANN003
     return {"glass": {k: v for k, v in glass.items() if v != "-"}}
 
 
-_cli = cli  # the command line in this process (run_cases.cli)
-
-
 def test_an_explicit_null_constant_beside_a_table_is_the_table_alone(tmp_path: Path) -> None:
     """``thermal_conductivity: null`` next to ``thermal_conductivity_table`` (a user who keeps
     every key and empties the one not used) ended in a TypeError traceback."""
     table = [[300.0, 1.0], [400.0, 2.0]]
     for name in ("thermal_conductivity", "specific_heat"):
         glass = _glass(**{name: None, f"{name}_table": table})
-        res = _cli("validate", _case(tmp_path, materials=glass))
+        res = cli("validate", _case(tmp_path, materials=glass))
         assert res.returncode == 0, res.stdout + res.stderr
         assert f"{name}_table:" in res.stdout
     # a value beside the table is still refused
     glass = _glass(thermal_conductivity=1.0, thermal_conductivity_table=table)
-    res = _cli("validate", _case(tmp_path, materials=glass))
+    res = cli("validate", _case(tmp_path, materials=glass))
     assert res.returncode == 2
     assert "thermal_conductivity: 1 W/(m K) is given together with" in res.stderr
 
@@ -86,7 +80,7 @@ def test_frame_settings_with_vtu_false_are_refused(tmp_path: Path) -> None:
     a word; the frame interval and wall extent were ignored the same way."""
     output = {"vtu": False, "contacts": True, "interval": 2.0e-5}
     case = _case(tmp_path, output=output)
-    res = _cli("run", case, "--output", tmp_path / "out", "--no-progress")
+    res = cli("run", case, "--output", tmp_path / "out", "--no-progress")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "output.vtu: false writes no VTU frame, so contacts: true, interval: 2e-05 would be "
@@ -95,9 +89,9 @@ def test_frame_settings_with_vtu_false_are_refused(tmp_path: Path) -> None:
     ) in res.stderr
     assert not (tmp_path / "out" / "timeseries.csv").exists()
     # vtu: false alone, and frames with contacts, are fine
-    assert _cli("validate", _case(tmp_path, output={"vtu": False})).returncode == 0
+    assert cli("validate", _case(tmp_path, output={"vtu": False})).returncode == 0
     both = {"vtu": True, "contacts": True}
-    assert _cli("validate", _case(tmp_path, output=both)).returncode == 0
+    assert cli("validate", _case(tmp_path, output=both)).returncode == 0
 
 
 def test_lengths_in_another_unit_are_refused_before_the_run(tmp_path: Path) -> None:
@@ -106,7 +100,7 @@ def test_lengths_in_another_unit_are_refused_before_the_run(tmp_path: Path) -> N
     surface = {"microhardness": 1.0e9, "surface_slope": 0.1, "thermal_accommodation": 0.9}
     glass = _glass(surface_roughness=0.01, **surface)
     thermal = {"direct_conduction": "resistance_network"}
-    res = _cli("run", _case(tmp_path, materials=glass, thermal=thermal), "--output",
+    res = cli("run", _case(tmp_path, materials=glass, thermal=thermal), "--output",
                tmp_path / "a", "--no-progress")  # fmt: skip
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
@@ -122,13 +116,13 @@ def test_lengths_in_another_unit_are_refused_before_the_run(tmp_path: Path) -> N
     pair = [{"materials": ["glass", "glass"], "surface_roughness": 0.0005}]
     case = _case(tmp_path, materials=_glass(surface_roughness=1e-7, **surface),
                  thermal=thermal, interactions=pair, insertion=insertion)  # fmt: skip
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 2, res.stdout + res.stderr
     assert "interactions.0.surface_roughness = 0.0005 m is not below the radius" in res.stderr
     assert "0.0002 m" in res.stderr
     # S of a surrounding layer model
     thermal = {"indirect_conduction": {"model": "musser2011", "min_separation": 2.75}}
-    res = _cli("validate", _case(tmp_path, thermal=thermal))
+    res = cli("validate", _case(tmp_path, thermal=thermal))
     assert res.returncode == 2
     assert (
         "thermal.indirect_conduction.min_separation = 2.75 m is not below the fluid layer of "
@@ -137,7 +131,7 @@ def test_lengths_in_another_unit_are_refused_before_the_run(tmp_path: Path) -> N
     ) in res.stderr
     # values in range run
     thermal = {"indirect_conduction": {"model": "musser2011", "min_separation": 1e-7}}
-    assert _cli("validate", _case(tmp_path, thermal=thermal)).returncode == 0
+    assert cli("validate", _case(tmp_path, thermal=thermal)).returncode == 0
 
 
 def test_tables_in_another_unit_are_warned_about(tmp_path: Path) -> None:
@@ -147,7 +141,7 @@ def test_tables_in_another_unit_are_warned_about(tmp_path: Path) -> None:
     glass = _glass(thermal_conductivity="-", thermal_conductivity_table=[[20, 1.0], [100, 1.2]])
     wall = {**CASE["walls"][0], "thermal": {"kind": "fixed", "temperature": [[0, 350], [2, 400]]}}
     case = _case(tmp_path, materials=glass, walls=[wall])
-    res = _cli("run", case, "--output", tmp_path / "out", "--no-progress")
+    res = cli("run", case, "--output", tmp_path / "out", "--no-progress")
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "warning: materials.glass.thermal_conductivity_table (row 0, its lowest temperature): "
@@ -161,7 +155,7 @@ def test_tables_in_another_unit_are_warned_about(tmp_path: Path) -> None:
     # a table that changes within the run, in kelvin: nothing said
     glass = _glass(thermal_conductivity="-", thermal_conductivity_table=[[293, 1.0], [400, 2]])
     wall["thermal"]["temperature"] = [[0, 350], [5.0e-5, 400]]
-    res = _cli("validate", _case(tmp_path, materials=glass, walls=[wall]))
+    res = cli("validate", _case(tmp_path, materials=glass, walls=[wall]))
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "warning: materials" not in res.stdout + res.stderr
@@ -175,12 +169,12 @@ def test_a_restart_with_other_particles_of_t0_is_refused(tmp_path: Path) -> None
     restarts (a case may change its properties)."""
     first = _case(tmp_path, "first")
     out = tmp_path / "first_out"
-    assert _cli("run", first, "--output", out, "--no-progress").returncode == 0
+    assert cli("run", first, "--output", out, "--no-progress").returncode == 0
     ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
     lattice = {**CASE["insertion"][0], "upper": [0.006, 0.006, 0.006]}
     larger = _case(tmp_path, "larger", insertion=[lattice])
     again = tmp_path / "again"
-    res = _cli("run", larger, "--restart", ckpt, "--output", again, "--end-time", "2e-4")
+    res = cli("run", larger, "--restart", ckpt, "--output", again, "--end-time", "2e-4")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "error: insertion.0.upper.0 differs from the case stored in the checkpoint "
@@ -189,7 +183,7 @@ def test_a_restart_with_other_particles_of_t0_is_refused(tmp_path: Path) -> None
     ) in res.stderr
     assert not again.exists()
     denser = _case(tmp_path, "denser", materials=_glass(density=3000))
-    res = _cli("run", denser, "--restart", ckpt, "--output", again, "--end-time", "2e-4",
+    res = cli("run", denser, "--restart", ckpt, "--output", again, "--end-time", "2e-4",
                "--no-progress")  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
 
@@ -200,7 +194,7 @@ def test_etc_of_a_packing_that_touches_nowhere_names_the_packing(tmp_path: Path)
     thermal.fixed_temperature, ...)': advice etc itself refuses; --axes zz measured z twice."""
     lattice = {**CASE["insertion"][0], "upper": [0.01, 0.01, 0.01], "spacing": 0.0016}
     case = _case(tmp_path, walls=[], insertion=[lattice])
-    res = _cli("etc", case, "--axes", "z")
+    res = cli("etc", case, "--axes", "z")
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "error: effective conductivity along z: 108 particles in 9 clusters are linked to "
@@ -208,7 +202,7 @@ def test_etc_of_a_packing_that_touches_nowhere_names_the_packing(tmp_path: Path)
         "conduct from one layer to the other"
     ) in res.stderr
     assert "thermal.walls kind fixed" not in res.stderr
-    res = _cli("etc", case, "--axes", "zz")
+    res = cli("etc", case, "--axes", "zz")
     assert res.returncode == 2
     assert "axes = 'zz'; allowed: letters of 'xyz', each once" in res.stderr
 
@@ -222,9 +216,9 @@ def test_export_and_plot_of_a_run_that_never_started_say_why(tmp_path: Path) -> 
     case = _case(tmp_path, "rough", materials=glass,
                  thermal={"direct_conduction": "resistance_network"})  # fmt: skip
     out = tmp_path / "out"
-    assert _cli("run", case, "--output", out, "--no-progress").returncode == 2
+    assert cli("run", case, "--output", out, "--no-progress").returncode == 2
     for command in ("export", "plot"):
-        res = _cli(command, out)
+        res = cli(command, out)
         assert res.returncode == 2, res.stdout + res.stderr
         assert (
             f"the run in '{out}' never started (status.json: its input was refused: "
@@ -234,7 +228,7 @@ def test_export_and_plot_of_a_run_that_never_started_say_why(tmp_path: Path) -> 
             f"after fixing the case (rough) run it again: thermodem run CASE --output {out}"
             in res.stderr
         )
-    assert "give --frame N" in _cli("export", tmp_path).stderr  # (not a run record)
+    assert "give --frame N" in cli("export", tmp_path).stderr  # (not a run record)
 
 
 def test_a_heat_capacity_ratio_no_gas_has_is_refused(tmp_path: Path) -> None:
@@ -244,9 +238,9 @@ def test_a_heat_capacity_ratio_no_gas_has_is_refused(tmp_path: Path) -> None:
     for gamma, status in ((40, 2), (1.67, 0)):
         thermal = {"indirect_conduction": "vargas_mccarthy2002",
                    "gas": {"heat_capacity_ratio": gamma}}  # fmt: skip
-        res = _cli("validate", _case(tmp_path, materials=glass, thermal=thermal))
+        res = cli("validate", _case(tmp_path, materials=glass, thermal=thermal))
         assert res.returncode == status, res.stdout + res.stderr
-    assert ("thermal.gas.heat_capacity_ratio: above 5/3, the largest c_p/c_v of a gas") in _cli(
+    assert ("thermal.gas.heat_capacity_ratio: above 5/3, the largest c_p/c_v of a gas") in cli(
         "validate", _case(tmp_path, thermal={"gas": {"heat_capacity_ratio": 40}})
     ).stderr
 
@@ -273,14 +267,14 @@ def test_a_contact_radius_with_another_contact_law_is_refused(tmp_path: Path) ->
     for contact, radius, message in cases:
         case = _case(tmp_path, materials=glass, contact=contact,
                      thermal={"contact_radius": radius})  # fmt: skip
-        res = _cli("run", case, "--output", tmp_path / "out", "--no-progress")
+        res = cli("run", case, "--output", tmp_path / "out", "--no-progress")
         assert res.returncode == 2, res.stdout + res.stderr
         assert message in res.stderr
         assert not (tmp_path / "out" / "timeseries.csv").exists()
     # the same law and k_n: runs
     radius = {"model": "morris2016_area_time", "contact_law": "linear", "normal_stiffness": 1e3}
     case = _case(tmp_path, materials=glass, contact=linear, thermal={"contact_radius": radius})
-    assert _cli("validate", case).returncode == 0
+    assert cli("validate", case).returncode == 0
 
 
 def test_a_restart_runs_the_changed_wall_values_and_refuses_a_moved_wall(tmp_path: Path) -> None:
@@ -290,13 +284,13 @@ def test_a_restart_runs_the_changed_wall_values_and_refuses_a_moved_wall(tmp_pat
     import h5py
 
     out = tmp_path / "first_out"
-    assert _cli("run", _case(tmp_path, "first"), "--output", out).returncode == 0
+    assert cli("run", _case(tmp_path, "first"), "--output", out).returncode == 0
     ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
     wall = {**CASE["walls"][0], "velocity": [0.0, 0.0, 0.1]}
     wall["thermal"] = {"kind": "fixed", "temperature": 400.0}
     hotter = _case(tmp_path, "hotter", walls=[wall])
     again = tmp_path / "again"
-    res = _cli("run", hotter, "--restart", ckpt, "--output", again, "--end-time", "2e-4")
+    res = cli("run", hotter, "--restart", ckpt, "--output", again, "--end-time", "2e-4")
     assert res.returncode == 0, res.stdout + res.stderr
     final = sorted((again / "checkpoints").glob("*.h5"))[-1]
     with h5py.File(final) as f:
@@ -304,7 +298,7 @@ def test_a_restart_runs_the_changed_wall_values_and_refuses_a_moved_wall(tmp_pat
     assert row[18] == 400.0 and list(row[6:9]) == [0.0, 0.0, 0.1]
     assert abs(row[2] - 0.1 * 1.0e-4) < 1e-12  # moved from the checkpoint's place
     moved = {**CASE["walls"][0], "point": [0.0, 0.0, -0.001]}
-    res = _cli("run", _case(tmp_path, "moved", walls=[moved]), "--restart", ckpt, "--output",
+    res = cli("run", _case(tmp_path, "moved", walls=[moved]), "--restart", ckpt, "--output",
                tmp_path / "moved_out", "--end-time", "2e-4")  # fmt: skip
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
@@ -323,12 +317,12 @@ def test_a_restart_that_swaps_a_heat_mechanism_runs_the_new_one(tmp_path: Path) 
     rad = {"radiation": {"model": "surroundings", "environment_temperature": 300.0}}
     glass = _glass(emissivity=0.8)
     out = tmp_path / "rad"
-    res = _cli("run", _case(tmp_path, "rad", materials=glass, thermal=rad), "--output", out)
+    res = cli("run", _case(tmp_path, "rad", materials=glass, thermal=rad), "--output", out)
     assert res.returncode == 0, res.stdout + res.stderr
     ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
     conv = {"convection": "stagnant", "fluid": {"temperature": 400.0}}
     again = tmp_path / "conv"
-    res = _cli("run", _case(tmp_path, "conv", materials=glass, thermal=conv), "--restart", ckpt,
+    res = cli("run", _case(tmp_path, "conv", materials=glass, thermal=conv), "--restart", ckpt,
                "--output", again, "--end-time", "2e-4")  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
     with h5py.File(ckpt) as f:
@@ -340,10 +334,10 @@ def test_a_restart_that_swaps_a_heat_mechanism_runs_the_new_one(tmp_path: Path) 
     assert "heat_in_convection" in header and "heat_in_radiation" not in header
     adiabatic = {**CASE["walls"][0], "thermal": {"kind": "adiabatic"}}
     out = tmp_path / "adiabatic"
-    res = _cli("run", _case(tmp_path, "adiabatic", walls=[adiabatic]), "--output", out)
+    res = cli("run", _case(tmp_path, "adiabatic", walls=[adiabatic]), "--output", out)
     assert res.returncode == 0, res.stdout + res.stderr
     ckpt = sorted((out / "checkpoints").glob("*.h5"))[-1]
-    res = _cli("run", _case(tmp_path, "fixed"), "--restart", ckpt, "--output",
+    res = cli("run", _case(tmp_path, "fixed"), "--restart", ckpt, "--output",
                tmp_path / "fixed_out", "--end-time", "2e-4")  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
 
@@ -355,7 +349,7 @@ def test_material_values_in_another_unit_are_warned_about(tmp_path: Path) -> Non
     glass = _glass(specific_heat=0.8, density=2.5, youngs_modulus_real=1.0e5)
     simulation = {"time_step": 1.0e-7, "end_time": 1.0e-6}
     thermal = {"contact_radius": "zhou2010"}
-    res = _cli("validate", _case(tmp_path, materials=glass, simulation=simulation,
+    res = cli("validate", _case(tmp_path, materials=glass, simulation=simulation,
                                  thermal=thermal))  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
     out = res.stdout + res.stderr
@@ -367,7 +361,7 @@ def test_material_values_in_another_unit_are_warned_about(tmp_path: Path) -> Non
         "warning: materials.glass.youngs_modulus_real: 100000 Pa is below youngs_modulus 1e+07 Pa",
     ):
         assert message in out
-    assert "materials.glass" not in _cli("validate", _case(tmp_path)).stdout
+    assert "materials.glass" not in cli("validate", _case(tmp_path)).stdout
 
 
 def test_thermal_settings_the_case_makes_unused_are_refused_or_told(tmp_path: Path) -> None:
@@ -380,12 +374,12 @@ def test_thermal_settings_the_case_makes_unused_are_refused_or_told(tmp_path: Pa
         ({"substeps": 3, "max_substeps": 10}, "thermal: max_substeps = 10 caps substeps: auto, "
          "but substeps is 3; allowed: substeps: auto, or leave max_substeps out"),
     ):  # fmt: skip
-        res = _cli("run", _case(tmp_path, thermal=thermal), "--output", tmp_path / "o")
+        res = cli("run", _case(tmp_path, thermal=thermal), "--output", tmp_path / "o")
         assert res.returncode == 2, res.stdout + res.stderr
         assert message in res.stderr
     auto = {"substeps": "auto", "max_substeps": 10}
-    assert _cli("validate", _case(tmp_path, thermal=auto)).returncode == 0
-    res = _cli("validate", _case(tmp_path, thermal={"fluid": {"temperature": 300.0}}))
+    assert cli("validate", _case(tmp_path, thermal=auto)).returncode == 0
+    res = cli("validate", _case(tmp_path, thermal={"fluid": {"temperature": 300.0}}))
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "warning: thermal.fluid is given but no selected model reads it (thermal.convection = "
@@ -399,7 +393,7 @@ def test_a_name_refused_where_a_number_fits_too_says_both(tmp_path: Path) -> Non
     as if only a name were allowed (a number r̄/R̄ > 0 is too)."""
     thermal = {"indirect_conduction": {"model": "batchelor_obrien_separated",
                                        "cylinder_radius": "dai2018"}}  # fmt: skip
-    res = _cli("validate", _case(tmp_path, thermal=thermal))
+    res = cli("validate", _case(tmp_path, thermal=thermal))
     assert res.returncode == 2, res.stdout + res.stderr
     assert (
         "thermal.indirect_conduction.cylinder_radius: should be a number or one of "
@@ -430,15 +424,15 @@ def test_etc_of_a_2d_case_measures_the_plane_and_refuses_ignored_options(tmp_pat
     }
     path = tmp_path / "disc.yaml"
     path.write_text(yaml.safe_dump(case))
-    res = _cli("etc", path, "--json")
+    res = cli("etc", path, "--json")
     assert res.returncode == 0, res.stdout + res.stderr
     assert [r["axis"] for r in json.loads(res.stdout)] == ["x", "y"]
-    res = _cli("etc", path, "--axes", "x", "--layer", "0.0048")  # one column in between
+    res = cli("etc", path, "--axes", "x", "--layer", "0.0048")  # one column in between
     assert res.returncode == 2, res.stdout + res.stderr
     assert "too thin for boundary layers of 0.0048 m" in res.stderr
-    res = _cli("etc", path, "--axes", "z")
+    res = cli("etc", path, "--axes", "z")
     assert res.returncode == 2 and "axes = 'z'; allowed: letters of 'xy'" in res.stderr
-    res = _cli("etc", path, "--periodic", "--layer", "0.001", "--temperature", "350")
+    res = cli("etc", path, "--periodic", "--layer", "0.001", "--temperature", "350")
     assert res.returncode == 2
     assert "--layer 0.001, --temperature 350.0: not used with --periodic" in res.stderr
 
@@ -447,11 +441,11 @@ def test_a_tessellation_that_nothing_reads_is_told(tmp_path: Path) -> None:
     """thermal.tessellation without a Voronoi model (the model switched, its settings kept)
     ran without a word, like the fluid and porosity sections before they were warned about."""
     path = _case(tmp_path, thermal={"tessellation": {"method": "radical", "every_steps": 5}})
-    res = _cli("validate", path)
+    res = cli("validate", path)
     assert res.returncode == 0, res.stdout + res.stderr
     assert "warning: thermal.tessellation is given but nothing tessellates" in res.stderr
     assert "thermal.indirect_conduction = 'none'" in res.stderr
-    res = _cli("validate", _case(tmp_path, "voronoi", thermal={
+    res = cli("validate", _case(tmp_path, "voronoi", thermal={
         "indirect_conduction": "voronoi_a", "tessellation": {"every_steps": 5}}))  # fmt: skip
     assert res.returncode == 0, res.stdout + res.stderr
     assert "nothing tessellates" not in res.stderr
@@ -505,7 +499,7 @@ def test_2d_region_selections_ignore_z(tmp_path: Path) -> None:
     }
     path = tmp_path / "disc.yaml"
     path.write_text(yaml.safe_dump(case))
-    res = _cli("run", path, "--output", tmp_path / "out")
+    res = cli("run", path, "--output", tmp_path / "out")
     assert res.returncode == 0, res.stdout + res.stderr
     ckpt = sorted((tmp_path / "out" / "checkpoints").glob("*.h5"))[-1]
     with h5py.File(ckpt) as f:
@@ -528,7 +522,7 @@ def test_a_heat_generation_mechanism_the_contact_laws_cannot_produce_is_told(
     listed = ["rolling_friction", "plastic_deformation", "normal_damping"]
     generation = {"model": "mechanical_dissipation", "mechanisms": listed}
     path = _case(tmp_path, thermal={"heat_generation": generation})
-    res = _cli("validate", path)
+    res = cli("validate", path)
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "warning: thermal.heat_generation.mechanisms: 'rolling_friction' gives zero heat with "
@@ -561,7 +555,7 @@ def test_a_porosity_cell_larger_than_the_domain_is_told(tmp_path: Path) -> None:
     radiative influence larger than the domain is refused: the broken-case corpus.)"""
     thermal = {"convection": "gunn1978", "fluid": {"temperature": 300.0},
                "porosity": {"kind": "cell", "cell_size": 0.5}}  # fmt: skip
-    res = _cli("validate", _case(tmp_path, thermal=thermal))
+    res = cli("validate", _case(tmp_path, thermal=thermal))
     assert res.returncode == 0, res.stdout + res.stderr
     assert (
         "warning: thermal.porosity.cell_size: 0.5 m is larger than the domain (edges 0.01, "

@@ -7,14 +7,11 @@ from __future__ import annotations
 
 import copy
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
 from run_cases import cli
-
-EXE = Path(sys.executable).with_name("thermodem")
 
 CASE = {
     "simulation": {"time_step": 1.0e-5, "end_time": 5.0e-5},
@@ -49,11 +46,8 @@ def _write(tmp_path: Path, name: str = "case.yaml", **sections) -> Path:  # noqa
     return path
 
 
-_cli = cli  # the command line in this process (run_cases.cli)
-
-
 def _run(case: Path, out: Path) -> subprocess.CompletedProcess:
-    return _cli("run", case, "--output", out, "--no-progress")
+    return cli("run", case, "--output", out, "--no-progress")
 
 
 def test_without_vtu_the_last_line_names_no_pvd(tmp_path: Path) -> None:
@@ -104,7 +98,7 @@ def test_a_warning_said_while_a_restart_is_built_reaches_run_log(tmp_path: Path)
         ),
         (("restart", out, "--end-time", 1.0e-4, "--no-progress"), out / "run.log"),
     ):
-        res = _cli(*args)
+        res = cli(*args)
         assert res.returncode == 0, res.stdout + res.stderr
         assert res.stdout.count(text) == 1, res.stdout
         assert text not in res.stderr, res.stderr
@@ -117,7 +111,7 @@ def test_the_warnings_before_a_refusal_are_told_with_it(tmp_path: Path) -> None:
     glass = {**CASE["materials"]["glass"], "density": 2.5}
     case = _write(tmp_path, materials={"glass": glass})
     warning = "warning: materials.glass.density: 2.5 kg/m³ is below 30 kg/m³"
-    res = _cli("validate", case)
+    res = cli("validate", case)
     assert res.returncode == 2, res.stdout + res.stderr
     assert res.stderr.count(warning) == 1, res.stderr
     assert res.stderr.index(warning) < res.stderr.index("error: time step refused")
@@ -138,20 +132,20 @@ def test_export_and_plot_of_a_run_without_heat_leave_the_heat_out(tmp_path: Path
     res = _run(_write(tmp_path), out)
     assert res.returncode == 0, res.stdout + res.stderr
     for args in (("--frame", "-1"), ()):
-        res = _cli("export", out, *args, "--out", "-")
+        res = cli("export", out, *args, "--out", "-")
         assert res.returncode == 0, res.stdout + res.stderr
         first, header, row = res.stdout.splitlines()[:3]
         assert "no thermal section: the run computed no temperature or heat rate" in first
         assert "temperature [K]" not in first
         assert header == "global_id,material,x,y,z,vx,vy,vz,radius"
         assert len(row.split(",")) == 9
-    res = _cli("plot", out)
+    res = cli("plot", out)
     assert res.returncode == 0, res.stdout + res.stderr
     assert sorted(Path(p).name for p in res.stdout.split()) == ["contacts.png", "energies.png"]
     # with heat: the columns are there
     heated = tmp_path / "heated"
     assert _run(_write(tmp_path, thermal={}), heated).returncode == 0
-    res = _cli("export", heated, "--out", "-")
+    res = cli("export", heated, "--out", "-")
     assert res.stdout.splitlines()[1].endswith(",radius,temperature,heat_rate")
 
 
@@ -206,7 +200,7 @@ def test_implausible_parameters_are_warned_about(
     selections that do nothing (radiation with every emissivity 0, heat generation with
     χ = 0) ran without a word."""
     materials = {"glass": {**CASE["materials"]["glass"], **glass}}
-    res = _cli("validate", _write(tmp_path, materials=materials, thermal=thermal))
+    res = cli("validate", _write(tmp_path, materials=materials, thermal=thermal))
     assert res.returncode == 0, res.stdout + res.stderr
     assert res.stderr.count(message) == 1, res.stderr
 
@@ -216,12 +210,12 @@ def test_plausible_parameters_and_a_fluid_at_rest_are_not_warned_about(tmp_path:
     natural-convection limit (Nu = 2), not a mistake."""
     materials = {"glass": {**CASE["materials"]["glass"], **SURFACE, "emissivity": 0.9}}
     thermal = {**NETWORK, **RADIATION, "heat_generation": {"model": "rojek2014"}}
-    res = _cli("validate", _write(tmp_path, materials=materials, thermal=thermal))
+    res = cli("validate", _write(tmp_path, materials=materials, thermal=thermal))
     assert res.returncode == 0, res.stdout + res.stderr
     for key in ("surface_slope", "microhardness", "emissivity", "conversion_fraction"):
         assert key not in res.stderr, res.stderr
     still = {"convection": "ranz_marshall1952",
              "fluid": {"temperature": 300.0, "velocity": [0.0, 0.0, 0.0]}}  # fmt: skip
-    res = _cli("validate", _write(tmp_path, thermal=still))
+    res = cli("validate", _write(tmp_path, thermal=still))
     assert res.returncode == 0, res.stdout + res.stderr
     assert "velocity" not in res.stderr, res.stderr

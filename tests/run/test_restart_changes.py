@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import copy
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,9 +15,6 @@ from run_cases import cli
 
 from thermodem.io.checkpoint import read_checkpoint
 from thermodem.io.run_files import read_timeseries
-
-BIN = Path(sys.executable).parent
-THERMODEM = BIN / "thermodem"
 
 R = 0.001  # [m]
 GLASS = {"density": 2500.0, "youngs_modulus": 1.0e7, "poisson_ratio": 0.3,
