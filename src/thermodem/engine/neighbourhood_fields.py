@@ -161,19 +161,6 @@ class NeighbourhoodFields:
         nh.member_constants(*self.members, area, member_area, member_count)
         self.member_sums = (area, emission, member_area, member_count)
 
-    # ---------------------------------------------------------------- several ranks
-    def _largest_radius(self) -> float:
-        """R_max of the whole simulation (on several MPI ranks a reduction: every rank must
-        make the same cells)."""
-        p = self.sim.particles
-        local = float(p.radius.max()) if p.count else 0.0
-        comm = self.sim.comm
-        if comm is None:
-            return local
-        from thermodem.mpi.exchange import allreduce_max
-
-        return float(allreduce_max(comm, np.array([local]))[0])
-
     def default_cell_size(self, r_max: float) -> float:
         """Edge asked for the porosity cells: ``cell_size``, else 6 R_max [m]."""
         return float(self.porosity.cell_size or 6.0 * r_max)
@@ -212,7 +199,8 @@ class NeighbourhoodFields:
         sim = self.sim
         p = sim.particles
         if self.cell_fluid.shape[0] == 0:
-            self._cell_grid(self.default_cell_size(self._largest_radius()))
+            # (R_max of every rank: each rank must make the same cells)
+            self._cell_grid(self.default_cell_size(sim.radius_max()))
         geometry = np.concatenate([sim.wall_rows[:, :6], sim.wall_rows[:, 9:15]], axis=1)
         if self._cell_walls.shape != geometry.shape or not np.array_equal(
             self._cell_walls, geometry
