@@ -434,9 +434,10 @@ class ListInsertion(_EntryBase):
 
     @field_validator("positions", "velocities", mode="before")
     @classmethod
-    def _one_flat_vector(cls, value: Any) -> Any:
-        """``positions: [x, y, z]`` (one particle written without its outer brackets) gave
-        one message per number; one message, with the list it meant."""
+    def _flat_numbers(cls, value: Any) -> Any:
+        """A flat list of numbers where vectors are expected (``positions: [x, y, z]``, one
+        particle without its outer brackets, or several particles in one list) gave one
+        message per number; one message, with the vectors it meant."""
         numbers = (
             isinstance(value, list)
             and len(value) >= 2
