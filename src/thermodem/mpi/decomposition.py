@@ -23,6 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from thermodem.kernels.halo import owner_ranks
+
 MAX_ITERATIONS = 60
 
 
@@ -49,18 +51,11 @@ class Decomposition:
         n = position.shape[0]
         if self.axis.shape[0] == 0:  # one rank
             return np.zeros(n, np.int64)
-        node = np.zeros(n, np.int64)
-        done = np.zeros(n, np.bool_)
-        rank = np.zeros(n, np.int64)
-        while not done.all():
-            todo = np.nonzero(~done)[0]
-            k = node[todo]
-            x = position[todo, self.axis[k]]
-            child = np.where(x >= self.cut[k], self.right[k], self.left[k])
-            leaf = child < 0
-            rank[todo[leaf]] = -child[leaf] - 1
-            done[todo[leaf]] = True
-            node[todo[~leaf]] = child[~leaf]
+        rank = np.empty(n, np.int64)
+        owner_ranks(np.ascontiguousarray(position), np.ascontiguousarray(self.axis, np.int64),
+                    np.ascontiguousarray(self.cut, np.float64),
+                    np.ascontiguousarray(self.left, np.int64),
+                    np.ascontiguousarray(self.right, np.int64), rank)  # fmt: skip
         return rank
 
     def rotated(self, shift: int) -> Decomposition:

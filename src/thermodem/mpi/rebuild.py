@@ -184,14 +184,21 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
         sent, _ = X.alltoallv_rows(comm, _split(dest[owner[go]], recs[go], size), rec_width)
         if go.any() or sent.shape[0]:  # (else the records stay as they are: no copy)
             recs = np.concatenate([recs[~go], sent])
-        moved_records.append(recs)
-    records, wall_records = moved_records
+        moved_records.append((recs, owner[~go], sent))
+    (records, rec_owner, rec_arrived), (wall_records, _, _) = moved_records
     if leaving.shape[0] or arrived.count:  # (else the owned particles stay as they are)
         staying = np.nonzero(~leave)[0]
         owned = X.concatenate_particles([X.take_particles(owned, staying), arrived])
         extra_own = [
             np.concatenate([e[staying], a]) for e, a in zip(extra_own, extra_arrived, strict=True)
         ]
+        # the owner of every particle record, in the new owned numbering: a staying
+        # particle's rank among the staying ones, an arrived record's particle by its id
+        new_index = np.cumsum(~leave) - 1
+        at = _positions_of(arrived.global_id, rec_arrived[:, 0].astype(np.int64))
+        if at.shape[0] and at.min() < 0:
+            raise AssertionError("an arrived history record without its particle")
+        rec_owner = np.concatenate([new_index[rec_owner], staying.shape[0] + at])
     # 5. this rank's grid; the owned particles sorted by its cells
     h = halo_width(sim, r_max)
     sim.halo_width = h
@@ -217,7 +224,9 @@ def rebuild_distributed(sim: DistributedSimulation) -> None:
     sorted_position = owned.position[order]
     # 6. ghosts with their records
     neighbours = neighbour_ranks(sim, h)
-    rec_owner = _positions_of(owned.global_id[order], records[:, 0].astype(np.int64))
+    sorted_index = np.empty(own, np.int64)  # owned index -> sorted index
+    sorted_index[order] = np.arange(own)
+    rec_owner = sorted_index[rec_owner]
     ghost_blocks = [np.zeros((0, width)) for _ in range(size)]
     record_blocks = [np.zeros((0, rec_width)) for _ in range(size)]
     send = []

@@ -48,6 +48,7 @@ from thermodem.geometry import wall_layout as WL
 from thermodem.geometry.insertion import InsertedParticles
 from thermodem.kernels import contact as C
 from thermodem.kernels import pair_pass as PP
+from thermodem.kernels.halo import near_box
 from thermodem.kernels.integrate import (
     CHECK_CHUNK,
     advance_walls,
@@ -57,7 +58,7 @@ from thermodem.kernels.integrate import (
     reset_forces,
 )
 from thermodem.mpi import exchange as X
-from thermodem.mpi.decomposition import box_distance, point_box_distance
+from thermodem.mpi.decomposition import box_distance
 from thermodem.mpi.support import check_case, check_thermal
 from thermodem.state.pairs import PairBuffers
 from thermodem.state.particles import Particles
@@ -512,8 +513,11 @@ def halo_members(
 ) -> np.ndarray:
     """Indices of ``position`` within ``width`` of the box of ``rank``."""
     box = sim.decomposition.boxes[rank]
-    d = point_box_distance(position, box[0], box[1], sim.upper - sim.lower, sim.periodic)
-    return np.nonzero(d < width)[0]
+    out = np.empty(position.shape[0], np.int64)
+    lower, upper = np.ascontiguousarray(box[0]), np.ascontiguousarray(box[1])
+    length = sim.upper - sim.lower
+    m = near_box(np.ascontiguousarray(position), lower, upper, length, sim.periodic, width, out)
+    return out[:m]
 
 
 def halo_width(sim: DistributedSimulation, r_max: float) -> float:
