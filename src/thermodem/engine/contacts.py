@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from thermodem.geometry import wall_layout as wall_cols
-from thermodem.kernels import contact_output, heat_terms
+from thermodem.kernels import contact_output, heat_terms, range_pass
 from thermodem.kernels import thermal as thermal_kernels
 from thermodem.kernels.contact import STATE_TOUCHING
 from thermodem.models import registry
@@ -130,9 +130,10 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
         k_i, k_j = term.k_columns if th.override else (-1, -1)
         scratch = th._term_rows(rows_needed)
         if term.target == "range":
-            range_pair_pass, range_wall_pass = heat_terms.range_passes_for(
-                term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0
-            )
+            range_pair_pass, range_wall_pass = range_pass.range_passes_for(
+                term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0,
+                term.table.shape[2],
+            )  # fmt: skip
             range_pair_pass(
                 p.position, p.radius, p.temperature, p.type_id, pb.i, pb.j, pb.group_start,
                 sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table,

@@ -17,6 +17,7 @@ from thermodem.engine.voronoi import INPUT_WIDTH, VoronoiProvider
 from thermodem.errors import ConfigError
 from thermodem.kernels import fields as field_kernels
 from thermodem.kernels import heat_terms as passes
+from thermodem.kernels import range_pass
 
 
 class TermEvaluation:
@@ -259,9 +260,10 @@ class TermEvaluation:
         k_i, k_j = term.k_columns if self.override else (-1, -1)
         rows = max(rs.ngroups, p.count // passes.WALL_CHUNK + 1)
         scratch = self._term_rows(rows)
-        range_pair_pass, range_wall_pass = passes.range_passes_for(
-            term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0
-        )
+        range_pair_pass, range_wall_pass = range_pass.range_passes_for(
+            term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0,
+            term.table.shape[2],
+        )  # fmt: skip
         range_pair_pass(
             p.position, p.radius, p.temperature, p.type_id, rs.i, rs.j, rs.group_start,
             sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table, k_i,

@@ -2,18 +2,15 @@
 
 Every pass evaluates one term on one pair set and **adds** the heat rate into its particles'
 mechanism column and the conductance into ``conductance_sum`` (the explicit stability limit).
-The range passes are compiled per model (the model a compile-time constant: the hot gap
-terms pay no model switch, and a variant compiles ~1 s); the other passes select the model
+The range passes are compiled per model (``kernels/range_pass.py``: the model a compile-time
+constant, so the hot gap terms pay no model switch); the passes here select the model
 at run time by its evaluator and model id through an integer switch (one compiled kernel per
 pass kind serves every model). Either way the compiled variants grow with the models
 selected, not with their combinations.
 
-- ``range_pair_pass`` (:func:`range_passes_for`): pairs of the range set (surface gap within
-  the term's interaction range, touching pairs included), run by slab groups like the
-  contact pass (even groups in parallel, then odd ones; :mod:`thermodem.kernels.slabs`):
-  race-free, and each particle receives its contributions in an order fixed by the list,
-  whatever the thread count;
-- ``range_wall_pass`` (the same): particle-wall pairs of the range set (fixed-temperature walls);
+- ``range_pair_pass``, ``range_wall_pass``: pairs and particle-wall pairs of the range set
+  (surface gap within the term's interaction range, touching pairs included), compiled per
+  model: :mod:`thermodem.kernels.range_pass`;
 - :func:`contact_term_pair_pass`, :func:`contact_term_wall_pass`: touching pairs of the
   contact lists (terms that need the contact radius model and the normal force);
 - :func:`external_pair_pass` and :func:`csr_heat`: pairs of an external pair set (not
@@ -92,108 +89,6 @@ def _row(table_row, k_col_i, k_col_j, k_i, k_j, scratch_row):
     scratch_row[k_col_i] = k_i
     scratch_row[k_col_j] = k_j
     return scratch_row
-
-
-_RANGE_PASSES: dict[tuple, tuple] = {}
-
-
-def range_passes_for(evaluator: int, model_id: int, need_rc: bool, override: bool) -> tuple:
-    """(pair pass, wall pass) of one range term: the evaluator, the model id, whether the
-    kernel reads the geometric contact radius and whether the k(T) override replaces row
-    columns are compile-time constants, so each pass holds one model's code (no run-time
-    model switch; one variant per selected range model: the variants grow with the models
-    selected, not with their combinations). The passes keep the generic argument list; the
-    evaluator, model and ``need_rc`` arguments passed in are ignored, and without
-    ``override`` so are ``k_col_i``/``k_col_j``."""
-    key = (int(evaluator), int(model_id), bool(need_rc), bool(override))
-    if key not in _RANGE_PASSES:
-        _RANGE_PASSES[key] = _compile_range_passes(*key)
-    return _RANGE_PASSES[key]
-
-
-def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE: bool):  # noqa: ANN202, N803
-    """Define the range passes of one term (see :func:`range_passes_for`)."""
-
-    @parallel_kernel(error_model="numpy")
-    def range_pair_pass(
-        position, radius, temperature, type_id, pair_i, pair_j, group_start, lower, upper,
-        periodic, evaluator, model_id, table, k_col_i, k_col_j, k_particle, scratch, column,
-        by_mechanism, conductance_sum, store, out_conductance, need_rc,
-    ):  # fmt: skip
-        """One pair term over the range pair set (slab groups; ``scratch``: a row per group).
-        The heat of a pair out of range (H = 0) is added as zeros, without a branch: in a
-        bed pairs in and out of range alternate at random."""
-        evaluator = EVALUATOR
-        model_id = MODEL_ID
-        if not OVERRIDE:
-            k_col_i = -1
-        length = upper - lower
-        ngroups = group_start.shape[0] - 1
-        for parity in range(2):
-            for half in prange((ngroups + 1 - parity) // 2):
-                g = 2 * half + parity
-                srow = scratch[g]
-                for k in range(group_start[g], group_start[g + 1]):
-                    i = pair_i[k]
-                    j = pair_j[k]
-                    dist = pair_separation(position, i, j, length, periodic)[3]
-                    ri = radius[i]
-                    rj = radius[j]
-                    r_c = geometric_contact_radius(ri, rj, ri + rj - dist) if NEED_RC else 0.0
-                    ki = kj = 0.0
-                    if OVERRIDE and k_col_i >= 0:
-                        ki = k_particle[i]
-                        kj = k_particle[j]
-                    p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
-                    h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
-                    if store:
-                        out_conductance[k] = h
-                    q = h * (temperature[j] - temperature[i])
-                    by_mechanism[column, i] += q
-                    by_mechanism[column, j] -= q
-                    conductance_sum[i] += h
-                    conductance_sum[j] += h
-
-    @parallel_kernel(error_model="numpy")
-    def range_wall_pass(
-        position, radius, temperature, type_id, wall_pair_w, wall_row_start, wall_kind,
-        wall_rows, wall_material, evaluator, model_id, table, k_col_i, k_col_j, k_particle,
-        k_wall, scratch, column, by_mechanism, conductance_sum, store, out_conductance, need_rc,
-    ):  # fmt: skip
-        """One pair term over the particle-wall pairs of the range set (``wall_row_start``:
-        the wall pairs of each particle); adiabatic walls give nothing."""
-        evaluator = EVALUATOR
-        model_id = MODEL_ID
-        if not OVERRIDE:
-            k_col_i = -1
-        n = radius.shape[0]
-        nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
-        for c in prange(nchunks):
-            srow = scratch[c]
-            for i in range(c * WALL_CHUNK, min(n, (c + 1) * WALL_CHUNK)):
-                for k in range(wall_row_start[i], wall_row_start[i + 1]):
-                    w = wall_pair_w[k]
-                    wrow = wall_rows[w]
-                    h = 0.0
-                    if wrow[COL_THERMAL_KIND] != 0.0:
-                        d = wall_distance(wall_kind[w], wrow, position[i])[0]
-                        ri = radius[i]
-                        r_c = geometric_contact_radius(ri, math.inf, ri - d) if NEED_RC else 0.0
-                        ki = kw = 0.0
-                        if OVERRIDE and k_col_i >= 0:
-                            ki = k_particle[i]
-                            kw = k_wall[w]
-                        p = _row(
-                            table[type_id[i], wall_material[w]], k_col_i, k_col_j, ki, kw, srow
-                        )
-                        h = term_conductance(evaluator, model_id, p, ri, math.inf, d, r_c, 0.0)
-                    if store:
-                        out_conductance[k] = h
-                    if h != 0.0:
-                        by_mechanism[column, i] += h * (wrow[COL_TEMPERATURE] - temperature[i])
-                        conductance_sum[i] += h
-
-    return range_pair_pass, range_wall_pass
 
 
 @parallel_kernel(error_model="numpy")

@@ -52,6 +52,7 @@ from thermodem.models.thermal.surrounding_layer import (
     RONG_HORIO1999,
     musser2011_conductance,
     rong_horio1999_conductance,
+    rong_horio1999_spheres,
 )
 from thermodem.models.thermal.vargas_mccarthy import (
     VARGAS_MCCARTHY2002,
@@ -180,6 +181,16 @@ def indirect_conduction_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n):
     elif model_id == NONE:
         return 0.0
     return np.nan
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def indirect_sphere_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n):
+    """:func:`indirect_conduction_dispatch` for two spheres (``r_j`` finite; the range pair
+    pass): a model with a branch-free sphere form is called without its wall branch, so that
+    the pass's conductance loop vectorises (``kernels/range_pass.py``); others: their kernel."""
+    if model_id == RONG_HORIO1999:
+        return rong_horio1999_spheres(p, r_i, r_j, dist, r_c, f_n)
+    return indirect_conduction_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n)
 
 
 # --------------------------------------------------------------------------- registration

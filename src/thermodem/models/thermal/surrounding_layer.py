@@ -40,6 +40,7 @@ from numba import njit
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
+from thermodem.kernels.fastmath_log import fast_log
 from thermodem.models.registry import register
 from thermodem.state.materials import PairContext
 
@@ -266,21 +267,40 @@ def rong_horio1999_conductance(p, r_i, r_j, dist, r_c, f_n):
     """H = k_f ∫_{θ1}^{θ2} 2π R_p² sinθ cosθ / max(S, d - 2R_p cosθ) dθ
     [+ k_f π (R_p sin θ1)²/S touching, with ``contact_term``] (Rong & Horio 1999; spec).
 
+    Two spheres: :func:`rong_horio1999_spheres`; a wall (``r_j`` = inf): the spec's analytic
+    particle-wall solution (:func:`rong_horio_wall_factor`).
+    """
+    if math.isinf(r_j):
+        layer = p[SL_LAYER] * r_i
+        return p[SL_K_F] * rong_horio_wall_factor(r_i, dist, layer, p[SL_MIN_GAP],
+                                                  p[RH_CONTACT_TERM])  # fmt: skip
+    return rong_horio1999_spheres(p, r_i, r_j, dist, r_c, f_n)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def rong_horio1999_spheres(p, r_i, r_j, dist, r_c, f_n):
+    """:func:`rong_horio1999_conductance` of two spheres (``r_j`` finite).
+
     R_p = (R_i + R_j)/2, δ_f = ratio × R_p; θ1 = 0 separated, the spec's max(acos(d/2R_p),
     acos(1 - S/2R_p)) touching; θ2 = acos((d² + R_p² - (R_p + δ_f)²)/(2R_p d)) <= π/2. In the
     path length y = d - 2R_p cosθ: y1 = gap (separated) or max(0, gap + S) (touching),
     y2 = ((R_p + δ_f)² - R_p²)/d; the part with y < S is an annulus at k_f/S, the rest
     (π/2)[d ln(y2/y_a) - (y2 - y_a)], y_a = max(y1, S).
+
+    Branch-free (selects only) and with the compiled logarithm of ``kernels/fastmath_log.py``
+    (within 1 ulp of ``math.log``), so that the range pass's conductance loop vectorises
+    (``kernels/range_pass.py``, which calls this form for its sphere pairs).
     """
+    # the row read first: the array view then dies in the first block, and Numba's
+    # reference-count pruning drops its incref/decref, a call that keeps a loop scalar
     k_f = p[SL_K_F]
     s_min = p[SL_MIN_GAP]
-    if math.isinf(r_j):
-        layer = p[SL_LAYER] * r_i
-        return k_f * rong_horio_wall_factor(r_i, dist, layer, s_min, p[RH_CONTACT_TERM])
+    ratio = p[SL_LAYER]
+    contact_term = p[RH_CONTACT_TERM] != 0.0
     r_sum = r_i + r_j
     r_p = 0.5 * r_sum
     gap = dist - r_sum
-    layer = p[SL_LAYER] * r_p
+    layer = ratio * r_p
     # written without data-dependent branches (selects only): in a bed, touching and
     # separated pairs alternate at random and mispredicted branches cost more than the
     # arithmetic (the 50k bed's range pairs, both forms in one process: 37 -> 26 ns per pair
@@ -296,11 +316,10 @@ def rong_horio1999_conductance(p, r_i, r_j, dist, r_c, f_n):
     h = math.pi * max(y_lo - y1, 0.0) * (2.0 * dist - y1 - y_lo) / (4.0 * s_min)
     y_a = max(y1, s_min)
     y_b = max(y2, y_a)
-    h += 0.5 * math.pi * (dist * math.log(y_b / y_a) - (y_b - y_a))
-    if p[RH_CONTACT_TERM] != 0.0:
-        # π (R_p sin θ1)²/S for touching pairs, (R_p sin θ1)² = R_p² - (d - y1)²/4
-        contact = math.pi * (y1 - gap) * (r_sum + dist - y1) / (4.0 * s_min)
-        h += contact if touching else 0.0
+    h += 0.5 * math.pi * (dist * fast_log(y_b / y_a) - (y_b - y_a))
+    # π (R_p sin θ1)²/S for touching pairs, (R_p sin θ1)² = R_p² - (d - y1)²/4
+    contact = math.pi * (y1 - gap) * (r_sum + dist - y1) / (4.0 * s_min)
+    h += contact if touching & contact_term else 0.0
     h = h if inside else 0.0
     return k_f * h
 
