@@ -4,7 +4,7 @@
 does not touch; the parallel passes that call them for every listed pair are in
 :mod:`thermodem.kernels.pair_pass`. This module also holds the column layout of the per-chunk
 ledger, the pair states, and the deposit of a contact's dissipated energy into its particles'
-heat generation accumulators (:func:`deposit_pair`, :func:`deposit_wall`).
+heat generation accumulators (:func:`deposits`, :func:`deposit_pair`, :func:`deposit_wall`).
 
 Sign conventions: n is the unit vector from i to j; the relative velocity of i with respect to j
 at the contact point is v_rel = (v_i + ω_i × R_i n) - (v_j - ω_j × R_j n); the overlap rate is
@@ -254,11 +254,30 @@ def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, led
 
 # ------------------------------------------------------------------- heat generation deposits
 @njit(cache=True, inline="always", error_model="numpy")
+def deposits(select, generation, rolls, plastic):
+    """Which deposits a pass makes, read once per pass: (sliding friction, rolling friction,
+    normal damping, tangential damping, plastic deformation), each selected (``select[g]``
+    != 0) and, for the rolling and plastic ones, possible with the pass's mechanics
+    (``rolls``: a rolling law; ``plastic``: the elasto-plastic normal law); none without
+    ``generation``. The passes give the last three as compile-time constants, so the
+    deposits of what is always zero (adding 0 changes no sum) are not compiled; and the
+    selection is read once, not at every deposit (the compiler cannot keep it in a register
+    across the stores into the accumulators, which might alias it)."""
+    return (
+        generation and select[G_SLIDING_FRICTION] != 0.0,
+        generation and rolls and select[G_ROLLING_FRICTION] != 0.0,
+        generation and select[G_NORMAL_DAMPING] != 0.0,
+        generation and select[G_TANGENTIAL_DAMPING] != 0.0,
+        generation and plastic and select[G_PLASTIC_DEFORMATION] != 0.0,
+    )
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def deposit_pair(
-    energy, i, j, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
+    energy, i, j, use, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
 ):
     """Add a particle pair's dissipated energies of one step [J] to the two particles'
-    accumulators of the selected mechanisms (``select[g]`` != 0): ψ e to i, the rest to j
+    accumulators of the mechanisms ``use`` (:func:`deposits`): ψ e to i, the rest to j
     (``psi_*``: i's share of the friction heat and of the other heat, the heat generation
     row's partition; models/thermal/heat_generation.py)."""
     s_ndamp = psi_other * e_ndamp
@@ -266,25 +285,25 @@ def deposit_pair(
     s_slip = psi_friction * e_slip
     s_roll = psi_friction * e_roll
     s_plastic = psi_other * e_plastic
-    deposit_particle(energy, i, select, s_ndamp, s_tdamp, s_slip, s_roll, s_plastic)
-    deposit_particle(energy, j, select, e_ndamp - s_ndamp, e_tdamp - s_tdamp, e_slip - s_slip,
+    deposit_particle(energy, i, use, s_ndamp, s_tdamp, s_slip, s_roll, s_plastic)
+    deposit_particle(energy, j, use, e_ndamp - s_ndamp, e_tdamp - s_tdamp, e_slip - s_slip,
                      e_roll - s_roll, e_plastic - s_plastic)  # fmt: skip
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def deposit_particle(energy, i, select, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
-    """Add one particle's shares of dissipated energy [J] to its accumulators of the selected
-    mechanisms (the particle pair pass: j's share of each pair at once, i's shares summed
-    over its run of pairs in the list and added when i changes)."""
-    if select[G_SLIDING_FRICTION] != 0.0:
+def deposit_particle(energy, i, use, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
+    """Add one particle's shares of dissipated energy [J] to its accumulators of the
+    mechanisms ``use`` (:func:`deposits`; the particle pair pass: j's share of each pair at
+    once, i's shares summed over its run of pairs in the list and added when i changes)."""
+    if use[0]:
         energy[i, G_SLIDING_FRICTION] += e_slip
-    if select[G_ROLLING_FRICTION] != 0.0:
+    if use[1]:
         energy[i, G_ROLLING_FRICTION] += e_roll
-    if select[G_NORMAL_DAMPING] != 0.0:
+    if use[2]:
         energy[i, G_NORMAL_DAMPING] += e_ndamp
-    if select[G_TANGENTIAL_DAMPING] != 0.0:
+    if use[3]:
         energy[i, G_TANGENTIAL_DAMPING] += e_tdamp
-    if select[G_PLASTIC_DEFORMATION] != 0.0:
+    if use[4]:
         energy[i, G_PLASTIC_DEFORMATION] += e_plastic
 
 
@@ -297,20 +316,20 @@ def _deposit_wall(energy, i, g, e, psi, ledger_row):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def deposit_wall(
-    energy, i, select, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic,
+    energy, i, use, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic,
     ledger_row,
 ):  # fmt: skip
     """The same for a particle-wall pair: the particle's share into its accumulators, the
     wall's share into the ledger row (``psi_*`` = 1 for an adiabatic wall)."""
-    if select[G_SLIDING_FRICTION] != 0.0:
+    if use[0]:
         _deposit_wall(energy, i, G_SLIDING_FRICTION, e_slip, psi_friction, ledger_row)
-    if select[G_ROLLING_FRICTION] != 0.0:
+    if use[1]:
         _deposit_wall(energy, i, G_ROLLING_FRICTION, e_roll, psi_friction, ledger_row)
-    if select[G_NORMAL_DAMPING] != 0.0:
+    if use[2]:
         _deposit_wall(energy, i, G_NORMAL_DAMPING, e_ndamp, psi_other, ledger_row)
-    if select[G_TANGENTIAL_DAMPING] != 0.0:
+    if use[3]:
         _deposit_wall(energy, i, G_TANGENTIAL_DAMPING, e_tdamp, psi_other, ledger_row)
-    if select[G_PLASTIC_DEFORMATION] != 0.0:
+    if use[4]:
         _deposit_wall(energy, i, G_PLASTIC_DEFORMATION, e_plastic, psi_other, ledger_row)
 
 

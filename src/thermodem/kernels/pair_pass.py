@@ -44,6 +44,7 @@ from thermodem.kernels.contact import (
     deposit_pair,
     deposit_particle,
     deposit_wall,
+    deposits,
     kinetic_energy,
 )
 from thermodem.kernels.contact_conduction import _pp_conductance, reusable
@@ -56,6 +57,15 @@ WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per ch
 
 
 _PASSES: dict[tuple, tuple] = {}
+
+
+def dissipates(mechanics: tuple[int, ...], layout: tuple[int, ...]) -> tuple[bool, bool]:
+    """(rolling friction, plastic deformation): whether the mechanics combination can
+    dissipate by them, a compile-time constant of the passes (:func:`thermodem.kernels.contact.
+    deposits`): a rolling law (id != 0; without one the rolling terms are zero) and the
+    elasto-plastic normal law, the one law that keeps a normal history column
+    (models/mechanics/normal.py: the elastic laws return a plastic energy of 0)."""
+    return int(mechanics[2]) != 0, int(layout[HL.NORMAL]) >= 0
 
 
 def passes_for(
@@ -114,6 +124,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
     H_COLLISION = LAYOUT[HL.COLLISION] if GENERATION else -1  # noqa: N806
     H_REUSE = LAYOUT[HL.REUSE]  # noqa: N806
     REUSABLE = REUSABLE and H_REUSE >= 0  # noqa: N806
+    ROLLS, PLASTIC = dissipates(MECHANICS, LAYOUT)  # noqa: N806
 
     @parallel_kernel(error_model="numpy")
     def particle_pair_pass(
@@ -191,6 +202,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
             tolerance = 0.0  # (the reuse's code is dropped)
         length = upper - lower
         ngroups = group_start.shape[0] - 1
+        use = deposits(gen_select, GENERATION, ROLLS, PLASTIC)  # (see contact.deposits)
         for parity in range(2):
             for half in prange((ngroups + 1 - parity) // 2):
                 g = 2 * half + parity
@@ -207,8 +219,8 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     j = pair_j[k]
                     if GENERATION and i != owner:
                         if owner >= 0:
-                            deposit_particle(gen_energy, owner, gen_select, a_ndamp, a_tdamp,
-                                             a_slip, a_roll, a_plastic)  # fmt: skip
+                            deposit_particle(gen_energy, owner, use, a_ndamp, a_tdamp, a_slip,
+                                             a_roll, a_plastic)  # fmt: skip
                         owner = i
                         a_ndamp = a_tdamp = a_slip = a_roll = a_plastic = 0.0
                     dx, dy, dz, dist = pair_separation(position, i, j, length, periodic)
@@ -236,7 +248,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             ti = type_id[i]
                             tj = type_id[j]
                             deposit_pair(
-                                gen_energy, i, j, gen_select, gen_partition[ti, tj, 0],
+                                gen_energy, i, j, use, gen_partition[ti, tj, 0],
                                 gen_partition[ti, tj, 1], 0.0, 0.0, e_spring, e_rspring, 0.0,
                             )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
@@ -328,7 +340,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             a_roll += s_roll
                             a_plastic += s_plastic
                             deposit_particle(
-                                gen_energy, j, gen_select, e_ndamp - s_ndamp, e_tdamp - s_tdamp,
+                                gen_energy, j, use, e_ndamp - s_ndamp, e_tdamp - s_tdamp,
                                 e_slip - s_slip, e_roll - s_roll, e_plastic - s_plastic,
                             )  # fmt: skip
                         # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
@@ -369,7 +381,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                         conductance_sum[i] += h
                         conductance_sum[j] += h
                 if GENERATION and owner >= 0:
-                    deposit_particle(gen_energy, owner, gen_select, a_ndamp, a_tdamp, a_slip,
+                    deposit_particle(gen_energy, owner, use, a_ndamp, a_tdamp, a_slip,
                                      a_roll, a_plastic)  # fmt: skip
 
     return particle_pair_pass
@@ -396,6 +408,7 @@ def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tup
     H_SPRING = LAYOUT[HL.SPRING]  # noqa: N806
     H_ROLL = LAYOUT[HL.ROLL]  # noqa: N806
     H_COLLISION = LAYOUT[HL.COLLISION] if GENERATION else -1  # noqa: N806
+    ROLLS, PLASTIC = dissipates(MECHANICS, LAYOUT)  # noqa: N806
 
     @parallel_kernel(error_model="numpy")
     def wall_pair_pass(
@@ -454,6 +467,7 @@ def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tup
         h_collision = H_COLLISION
         n = radius.shape[0]
         nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
+        use = deposits(gen_select, GENERATION, ROLLS, PLASTIC)  # (see contact.deposits)
         for c in prange(nchunks):
             row = chunk_ledger[c]
             for q in range(row.shape[0]):
@@ -485,8 +499,8 @@ def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tup
                     )
                     if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
                         deposit_wall(
-                            gen_energy, i, gen_select, psi_f, psi_o, 0.0, 0.0, e_spring, e_rspring,
-                            0.0, row,
+                            gen_energy, i, use, psi_f, psi_o, 0.0, 0.0, e_spring, e_rspring, 0.0,
+                            row,
                         )  # fmt: skip
                     out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                 else:
@@ -552,8 +566,8 @@ def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tup
                      e_plastic) = out  # fmt: skip
                     if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
                         deposit_wall(
-                            gen_energy, i, gen_select, psi_f, psi_o, e_ndamp, e_tdamp, e_slip,
-                            e_roll, e_plastic, row,
+                            gen_energy, i, use, psi_f, psi_o, e_ndamp, e_tdamp, e_slip, e_roll,
+                            e_plastic, row,
                         )  # fmt: skip
                     # work done by the wall on the particle this step
                     fx = -f_n * nx + ftx
