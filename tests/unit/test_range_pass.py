@@ -1,5 +1,5 @@
-"""The range pair pass (kernels/range_pass.py: gather, conductance and scatter loops per
-chunk of pairs) against a plain loop in pair order over the same pairs with the kernel
+"""The range pair pass (kernels/range_pass.py), in chunks (gather, conductance and scatter
+loops) and fused, against a plain loop in pair order over the same pairs with the kernel
 called pair by pair (heat_terms.term_conductance): the same conductances, heat rates and
 conductance sums bit for bit, with one parameter row for all pairs, with several rows, and
 with the k(T) override replacing row columns; 1 and 2 threads."""
@@ -11,7 +11,7 @@ import pytest
 
 from thermodem.engine.threads import apply_threads
 from thermodem.kernels.heat_terms import EVAL_INDIRECT, term_conductance
-from thermodem.kernels.range_pass import CHUNK, range_passes_for
+from thermodem.kernels.range_pass import CHUNK, _compile_range_passes, range_passes_for
 from thermodem.models import registry
 from thermodem.state.gas import GasProperties
 from thermodem.state.materials import Material, resolve_pair
@@ -88,9 +88,28 @@ CASES = {
 }  # fmt: skip
 
 
-@pytest.mark.parametrize("threads", [1, 2])
-@pytest.mark.parametrize("case", list(CASES))
-def test_range_pass_equals_the_kernel_pair_by_pair(case: str, threads: int) -> None:
+_PASSES: dict[tuple, object] = {}
+
+
+def _chunked(model: str, width: int) -> bool:
+    """Whether the range pair pass of ``model`` runs in chunks (its CHUNKED constant)."""
+    f = range_passes_for(EVAL_INDIRECT, registry.get("indirect_conduction", model).model_id,
+                         False, False, width)[0].py_func  # fmt: skip
+    return f.__closure__[f.__code__.co_freevars.index("CHUNKED")].cell_contents
+
+
+def test_rong_horio_runs_in_chunks_the_others_fused() -> None:
+    assert _chunked("rong_horio1999", 4)
+    assert not _chunked("musser2011", 3)
+    assert not _chunked("batchelor_obrien_separated", 6)
+
+
+@pytest.mark.parametrize(
+    ("case", "chunked", "threads"),
+    [(case, chunked, 1) for case in CASES for chunked in (False, True)]
+    + [("rong_two_rows", True, 2), ("bob_override", True, 2)],
+)
+def test_range_pass_equals_the_kernel_pair_by_pair(case: str, chunked: bool, threads: int) -> None:
     model, conductivities, params = CASES[case]
     spec = registry.get("indirect_conduction", model)
     table = _table(model, conductivities, params)
@@ -104,8 +123,10 @@ def test_range_pass_equals_the_kernel_pair_by_pair(case: str, threads: int) -> N
     heat = np.zeros((3, radius.shape[0]))
     sums = np.zeros(radius.shape[0])
     out = np.zeros(pi.shape[0])
-    pair_pass = range_passes_for(EVAL_INDIRECT, spec.model_id, False, override,
-                                 table.shape[2])[0]  # fmt: skip
+    key = (EVAL_INDIRECT, spec.model_id, False, override, table.shape[2], chunked)
+    if key not in _PASSES:
+        _PASSES[key] = _compile_range_passes(*key)[0]
+    pair_pass = _PASSES[key]
     apply_threads(threads)
     try:
         pair_pass(

@@ -8,8 +8,10 @@ thread count. ``range_wall_pass``: the particle-wall pairs of the set (fixed-tem
 walls). Conventions (heat added into a mechanism column, ``conductance_sum``, ``store``, the
 k(T) override): :mod:`thermodem.kernels.heat_terms`.
 
-The pair pass works through each group in chunks of :data:`CHUNK` pairs, in three loops
-(issue 10 §3: the range pass of Rong & Horio at 0.5 R̄ went from ~25 to ~15 ns per pair):
+For a model whose sphere form vectorises (``VECTORISED_SPHERE_FORMS`` of the family
+module: Rong & Horio), the pair pass works through each group in chunks of :data:`CHUNK`
+pairs, in three loops (issue 10 §3: the range pass of Rong & Horio at 0.5 R̄ on the 50k bed
+went from ~25 to ~10-12 ns per pair, 1 thread):
 
 1. *gather*: the squared centre distance, both radii and the pair's parameter row (copied
    column by column; skipped when every row of the table is the same and no column is
@@ -22,7 +24,10 @@ The pair pass works through each group in chunks of :data:`CHUNK` pairs, in thre
    Sphere pairs only, so the models' wall branch is not in it
    (:func:`~thermodem.models.thermal.indirect_conduction.indirect_sphere_dispatch`);
 3. *scatter*: q = H (T_j - T_i) added to i and subtracted from j, in pair order (the
-   summation order of the fused loop it replaced: bit-identical sums for the same H).
+   summation order of the fused loop: bit-identical sums for the same H).
+
+The other models run pair by pair in one fused loop (for them the chunk buffers cost ~3-10 %:
+Batchelor & O'Brien's separated part, 40 ns per pair).
 
 The distance is computed with the same operations as ``pair_separation`` and every loop
 keeps IEEE semantics (no fast-math), so H is the model's value whatever LLVM vectorises.
@@ -36,12 +41,21 @@ import numpy as np
 from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
-from thermodem.kernels.heat_terms import EVAL_SEPARATED, WALL_CHUNK, _row, term_conductance
-from thermodem.kernels.neighbors import minimum_image, wall_distance
+from thermodem.kernels.heat_terms import (
+    EVAL_INDIRECT,
+    EVAL_SEPARATED,
+    WALL_CHUNK,
+    _row,
+    term_conductance,
+)
+from thermodem.kernels.neighbors import minimum_image, pair_separation, wall_distance
 from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.thermal.contact_radius import geometric_contact_radius
 from thermodem.models.thermal.direct_conduction import separated_conductance
-from thermodem.models.thermal.indirect_conduction import indirect_sphere_dispatch
+from thermodem.models.thermal.indirect_conduction import (
+    VECTORISED_SPHERE_FORMS,
+    indirect_sphere_dispatch,
+)
 
 #: Pairs per chunk of the range pair pass (buffers of (width + 4) × CHUNK doubles per group:
 #: 8 kB for Rong & Horio's 4 columns, in L1). 128 and 256 measured alike, 64 slower.
@@ -80,15 +94,18 @@ def range_passes_for(
     holds one model's code (no run-time model switch; one variant per selected range model:
     the variants grow with the models selected, not with their combinations). The passes
     keep the generic argument list; the evaluator, model and ``need_rc`` arguments passed in
-    are ignored, and without ``override`` so are ``k_col_i``/``k_col_j``."""
-    key = (int(evaluator), int(model_id), bool(need_rc), bool(override), int(width))
+    are ignored, and without ``override`` so are ``k_col_i``/``k_col_j``. The pair pass runs
+    in chunks (module docstring) for the models whose sphere form vectorises, else pair by
+    pair in one fused loop (the chunks' buffers cost those models ~3-10 %)."""
+    chunked = evaluator == EVAL_INDIRECT and model_id in VECTORISED_SPHERE_FORMS
+    key = (int(evaluator), int(model_id), bool(need_rc), bool(override), int(width), chunked)
     if key not in _RANGE_PASSES:
         _RANGE_PASSES[key] = _compile_range_passes(*key)
     return _RANGE_PASSES[key]
 
 
 def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE: bool,  # noqa: ANN202, N803
-                          WIDTH: int):  # fmt: skip  # noqa: N803
+                          WIDTH: int, CHUNKED: bool):  # fmt: skip  # noqa: N803
     """Define the range passes of one term (see :func:`range_passes_for`)."""
 
     @parallel_kernel(error_model="numpy")
@@ -105,7 +122,7 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
         if not OVERRIDE:
             k_col_i = -1
         override = OVERRIDE and k_col_i >= 0
-        copy_rows = override or not uniform_rows(table)
+        copy_rows = override or not (CHUNKED and uniform_rows(table))
         length = upper - lower
         lx, ly, lz = length[0], length[1], length[2]
         px, py, pz = periodic[0], periodic[1], periodic[2]
@@ -113,46 +130,21 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
         for parity in range(2):
             for half in prange((ngroups + 1 - parity) // 2):
                 g = 2 * half + parity
-                geometry = np.empty((4, CHUNK))  # d², r_i, r_j, H of the chunk's pairs
-                cols = np.empty((WIDTH, CHUNK))  # their parameter rows, by column
-                if not copy_rows:
-                    for q in range(WIDTH):
-                        cols[q, :] = table[0, 0, q]
-                d2 = geometry[0]
-                r_i = geometry[1]
-                r_j = geometry[2]
-                h = geometry[3]
-                for start in range(group_start[g], group_start[g + 1], CHUNK):
-                    n = min(CHUNK, group_start[g + 1] - start)
-                    for t in range(n):  # 1. gather
-                        i = pair_i[start + t]
-                        j = pair_j[start + t]
-                        dx = minimum_image(position[j, 0] - position[i, 0], lx, px)
-                        dy = minimum_image(position[j, 1] - position[i, 1], ly, py)
-                        dz = minimum_image(position[j, 2] - position[i, 2], lz, pz)
-                        d2[t] = dx * dx + dy * dy + dz * dz
-                        r_i[t] = radius[i]
-                        r_j[t] = radius[j]
-                        if copy_rows:
-                            row = table[type_id[i], type_id[j]]
-                            for q in range(WIDTH):
-                                cols[q, t] = row[q]
-                            if override:
-                                cols[k_col_i, t] = k_particle[i]
-                                cols[k_col_j, t] = k_particle[j]
-                    for t in range(n):  # 2. conductances (vectorised where the model allows)
-                        dist = math.sqrt(d2[t])
-                        ri = r_i[t]
-                        rj = r_j[t]
-                        r_c = geometric_contact_radius(ri, rj, ri + rj - dist) if NEED_RC else 0.0
-                        h[t] = term_sphere_conductance(
-                            evaluator, model_id, cols[:, t], ri, rj, dist, r_c, 0.0
-                        )
-                    for t in range(n):  # 3. scatter, in pair order
-                        k = start + t
+                if not CHUNKED:  # pair by pair, one fused loop
+                    srow = scratch[g]
+                    for k in range(group_start[g], group_start[g + 1]):
                         i = pair_i[k]
                         j = pair_j[k]
-                        hk = h[t]
+                        dist = pair_separation(position, i, j, length, periodic)[3]
+                        ri = radius[i]
+                        rj = radius[j]
+                        r_c = geometric_contact_radius(ri, rj, ri + rj - dist) if NEED_RC else 0.0
+                        ki = kj = 0.0
+                        if override:
+                            ki = k_particle[i]
+                            kj = k_particle[j]
+                        p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+                        hk = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
                         if store:
                             out_conductance[k] = hk
                         q = hk * (temperature[j] - temperature[i])
@@ -160,6 +152,56 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                         by_mechanism[column, j] -= q
                         conductance_sum[i] += hk
                         conductance_sum[j] += hk
+                else:  # in chunks: gather, conductances, scatter
+                    geometry = np.empty((4, CHUNK))  # d², r_i, r_j, H of the chunk's pairs
+                    cols = np.empty((WIDTH, CHUNK))  # their parameter rows, by column
+                    if not copy_rows:
+                        for c in range(WIDTH):
+                            cols[c, :] = table[0, 0, c]
+                    d2 = geometry[0]
+                    r_i = geometry[1]
+                    r_j = geometry[2]
+                    h = geometry[3]
+                    for start in range(group_start[g], group_start[g + 1], CHUNK):
+                        n = min(CHUNK, group_start[g + 1] - start)
+                        for t in range(n):  # 1. gather
+                            i = pair_i[start + t]
+                            j = pair_j[start + t]
+                            dx = minimum_image(position[j, 0] - position[i, 0], lx, px)
+                            dy = minimum_image(position[j, 1] - position[i, 1], ly, py)
+                            dz = minimum_image(position[j, 2] - position[i, 2], lz, pz)
+                            d2[t] = dx * dx + dy * dy + dz * dz
+                            r_i[t] = radius[i]
+                            r_j[t] = radius[j]
+                            if copy_rows:
+                                row = table[type_id[i], type_id[j]]
+                                for c in range(WIDTH):
+                                    cols[c, t] = row[c]
+                                if override:
+                                    cols[k_col_i, t] = k_particle[i]
+                                    cols[k_col_j, t] = k_particle[j]
+                        for t in range(n):  # 2. conductances (vectorised where the model allows)
+                            dist = math.sqrt(d2[t])
+                            ri = r_i[t]
+                            rj = r_j[t]
+                            r_c = 0.0
+                            if NEED_RC:
+                                r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+                            h[t] = term_sphere_conductance(
+                                evaluator, model_id, cols[:, t], ri, rj, dist, r_c, 0.0
+                            )
+                        for t in range(n):  # 3. scatter, in pair order
+                            k = start + t
+                            i = pair_i[k]
+                            j = pair_j[k]
+                            hk = h[t]
+                            if store:
+                                out_conductance[k] = hk
+                            q = hk * (temperature[j] - temperature[i])
+                            by_mechanism[column, i] += q
+                            by_mechanism[column, j] -= q
+                            conductance_sum[i] += hk
+                            conductance_sum[j] += hk
 
     @parallel_kernel(error_model="numpy")
     def range_wall_pass(

@@ -183,6 +183,11 @@ def indirect_conduction_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n):
     return np.nan
 
 
+#: Models whose sphere form (indirect_sphere_dispatch) is branch-free and calls no library
+#: function, so that the range pass computes it in a loop LLVM vectorises (kernels/range_pass.py)
+VECTORISED_SPHERE_FORMS = frozenset({RONG_HORIO1999})
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def indirect_sphere_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n):
     """:func:`indirect_conduction_dispatch` for two spheres (``r_j`` finite; the range pair
