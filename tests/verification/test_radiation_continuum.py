@@ -458,3 +458,6 @@ def test_neighbour_listing_stays_exact_while_the_bed_moves(tmp_path: Path, model
             assert f[fk.F_NEIGHBOUR_TEMPERATURE] == pytest.approx(inside @ p.temperature, rel=1e-13)
     ns = fp.neighbourhood
     assert fp.members_listings > ns.builds > 1
+    # the border entries' classes were redone between listings too (particles moved a
+    # quarter of their band; tests/unit/test_neighbourhood_border.py has tested entries)
+    assert fp.border_classifications > fp.members_listings

@@ -231,6 +231,21 @@ class FieldProvider(FluidSources, NeighbourhoodFields):
         self.members_offset = 0.0
         self.members_band = 0.0
         self.members_listings = 0
+        # the classes of the listing's border entries (inside, outside, tested at every
+        # step; kernels/neighbourhood.py: border_classes, border_lists): (weights, listed
+        # rows, entries, chunk starts, tested rows, entries, count), valid while no particle
+        # moved more than border_band / BORDER_MARGIN since the classification
+        empty = np.zeros(0, np.int64)
+        self.border_weights = (np.zeros(0, np.int8), empty, empty, np.zeros(2, np.int64),
+                               empty, empty, 0)  # fmt: skip
+        self.border_band = 0.0
+        self.border_offset = 0.0
+        self.border_reference = np.zeros((0, 3))  # the positions at the classification
+        self.border_owned = -1  # the rows classified (owned particles)
+        self.border_listing_moved = 0.0  # the displacement since the listing at it
+        self.border_listing = -1
+        self.border_classifications = 0
+        self.border_tested = 0  # TESTED entries summed over the classifications
         self.scratch = np.zeros((1, 4))
         # cell porosity (the grid is set up at the first evaluation: its default size)
         self.cell_size = 0.0
@@ -418,6 +433,7 @@ class FieldProvider(FluidSources, NeighbourhoodFields):
             self.members = (np.array(offsets, np.int64), np.array(border, np.int64),
                             np.array(index, np.int32))  # fmt: skip
             self.member_sums = tuple(np.zeros(0) for _ in range(4))  # recomputed at first use
+            self.border_listing = -1  # (and the border entries' classes)
         self._constants_for = None
 
 

@@ -6,6 +6,7 @@ A mixin of :class:`~thermodem.engine.fields.FieldProvider`.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -16,6 +17,11 @@ from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import heat_terms
 from thermodem.kernels import neighbourhood as nh
 from thermodem.kernels import porosity as pk
+
+#: The border entries' classes hold while BORDER_MARGIN × the largest displacement since
+#: their classification is at most their band (2 would be exact: a distance changes by at most
+#: twice the displacement).
+BORDER_MARGIN = 2.2
 
 
 class NeighbourhoodFields:
@@ -71,25 +77,26 @@ class NeighbourhoodFields:
             ns.build(sim, self._neighbourhood_gap(), 0.0)
         n = p.count
         if self.radiation_ratio > 0.0:
-            if (
-                ns.builds != self.members_builds
-                or self.members[0].shape[0] != n + 1
-                or self._listing_expired()
-            ):
+            relist = ns.builds != self.members_builds or self.members[0].shape[0] != n + 1
+            moved = math.inf if relist else self._border_moved()
+            if relist or self._listing_expired(moved):
                 self._list_members()
+                self._classify_border(0.0)
+            elif BORDER_MARGIN * moved > self.border_band:
+                self._classify_border(None)
             if self.member_sums[0].shape[0] != n:
                 self._member_constants()
             area, emission, member_area, member_count = self.member_sums
-            if self.radiation_mode & nh.NB_KRAUSE:
-                nh.neighbourhood_weights(p.radius, p.temperature, p.type_id, self.emissivity,
-                                         area, emission)  # fmt: skip
+            if self.radiation_mode & nh.NB_KRAUSE:  # (the areas hold with the listing)
+                nh.neighbourhood_emission(area, p.temperature, emission)
             # the rows of the owned particles (all; on several MPI ranks not the ghosts, whose
             # rows lack the neighbours beyond the halo: their owners sum theirs)
             offsets, border, index = self.members
             nh.neighbourhood_sums(p.position, p.radius, p.temperature,
-                                  offsets[: sim.owned_count + 1], border, index, area,
-                                  emission, member_area, member_count, sim.lower, sim.upper,
-                                  sim.periodic, self.radiation_ratio, self.radiation_mode,
+                                  offsets[: sim.owned_count + 1], border, index,
+                                  *self.border_weights, area, emission, member_area,
+                                  member_count, sim.lower, sim.upper, sim.periodic,
+                                  self.radiation_ratio, self.radiation_mode,
                                   fields)  # fmt: skip
         if self.shell_ratio > 0.0:
             if self.sums.shape[0] != n:
@@ -135,20 +142,83 @@ class NeighbourhoodFields:
         self.members_band = band
         self.members_listings += 1
 
-    def _listing_expired(self) -> bool:
+    def _listing_expired(self, border_moved: float) -> bool:
         """Whether a particle may have moved more than band / 2 since the listing. First the
         bound |x - x_list| <= |x - x_set| + |x_list - x_set| from the range set's own
         displacement (found by its due() this step) and the one at the listing: no pass of
-        its own while a bed hardly moves; then, if the bound is too large, the displacement
-        since the listing itself (parallel, by chunks: the same for any thread count)."""
+        its own while a bed hardly moves; then the same through the border entries'
+        classification (``border_moved`` since it, plus the displacement since the listing
+        at it); then, if both bounds are too large, the displacement since the listing
+        itself (parallel, by chunks: the same for any thread count)."""
         ns = self.neighbourhood
         if 2.0 * (ns.moved + self.members_offset) <= self.members_band:
             return False
+        if 2.0 * (border_moved + self.border_listing_moved) <= self.members_band:
+            return False
+        return 2.0 * self._moved_since(self.members_reference) > self.members_band
+
+    def _moved_since(self, reference: np.ndarray) -> float:
         sim = self.sim
-        moved = heat_terms.largest_displacement(sim.particles.position, self.members_reference,
-                                                sim.lower, sim.upper, sim.periodic,
-                                                self._part())  # fmt: skip
-        return 2.0 * float(moved) > self.members_band
+        return float(heat_terms.largest_displacement(sim.particles.position, reference,
+                                                     sim.lower, sim.upper, sim.periodic,
+                                                     self._part()))  # fmt: skip
+
+    def _border_moved(self) -> float:
+        """A bound on how far a particle moved since the border entries were classified
+        (inf if they were not, for this listing): the range set's displacement now and at
+        the classification, or, if that is too large to keep the classes, the displacement
+        since the classification itself."""
+        if (
+            self.border_listing != self.members_listings
+            or self.border_weights[0].shape[0] != self.members[2].shape[0]
+            or self.border_reference.shape != self.sim.particles.position.shape
+            or self.border_owned != self.sim.owned_count
+        ):
+            return math.inf
+        bound = self.neighbourhood.moved + self.border_offset
+        if BORDER_MARGIN * bound <= self.border_band:
+            return bound
+        return self._moved_since(self.border_reference)
+
+    def _classify_border(self, since_listing: float | None) -> None:
+        """Classify the border entries at the current positions with a band of a quarter of
+        the listing's (kernels/neighbourhood.py: border_classes): inside, outside, or tested
+        at every step, ~a quarter of them; list those that can add to a sum (inside or
+        tested) in row order for the sums' flat loop (border_lists). The classes change no
+        sum: they say which outcomes are known (the same 0/1 weights in the same order; an
+        outside entry added 0), so the sums stay bit-identical and nothing goes into
+        checkpoints. On the 50k bed (~1 border entry per particle, 1 thread) the border
+        entries took ~0.45 ms per step, most of it the mispredicted end of each row's loop
+        over its 0-3 border entries, not the distances. The classes hold while no particle
+        moved more than border_band / BORDER_MARGIN (a distance changes by at most twice
+        that: a margin of ~10 % of the band for the round-off); ``since_listing``: the
+        displacement since the listing (None: found here)."""
+        sim = self.sim
+        p = sim.particles
+        offsets, border, index = self.members
+        own = sim.owned_count
+        weight = np.zeros(index.shape[0], np.int8)
+        band = 0.25 * self.members_band
+        nh.border_classes(p.position, p.radius, offsets[: own + 1], border, index, sim.lower,
+                          sim.upper, sim.periodic, self.radiation_ratio, band,
+                          weight)  # fmt: skip
+        size = int((offsets[1 : own + 1] - border[:own]).sum()) if own else 0
+        lists = [np.zeros(size, np.int64) for _ in range(4)]
+        starts = np.zeros(own // nh.CHUNK + 2, np.int64)
+        listed, tested = nh.border_lists(offsets[: own + 1], border, weight, lists[0],
+                                         lists[1], starts, lists[2], lists[3])  # fmt: skip
+        self.border_weights = (weight, lists[0][:listed], lists[1][:listed], starts,
+                               lists[2][:tested], lists[3][:tested], int(tested))  # fmt: skip
+        self.border_band = band
+        self.border_offset = self.neighbourhood.moved
+        self.border_reference = p.position.copy()
+        self.border_owned = own
+        if since_listing is None:
+            since_listing = self._moved_since(self.members_reference)
+        self.border_listing_moved = since_listing
+        self.border_listing = self.members_listings
+        self.border_classifications += 1
+        self.border_tested += int(tested)
 
     def _member_constants(self) -> None:
         """ε A / 2 of every particle and the members' count and Σ ε A / 2 of every row."""
