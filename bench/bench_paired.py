@@ -19,7 +19,8 @@ per-pair block ratios (median, lower and upper quartile) says how far to trust i
 case with that indirect conduction model on the range set (e.g. ``--indirect
 rong_horio1999 --indirect-param layer_thickness_ratio=0.5``: a gap cut-off of 0.5 R̄),
 timed in the same rotation; its overhead over mechanics and the gap term's own cost (its
-time over the heat case's, in units of the mechanics time) are printed too.
+time over the heat case's, in units of the mechanics time) are printed too. ``--substeps N``
+gives the heat cases N mechanical steps per thermal step (issue 10 §3's ``substeps: 10``).
 
 ``--convection MODEL`` / ``--radiation MODEL`` [``--porosity cell|shell|global``] (issue 13):
 the heat case against the same case with these per-particle terms
@@ -65,6 +66,7 @@ def main() -> None:
     ap.add_argument("--convection", default=None, help="issue 13: heat vs heat + terms")
     ap.add_argument("--porosity", default="cell", choices=["cell", "shell", "global"])
     ap.add_argument("--radiation", default=None, help="issue 13: heat vs heat + terms")
+    ap.add_argument("--substeps", type=int, default=1, help="thermal substeps of the heat cases")
     args = ap.parse_args()
     if args.convection or args.radiation:
         terms_main(args)
@@ -83,13 +85,15 @@ def main() -> None:
         }
     else:
         shared.particle_files()
-        cases = {kind: shared.case_dict(kind, None, 1) for kind in ("mechanics", args.heat)}
+        cases = {
+            kind: shared.case_dict(kind, None, args.substeps) for kind in ("mechanics", args.heat)
+        }
         if args.indirect:
             indirect: dict = {"model": args.indirect}
             for kv in args.indirect_param:
                 key, value = kv.split("=", 1)
                 indirect[key] = float(value)
-            cases["gap"] = shared.case_dict(args.heat, indirect, 1)
+            cases["gap"] = shared.case_dict(args.heat, indirect, args.substeps)
     sims = {
         kind: Simulation(case_from_dict(case), threads=args.threads) for kind, case in cases.items()
     }
