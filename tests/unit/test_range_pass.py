@@ -133,7 +133,7 @@ def test_range_pass_equals_the_kernel_pair_by_pair(case: str, chunked: bool, thr
             position, radius, temperature, type_id, pi, pj, group_start, np.zeros(3),
             np.ones(3), np.zeros(3, np.bool_), EVAL_INDIRECT, spec.model_id, table, k_cols[0],
             k_cols[1], k_particle, np.zeros((2, table.shape[2])), 1, heat, sums, True, out,
-            False,
+            False, np.full((2, 4, CHUNK), np.nan), np.full((2, table.shape[2], CHUNK), np.nan),
         )  # fmt: skip
     finally:
         apply_threads(1)

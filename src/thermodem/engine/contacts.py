@@ -134,11 +134,16 @@ def _heat(sim: Simulation, rows: np.ndarray, wrows: np.ndarray) -> dict[str, np.
                 term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0,
                 term.table.shape[2],
             )  # fmt: skip
+            chunked = range_pass.runs_in_chunks(term.evaluator, term.model_id)
+            groups = pb.group_start.shape[0] - 1
+            geometry, cols = range_pass.chunk_buffers(
+                th.range_chunks, groups, term.table.shape[2], chunked
+            )
             range_pair_pass(
                 p.position, p.radius, p.temperature, p.type_id, pb.i, pb.j, pb.group_start,
                 sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table,
                 k_i, k_j, th.k_p, scratch, term.column, by_mech, sums, True, pair_h,
-                term.needs_contact_radius,
+                term.needs_contact_radius, geometry, cols,
             )  # fmt: skip
             range_wall_pass(
                 p.position, p.radius, p.temperature, p.type_id, wb.j, sim.wall_row_start,

@@ -250,6 +250,9 @@ class ThermalEngine(ContactConduction, TermEvaluation, ThermalLedger):
         self.override = 2 if has_c else (1 if has_k else 0)
         self.scratch = np.zeros((1, max(self.conduction_table.shape[-1], 1)))
         self.term_scratch = np.zeros((1, max([t.table.shape[-1] for t in self.terms] + [1])))
+        # the range pass's chunk buffers by row width (kernels/range_pass.py: chunk_buffers;
+        # a dict of arrays: not part of a checkpoint's state)
+        self.range_chunks: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.euler_partials = np.zeros((1, kernels.EULER_FIXED + len(heat.MECHANISMS)))
 
     def _interp(

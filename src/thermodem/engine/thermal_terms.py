@@ -264,11 +264,15 @@ class TermEvaluation:
             term.evaluator, term.model_id, term.needs_contact_radius, k_i >= 0,
             term.table.shape[2],
         )  # fmt: skip
+        chunked = range_pass.runs_in_chunks(term.evaluator, term.model_id)
+        geometry, cols = range_pass.chunk_buffers(
+            self.range_chunks, rs.ngroups, term.table.shape[2], chunked
+        )
         range_pair_pass(
             p.position, p.radius, p.temperature, p.type_id, rs.i, rs.j, rs.group_start,
             sim.lower, sim.upper, sim.periodic, term.evaluator, term.model_id, term.table, k_i,
             k_j, self.k_p, scratch, term.column, by_mech, self.conductance_sum, store, pair_h,
-            term.needs_contact_radius,
+            term.needs_contact_radius, geometry, cols,
         )  # fmt: skip
         range_wall_pass(
             p.position, p.radius, p.temperature, p.type_id, rs.wall_w, rs.wall_row_start,

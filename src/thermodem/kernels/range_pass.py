@@ -85,6 +85,26 @@ def uniform_rows(table):
 _RANGE_PASSES: dict[tuple, tuple] = {}
 
 
+def runs_in_chunks(evaluator: int, model_id: int) -> bool:
+    """Whether the range pair pass of this model runs in chunks (module docstring)."""
+    return evaluator == EVAL_INDIRECT and model_id in VECTORISED_SPHERE_FORMS
+
+
+def chunk_buffers(
+    cache: dict[int, tuple[np.ndarray, np.ndarray]], groups: int, width: int, chunked: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """The (geometry, columns) chunk buffers of the range pair pass for ``groups`` slab
+    groups and rows of ``width`` columns, kept in ``cache`` (the caller's, by width) and
+    grown when the groups outnumber them: no allocation per step. Without chunks, empty."""
+    if not chunked:
+        groups = 0
+    held = cache.get(width)
+    if held is None or held[0].shape[0] < groups:
+        held = (np.empty((groups, 4, CHUNK)), np.empty((groups, width, CHUNK)))
+        cache[width] = held
+    return held
+
+
 def range_passes_for(
     evaluator: int, model_id: int, need_rc: bool, override: bool, width: int
 ) -> tuple:
@@ -97,7 +117,7 @@ def range_passes_for(
     are ignored, and without ``override`` so are ``k_col_i``/``k_col_j``. The pair pass runs
     in chunks (module docstring) for the models whose sphere form vectorises, else pair by
     pair in one fused loop (the chunks' buffers cost those models ~3-10 %)."""
-    chunked = evaluator == EVAL_INDIRECT and model_id in VECTORISED_SPHERE_FORMS
+    chunked = runs_in_chunks(evaluator, model_id)
     key = (int(evaluator), int(model_id), bool(need_rc), bool(override), int(width), chunked)
     if key not in _RANGE_PASSES:
         _RANGE_PASSES[key] = _compile_range_passes(*key)
@@ -112,11 +132,15 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
     def range_pair_pass(
         position, radius, temperature, type_id, pair_i, pair_j, group_start, lower, upper,
         periodic, evaluator, model_id, table, k_col_i, k_col_j, k_particle, scratch, column,
-        by_mechanism, conductance_sum, store, out_conductance, need_rc,
+        by_mechanism, conductance_sum, store, out_conductance, need_rc, chunk_geometry,
+        chunk_cols,
     ):  # fmt: skip
         """One pair term over the range pair set, by slab groups and chunks of pairs (module
         docstring). The heat of a pair out of range (H = 0) is added as zeros, without a
-        branch: in a bed pairs in and out of range alternate at random."""
+        branch: in a bed pairs in and out of range alternate at random. ``chunk_geometry``
+        (groups, 4, CHUNK) and ``chunk_cols`` (groups, WIDTH, CHUNK): the chunk buffers of
+        each group, kept by the caller between steps (:func:`chunk_buffers`; read only when
+        the pass runs in chunks)."""
         evaluator = EVALUATOR
         model_id = MODEL_ID
         if not OVERRIDE:
@@ -153,8 +177,8 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                         conductance_sum[i] += hk
                         conductance_sum[j] += hk
                 else:  # in chunks: gather, conductances, scatter
-                    geometry = np.empty((4, CHUNK))  # d², r_i, r_j, H of the chunk's pairs
-                    cols = np.empty((WIDTH, CHUNK))  # their parameter rows, by column
+                    geometry = chunk_geometry[g]  # d², r_i, r_j, H of the chunk's pairs
+                    cols = chunk_cols[g]  # their parameter rows, by column
                     if not copy_rows:
                         for c in range(WIDTH):
                             cols[c, :] = table[0, 0, c]
