@@ -80,6 +80,18 @@ def term_conductance(evaluator, model_id, p, r_i, r_j, dist, r_c, f_n):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def add_pair_heat(by_mechanism, column, conductance_sum, temperature, i, j, h):
+    """A pair's exchange of conductance ``h``: q = h (T_j - T_i) added to i's mechanism
+    column and subtracted from j's (antisymmetric: what i gains j loses), h added to both
+    particles' conductance sums (the explicit stability limit)."""
+    q = h * (temperature[j] - temperature[i])
+    by_mechanism[column, i] += q
+    by_mechanism[column, j] -= q
+    conductance_sum[i] += h
+    conductance_sum[j] += h
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _row(table_row, k_col_i, k_col_j, k_i, k_j, scratch_row):
     """The parameter row, with the conductivity columns replaced when k_col_i >= 0."""
     if k_col_i < 0:
@@ -128,11 +140,7 @@ def contact_term_pair_pass(
                     p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
                     h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, f_n)
                     if h != 0.0:
-                        q = h * (temperature[j] - temperature[i])
-                        by_mechanism[column, i] += q
-                        by_mechanism[column, j] -= q
-                        conductance_sum[i] += h
-                        conductance_sum[j] += h
+                        add_pair_heat(by_mechanism, column, conductance_sum, temperature, i, j, h)
                 if store:
                     out_conductance[k] = h
 
@@ -408,13 +416,8 @@ def pair_heat_from_conductance(
             for k in range(group_start[g], group_start[g + 1]):
                 h = conductance[k]
                 if h != 0.0:
-                    i = pair_i[k]
-                    j = pair_j[k]
-                    q = h * (temperature[j] - temperature[i])
-                    by_mechanism[column, i] += q
-                    by_mechanism[column, j] -= q
-                    conductance_sum[i] += h
-                    conductance_sum[j] += h
+                    add_pair_heat(by_mechanism, column, conductance_sum, temperature,
+                                  pair_i[k], pair_j[k], h)  # fmt: skip
 
 
 @parallel_kernel(error_model="numpy")

@@ -46,6 +46,7 @@ from thermodem.kernels.heat_terms import (
     EVAL_SEPARATED,
     WALL_CHUNK,
     _row,
+    add_pair_heat,
     term_conductance,
 )
 from thermodem.kernels.neighbors import minimum_image, pair_separation, wall_distance
@@ -171,11 +172,7 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                         hk = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
                         if store:
                             out_conductance[k] = hk
-                        q = hk * (temperature[j] - temperature[i])
-                        by_mechanism[column, i] += q
-                        by_mechanism[column, j] -= q
-                        conductance_sum[i] += hk
-                        conductance_sum[j] += hk
+                        add_pair_heat(by_mechanism, column, conductance_sum, temperature, i, j, hk)
                 else:  # in chunks: gather, conductances, scatter
                     geometry = chunk_geometry[g]  # d², r_i, r_j, H of the chunk's pairs
                     cols = chunk_cols[g]  # their parameter rows, by column
@@ -216,16 +213,10 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                             )
                         for t in range(n):  # 3. scatter, in pair order
                             k = start + t
-                            i = pair_i[k]
-                            j = pair_j[k]
-                            hk = h[t]
                             if store:
-                                out_conductance[k] = hk
-                            q = hk * (temperature[j] - temperature[i])
-                            by_mechanism[column, i] += q
-                            by_mechanism[column, j] -= q
-                            conductance_sum[i] += hk
-                            conductance_sum[j] += hk
+                                out_conductance[k] = h[t]
+                            add_pair_heat(by_mechanism, column, conductance_sum, temperature,
+                                          pair_i[k], pair_j[k], h[t])  # fmt: skip
 
     @parallel_kernel(error_model="numpy")
     def range_wall_pass(

@@ -242,24 +242,6 @@ def finish_heat(source, heat_rate, by_mechanism, columns):
         heat_rate[i] = q
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _take_generation(gen_energy, i, scale):
-    """The six heat rates scale × E_g of particle i's generation accumulators, emptied."""
-    q0 = scale * gen_energy[i, 0]
-    q1 = scale * gen_energy[i, 1]
-    q2 = scale * gen_energy[i, 2]
-    q3 = scale * gen_energy[i, 3]
-    q4 = scale * gen_energy[i, 4]
-    q5 = scale * gen_energy[i, 5]
-    gen_energy[i, 0] = 0.0
-    gen_energy[i, 1] = 0.0
-    gen_energy[i, 2] = 0.0
-    gen_energy[i, 3] = 0.0
-    gen_energy[i, 4] = 0.0
-    gen_energy[i, 5] = 0.0
-    return q0, q1, q2, q3, q4, q5
-
-
 EULER_CHUNK = 1024  # (50,000 particles: 49 chunks, 25 and 24 on two threads; 4096 gave 7 and 6)
 #: Columns of the per-chunk partial results of :func:`euler_step` before the per-mechanism sums.
 EULER_FIXED = 4
@@ -307,36 +289,23 @@ def euler_step(temperature, heat_rate, by_mechanism, columns, source, source_on,
         # mechanism chained every addition through memory: 0.28 -> 0.11 ms per step for
         # 50,000 particles); all six accumulators are read, the unselected ones stay zero
         s0 = s1 = s2 = s3 = s4 = s5 = 0.0
-        first = c * EULER_CHUNK
-        last = min(n, first + EULER_CHUNK)
-        if generation and not source_on and not conductances and columns.shape[0] == 0:
-            # the generated heat is all the heat (e.g. a drum heated by its friction): the
-            # same update as the loop below without its switches (50,000 particles: 0.29 ->
-            # 0.24 ms per step)
-            for i in range(first, last):
-                q0, q1, q2, q3, q4, q5 = _take_generation(gen_energy, i, gen_scale)
-                s0 += q0
-                s1 += q1
-                s2 += q2
-                s3 += q3
-                s4 += q4
-                s5 += q5
-                q = q0 + q1 + q2 + q3 + q4 + q5
-                heat_rate[i] = q
-                if fixed[i]:
-                    absorbed += q
-                    continue
-                t = temperature[i] + dt * q / (mass[i] * c_by_type[type_id[i]])
-                temperature[i] = t
-                if bad < 0 and not (t > 0.0 and math.isfinite(t)):
-                    bad = i
-            first = last  # (nothing left for the general loop)
-        for i in range(first, last):
+        for i in range(c * EULER_CHUNK, min(n, (c + 1) * EULER_CHUNK)):
             if source_on:
                 by_mechanism[M_SOURCE, i] = source[i]
             q = 0.0
             if generation:
-                q0, q1, q2, q3, q4, q5 = _take_generation(gen_energy, i, gen_scale)
+                q0 = gen_scale * gen_energy[i, 0]
+                q1 = gen_scale * gen_energy[i, 1]
+                q2 = gen_scale * gen_energy[i, 2]
+                q3 = gen_scale * gen_energy[i, 3]
+                q4 = gen_scale * gen_energy[i, 4]
+                q5 = gen_scale * gen_energy[i, 5]
+                gen_energy[i, 0] = 0.0
+                gen_energy[i, 1] = 0.0
+                gen_energy[i, 2] = 0.0
+                gen_energy[i, 3] = 0.0
+                gen_energy[i, 4] = 0.0
+                gen_energy[i, 5] = 0.0
                 s0 += q0
                 s1 += q1
                 s2 += q2
