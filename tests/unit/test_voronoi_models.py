@@ -374,3 +374,76 @@ def test_model_b_cutoff_and_touching_limits() -> None:
         inside = v.voronoi_b_conductance(rw, r, r, d_in, geometric_rc(r, r, d_in), a_n)
         assert math.isfinite(touch) and touch > 0
         assert apart == pytest.approx(touch, rel=1e-6) and inside == pytest.approx(touch, rel=1e-4)
+
+
+@pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
+def test_model_a_closed_form_matches_quad_and_the_general_quadrature() -> None:
+    """cone_integral (the elementary integral of the one-sphere path: mono-size, mean radius,
+    wall) against scipy.integrate.quad of Σ = s (β - ℓ r/r_ij) + f (ℓ - β) and against the
+    graded Gauss-Legendre integration of the general path (model_a_integral with equal
+    spheres), over k_p/k_f = 1e-2 ... 1e6 (both signs of A = s - f, both signs of B - ρ) and
+    surface gaps down to 1e-10 R."""
+    from thermodem.models.thermal.voronoi_integrals import cone_integral, model_a_integral
+
+    rng = np.random.default_rng(11)
+    worst_quad = worst_gl = 0.0
+    seen = set()
+    for _ in range(600):
+        r = 1e-3
+        k_p = K_F * 10 ** rng.uniform(-2.0, 6.0)
+        wall = rng.random() < 0.3
+        if rng.random() < 0.3:
+            axial = r * (1.0 + 10 ** rng.uniform(-10.0, -1.0))
+        else:
+            axial = r * rng.uniform(0.5, 2.0)
+        r_ij = r * 10 ** rng.uniform(-0.3, 0.7)
+        solid, fluid = (1.0 / k_p, 1.0 / K_F) if wall else (2.0 / k_p, 2.0 / K_F)
+        r_sf = r * r_ij / math.sqrt(r_ij**2 + axial**2)
+        r_lo = math.sqrt(max(r * r - axial * axial, 0.0))
+        if rng.random() < 0.2:
+            r_lo = max(r_lo, rng.uniform(0.0, 0.9) * r_sf)
+        if not r_sf > r_lo:
+            continue
+        big_a, big_b = solid - fluid, fluid * axial
+        rho = r * math.hypot(big_a, solid * axial / r_ij)
+        seen.add((big_a > 0.0, big_b > rho))
+        h = cone_integral(solid, fluid, axial, r_ij, r, r_lo, r_sf)
+
+        def f(x: float, r=r, s=solid, fl=fluid, ax=axial, c=r_ij) -> float:  # noqa: ANN001
+            b = math.sqrt(r * r - x * x)
+            return 2 * math.pi * x / (s * (b - ax * x / c) + fl * (ax - b))
+
+        pts = [r_lo + (r_sf - r_lo) * x for x in (1e-8, 1e-6, 1e-4, 1e-2, 0.5, 0.9, 0.99)]
+        ref = quad(f, r_lo, r_sf, epsabs=0, epsrel=1e-13, limit=1000, points=pts)[0]
+        worst_quad = max(worst_quad, abs(h - ref) / ref)
+        # the same path as two equal halves in the general form (half the solid each side)
+        ik = 0.5 * solid if not wall else solid
+        if not wall:
+            gl = model_a_integral(r, axial, r_ij, ik, r, axial, r_ij, ik, 2 * axial,
+                                  1.0 / K_F, False, r_lo, r_sf)  # fmt: skip
+        else:
+            gl = model_a_integral(r, axial, r_ij, ik, 0.0, 0.0, 1.0, 0.0, axial, 1.0 / K_F,
+                                  True, r_lo, r_sf)  # fmt: skip
+        worst_gl = max(worst_gl, abs(h - gl) / gl)
+    assert seen == {(True, True), (True, False), (False, True), (False, False)}, seen
+    assert worst_quad < 1e-9, worst_quad
+    assert worst_gl < 1e-8, worst_gl
+
+
+def test_inverse_quadratic_integral_on_every_branch() -> None:
+    """∫ dt/(p + q t²) of model A's closed form against quad: p > 0 with q of both signs, p <= 0
+    (integrated in 1/t) and the half turn of atan (p + q t1 t2 <= 0)."""
+    from thermodem.models.thermal.voronoi_integrals import _inverse_quadratic_integral as iq
+
+    cases = [(1.0, 2.0, 0.3, 0.7), (1.0, -0.5, -0.9, 1.2), (-0.5, 2.0, 0.6, 1.5),
+             (-0.5, 2.0, -1.5, -0.6), (0.0, 3.0, 0.2, 0.9), (1e-3, 1.0, -0.5, 0.6),
+             (1e-3, 1.0, -30.0, 40.0), (2.0, 1e-12, -3.0, 5.0),
+             (2.0, -1e-12, -3.0, 5.0)]  # fmt: skip
+    branches = set()
+    for p, q, t1, t2 in cases:
+        ref = quad(lambda t: 1.0 / (p + q * t * t), t1, t2, epsabs=0, epsrel=1e-13,  # noqa: B023
+                   limit=500, points=[0.0] if t1 < 0 < t2 else None)[0]  # fmt: skip
+        assert iq(t1, t2, p, q) == pytest.approx(ref, rel=1e-12), (p, q, t1, t2)
+        assert iq(t2, t1, p, q) == pytest.approx(-ref, rel=1e-12)
+        branches.add("p<=0" if not p > 0 else ("half turn" if p + q * t1 * t2 <= 0 else "x"))
+    assert branches == {"p<=0", "half turn", "x"}

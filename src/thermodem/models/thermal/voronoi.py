@@ -42,6 +42,7 @@ from pydantic import Field, field_validator
 from thermodem.config.base import StrictModel
 from thermodem.models.registry import packed, register
 from thermodem.models.thermal.contact_radius import require
+from thermodem.models.thermal.voronoi_integrals import arctan_ratio, cone_integral, model_a_integral
 from thermodem.state.materials import PairContext
 
 FAMILY = "indirect_conduction"
@@ -78,14 +79,6 @@ B_COLUMNS = ("k_i", "k_j", "k_f", "core_ratio_i", "core_ratio_j", "multi_size",
              "cutoff_gap_ratio")  # fmt: skip
 B_SWAP_PAIRS = ((B_K_I, B_K_J), (B_CORE_I, B_CORE_J))
 
-#: Gauss-Legendre rule of model A's quadrature on [0, 1], used on each half interval (see
-#: ``model_a_integral``).
-QUAD_NODES = 20
-_x, _w = np.polynomial.legendre.leggauss(QUAD_NODES)
-GL_U = np.ascontiguousarray(0.5 * (_x + 1.0))
-GL_W = np.ascontiguousarray(0.5 * _w)
-del _x, _w
-
 
 # ------------------------------------------------------------------------ parameters
 class _Common(StrictModel):
@@ -107,7 +100,9 @@ class VoronoiAParams(_Common):
     """Voronoi model A, Cheng, Yu & Zulli (1999) Int. J. Heat Mass Transfer 42, 2847-2856:
     the double tapered cone's surface is isothermal, the region outside it does not conduct
     and the heat paths are parallel to the line of centres; H is an integral over the path
-    radius r from R_c to r_sf evaluated by a compiled quadrature.
+    radius r from R_c to r_sf: elementary when the path crosses one sphere size (mono-size,
+    mean radius, a wall; ``voronoi_integrals.cone_integral``), else (Gan et al. 2016 with
+    R_i != R_j) by a compiled quadrature (``voronoi_integrals.model_a_integral``).
 
     Mono-size (R_i = R_j = R_p)::
 
@@ -218,96 +213,6 @@ def voronoi_range(params: _Common, radius_i: float, radius_j: float) -> float:
 
 # ------------------------------------------------------------------------- model A
 @njit(cache=True, inline="always", error_model="numpy")
-def _path_denominator(r, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall):
-    """Σ (path length / conductivity) of the path at radius r (model A): in the smaller
-    particle, in the larger one (absent at a wall) and in the fluid."""
-    beta_s = math.sqrt(max(r_s * r_s - r * r, 0.0))
-    den = (beta_s - d_s * r / c_s) * ik_s
-    if wall:
-        return den + (dist - beta_s) * ik_f
-    beta_l = math.sqrt(max(r_l * r_l - r * r, 0.0))
-    return den + (beta_l - d_l * r / c_l) * ik_l + (dist - beta_s - beta_l) * ik_f
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _path_slope(r, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, ik_f, wall):
-    """d/dr of ``_path_denominator``."""
-    beta_s = math.sqrt(max(r_s * r_s - r * r, 0.0))
-    slope = (-r / beta_s - d_s / c_s) * ik_s + r / beta_s * ik_f
-    if wall:
-        return slope
-    beta_l = math.sqrt(max(r_l * r_l - r * r, 0.0))
-    return slope + (-r / beta_l - d_l / c_l) * ik_l + r / beta_l * ik_f
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _graded_half(phi_end, direction, lam, half, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l,
-                 dist, ik_f, wall):  # fmt: skip
-    """∫ over the half interval [phi_end, phi_end + direction × half] of 2πr dr/Σ(path/k),
-    with the nodes graded geometrically away from phi_end on the scale ``lam``."""
-    lam = max(min(lam, half), 1e-14 * half)
-    alpha = math.log1p(half / lam)
-    total = 0.0
-    for q in range(GL_U.shape[0]):
-        e = math.expm1(alpha * GL_U[q])
-        phi = phi_end + direction * lam * e
-        r = r_s * math.sin(phi)
-        jac = alpha * lam * (e + 1.0) * r_s * math.cos(phi)  # |dr/du|
-        den = _path_denominator(r, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall)
-        total += GL_W[q] * r / den * jac
-    return total
-
-
-@njit(cache=True, error_model="numpy")
-def model_a_integral(r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall, r_lo, r_hi):
-    """∫_{r_lo}^{r_hi} 2πr dr / Σ(path/k) of model A (``_path_denominator``; ``r_s`` is the
-    smaller radius, ``ik_*`` reciprocal conductivities).
-
-    The integrand is smooth in φ with r = R_s sin φ (β_s = R_s cos φ has no square-root end
-    point even when r_hi is close to R_s), but it can vary on scales much smaller than the
-    interval at either end: at r_lo where the fluid gap d - β_s - β_l is small (its
-    resistance grows from ~0 to that of the solid path over a length λ_lo, estimated from the
-    gap's Taylor expansion: gap'·s + gap''·s²/2 = k_f × the path resistance at r_lo), and at
-    r_hi when k_p ~ k_f (the resistance falls towards the small fluid path at r_sf, like a
-    pole at λ_hi = Σ/|dΣ/dr| beyond the end). Each half of the φ interval is integrated by
-    Gauss-Legendre with its nodes graded geometrically from its end on that scale,
-    φ - φ_end = λ (exp(α u) - 1), α = ln(1 + (Φ/2)/λ), u in [0, 1].
-    Checked against scipy.integrate.quad to 1e-8 (tests/unit/test_voronoi_models.py).
-    """
-    if not r_hi > r_lo:
-        return 0.0
-    phi_lo = math.asin(min(r_lo / r_s, 1.0))
-    phi_hi = math.asin(min(r_hi / r_s, 1.0))
-    half = 0.5 * (phi_hi - phi_lo)
-    # the lower end: the scale of the fluid gap's growth
-    beta_s = math.sqrt(max(r_s * r_s - r_lo * r_lo, 0.0))
-    c1 = r_lo / beta_s
-    c2 = 0.5 * (1.0 / beta_s + r_lo * r_lo / (beta_s * beta_s * beta_s))
-    if not wall:
-        beta_l = math.sqrt(max(r_l * r_l - r_lo * r_lo, 0.0))
-        c1 += r_lo / beta_l
-        c2 += 0.5 * (1.0 / beta_l + r_lo * r_lo / (beta_l * beta_l * beta_l))
-    delta = (
-        _path_denominator(r_lo, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall) / ik_f
-    )
-    scale = 2.0 * delta / (c1 + math.sqrt(c1 * c1 + 4.0 * c2 * delta))
-    lam_lo = scale / beta_s
-    # the upper end: distance to the pole of 1/Σ when Σ falls towards r_hi
-    den_hi = _path_denominator(r_hi, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall)
-    slope_hi = _path_slope(r_hi, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, ik_f, wall)
-    lam_hi = half
-    if slope_hi < 0.0:
-        lam_hi = den_hi / (-slope_hi) / (r_s * math.cos(phi_hi))
-    total = _graded_half(
-        phi_lo, 1.0, lam_lo, half, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall
-    )
-    total += _graded_half(
-        phi_hi, -1.0, lam_hi, half, r_s, d_s, c_s, ik_s, r_l, d_l, c_l, ik_l, dist, ik_f, wall
-    )
-    return 2.0 * math.pi * total
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def _gap_beyond_cutoff(r_i, r_j, dist, ratio):
     if math.isinf(r_j):
         return dist - r_i >= ratio * r_i
@@ -326,8 +231,7 @@ def voronoi_a_conductance(p, r_i, r_j, dist, r_c, inputs):
     ik_f = 1.0 / p[A_K_F]
     if math.isinf(r_j):  # a flat wall: one particle, d_pw = dist
         r_sf = r_i * r_ij / math.sqrt(r_ij * r_ij + dist * dist)
-        return model_a_integral(r_i, dist, r_ij, 1.0 / p[A_K_I], 0.0, 0.0, 1.0, 0.0, dist,
-                                ik_f, True, r_c, r_sf)  # fmt: skip
+        return cone_integral(1.0 / p[A_K_I], ik_f, dist, r_ij, r_i, r_c, r_sf)
     k_i = p[A_K_I]
     k_j = p[A_K_J]
     if p[A_SIZES] == SIZES_MEAN_RADIUS or r_i == r_j:
@@ -338,8 +242,7 @@ def voronoi_a_conductance(p, r_i, r_j, dist, r_c, inputs):
         ik = (k_i + k_j) / (k_i * k_j)
         # the paths start where the two mean spheres part (no negative fluid path)
         r_lo = max(r_c, math.sqrt(max(r_p * r_p - half * half, 0.0)))
-        return model_a_integral(r_p, half, r_ij, 0.5 * ik, r_p, half, r_ij, 0.5 * ik, dist,
-                                ik_f, False, r_lo, r_sf)  # fmt: skip
+        return cone_integral(ik, 2.0 * ik_f, half, r_ij, r_p, r_lo, r_sf)
     # Gan et al. (2016), written for R_i <= R_j: s is the smaller particle, l the larger
     if r_i < r_j:
         r_s, r_l, k_s, k_l = r_i, r_j, k_i, k_j
@@ -368,18 +271,8 @@ def _quadratic_integral(u1, u2, lam):
     """∫_{u1}^{u2} du/(u² - Λ), in a form without cancellation near Λ = 0:
     (u2 - u1)/(u1 u2 - Λ) × f(ζ²), ζ² = Λ (u2 - u1)²/(u1 u2 - Λ)², f = artanh(ζ)/ζ for
     ζ² > 0, atan(|ζ|)/|ζ| for ζ² < 0, 1 + ζ²/3 + ζ⁴/5 + ... near 0."""
-    den = u1 * u2 - lam
-    ratio = (u2 - u1) / den
-    z2 = lam * ratio * ratio
-    if abs(z2) < 1e-4:
-        f = 1.0 + z2 * (1.0 / 3.0 + z2 * (0.2 + z2 * (1.0 / 7.0 + z2 / 9.0)))
-    elif z2 > 0.0:
-        z = math.sqrt(z2)
-        f = math.atanh(z) / z
-    else:
-        z = math.sqrt(-z2)
-        f = math.atan(z) / z
-    return ratio * f
+    ratio = (u2 - u1) / (u1 * u2 - lam)
+    return ratio * arctan_ratio(lam * ratio * ratio)
 
 
 @njit(cache=True, error_model="numpy")
@@ -497,7 +390,7 @@ register(
     params=VoronoiAParams,
     pack=pack_voronoi_a,
     summary="Voronoi model A: fluid conduction in the double cone of the shared Voronoi face "
-    "(quadrature)",
+    "(closed form; quadrature for gan2016's unequal radii)",
     reference=f"{_CHENG}; Gan et al. (2016) (multi-size); Norouzi et al. (2016) (mean radius); "
     f"{_ZHOU}",
     requires=("thermal_conductivity",),
