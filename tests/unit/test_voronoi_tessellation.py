@@ -124,3 +124,48 @@ def test_a_periodic_box_of_two_cells_is_refused() -> None:
     with pytest.raises(ValueError, match=r"^particle 10\d and particle 10\d share more"):
         tessellate(pos, np.full(len(pos), R), np.zeros(3), np.full(3, 2 * a), np.ones(3, bool),
                    [], "plain", np.arange(len(pos)) + 100)  # fmt: skip
+
+
+@pytest.mark.parametrize("method", ["plain", "radical"])
+def test_the_mirror_selection_by_reach_gives_the_cells_of_the_layered_one(
+    method: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A loose polydisperse heap with a rough free surface between two walls and a floor (the
+    nearest centres far from some wall points): the particles mirrored by their possible
+    reach of a plane (its nodes' distances to the nearest centre) pass the checks at the first
+    attempt and give the cells of the column-layer selection (forced by an empty first
+    selection, which fails its checks and falls back), with fewer mirrors."""
+    import thermodem.engine.tessellation as tess
+
+    rng = np.random.default_rng(5)
+    side, height = 24 * R, 30 * R
+    n = 400
+    pos = rng.uniform([R, R, R], [side - R, side - R, height], size=(n, 3))
+    # a rough surface: keep the points under a wavy height field, thin near the x walls
+    top = 10 * R + 6 * R * np.sin(pos[:, 1] / (3 * R)) ** 2 + 8 * R * (pos[:, 0] > 0.3 * side)
+    pos = pos[pos[:, 2] < top]
+    radius = rng.uniform(0.6, 1.0, pos.shape[0]) * R
+    lower, upper = np.zeros(3), np.array([side, side, height])
+    planes = box_planes(lower, upper, axes=(0, 1))
+    planes.append(Plane(np.zeros(3), np.array([0.0, 0.0, 1.0]), (), "floor"))
+    top_plane = np.array([0.0, 0.0, pos[:, 2].max() + 2 * R])
+    planes.append(Plane(top_plane, np.array([0.0, 0.0, -1.0]), (), "free surface"))
+    upper[2] = top_plane[2]
+    periodic = np.zeros(3, bool)
+    by_reach = tessellate(pos, radius, lower, upper, periodic, planes, method)
+    assert by_reach.attempts == 1
+
+    def nothing(x: np.ndarray, normals: np.ndarray, *args: object) -> list[np.ndarray]:
+        return [np.zeros(x.shape[0], bool)] * len(normals)
+
+    monkeypatch.setattr(tess, "_reaching", nothing)
+    layered = tessellate(pos, radius, lower, upper, periodic, planes, method)
+    assert layered.attempts >= 2
+    assert by_reach.mirrors < layered.mirrors
+    for name in ("pair_i", "pair_j", "wall_particle", "wall_index"):
+        assert np.array_equal(getattr(by_reach, name), getattr(layered, name)), name
+    tol = 1e-5 if method == "plain" else 1e-12  # freud's single precision
+    for name in ("pair_area", "wall_area", "volume"):
+        a, b = getattr(by_reach, name), getattr(layered, name)
+        assert np.abs(a - b).max() <= tol * np.abs(b).max(), name
+    assert by_reach.volume.sum() == pytest.approx(side * side * top_plane[2], rel=1e-6)
