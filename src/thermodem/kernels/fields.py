@@ -52,7 +52,13 @@ F_NEIGHBOUR_EMISSION = 12  # Σ_j ε_j A_j T_j⁴ / 2 over them [m² K⁴]
 F_NEIGHBOUR_AREA = 13  # Σ_j ε_j A_j / 2 over them [m²]
 F_WALL_VIEW = 14  # Σ_w F_iw over the fixed-temperature walls in view [-]
 F_WALL_EMISSION = 15  # Σ_w F_iw T_w⁴ [K⁴]
-NFIELDS = 16
+#: Scratch rows of the per-particle pass (``kernels/heat_terms.py: particle_pass``): a
+#: term's heat rate and conductance of each particle before they are added to the
+#: particle's sums. Written and read by that pass only (no provider fills them; their
+#: values between steps mean nothing).
+F_SCRATCH_HEAT = 16
+F_SCRATCH_CONDUCTANCE = 17
+NFIELDS = 18
 
 FIELD_NAMES: tuple[str, ...] = (
     "porosity",
@@ -71,6 +77,8 @@ FIELD_NAMES: tuple[str, ...] = (
     "neighbour_emissive_area",
     "wall_view_factor",
     "wall_emission",
+    "scratch_heat_rate",
+    "scratch_conductance",
 )
 
 CHUNK = 4096  # particles per chunk of the parallel passes

@@ -40,13 +40,14 @@ from numba import njit, prange
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
 from thermodem.kernels.contact import H_DURATION, H_IMPACT_VELOCITY, STATE_TOUCHING
+from thermodem.kernels.fields import F_SCRATCH_CONDUCTANCE, F_SCRATCH_HEAT
 from thermodem.kernels.neighbors import minimum_image, pair_separation, wall_distance
 from thermodem.kernels.variants import parallel_kernel
 from thermodem.models.thermal.contact_radius import (
     contact_radius_dispatch,
     geometric_contact_radius,
 )
-from thermodem.models.thermal.convection import convection_dispatch
+from thermodem.models.thermal.convection import GUNN, convection_dispatch, gunn_chunk
 from thermodem.models.thermal.direct_conduction import separated_conductance
 from thermodem.models.thermal.indirect_conduction import indirect_conduction_dispatch
 from thermodem.models.thermal.radiation import radiation_dispatch
@@ -382,24 +383,42 @@ def particle_pass(
     """One per-particle term over every particle (``table``: a row per material), and a
     second one in the same pass when ``column2`` >= 0 (two consecutive terms, e.g. convection
     and radiation: one pass over the particles and their fields; each particle adds the
-    first term, then the second, as two passes would)."""
+    first term, then the second, as two passes would).
+
+    By chunks of PARTICLE_CHUNK particles, term by term: the term's (Q, G) of the chunk's
+    particles into the scratch rows ``fields[F_SCRATCH_HEAT]``, ``fields[F_SCRATCH_
+    CONDUCTANCE]``, then added to the term's column and to ``conductance_sum`` (each
+    particle's sums receive the same numbers in the same order as particle by particle).
+    Gunn (1978) fills them in loops that vectorise (``convection.gunn_chunk``); the other
+    models particle by particle through the dispatchers."""
     n = temperature.shape[0]
     nterms = 2 if column2 >= 0 else 1
     nchunks = (n + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
     for c in prange(nchunks):
-        for i in range(c * PARTICLE_CHUNK, min(n, (c + 1) * PARTICLE_CHUNK)):
-            t_i = temperature[i]
-            r_i = radius[i]
-            # one call site of the (inlined) dispatchers: two would double the compile time
-            for k in range(nterms):
-                first = k == 0
-                ev = evaluator if first else evaluator2
-                mid = model_id if first else model_id2
-                col = column if first else column2
-                row = table[type_id[i]] if first else table2[type_id[i]]
-                q, g = particle_term(ev, mid, row, t_i, r_i, fields, i)
-                by_mechanism[col, i] += q
-                conductance_sum[i] += g
+        lo = c * PARTICLE_CHUNK
+        hi = min(n, lo + PARTICLE_CHUNK)
+        heat = fields[F_SCRATCH_HEAT, lo:hi]
+        conductance = fields[F_SCRATCH_CONDUCTANCE, lo:hi]
+        for k in range(nterms):
+            first = k == 0
+            ev = evaluator if first else evaluator2
+            mid = model_id if first else model_id2
+            col = column if first else column2
+            rows = table if first else table2
+            if ev == EVAL_CONVECTION and mid == GUNN:
+                gunn_chunk(rows, type_id, radius, temperature, fields, lo, hi, heat, conductance)
+            else:
+                # one call site of the (inlined) dispatchers: two would double the compile time
+                for i in range(lo, hi):
+                    q, g = particle_term(ev, mid, rows[type_id[i]], temperature[i], radius[i],
+                                         fields, i)  # fmt: skip
+                    heat[i - lo] = q
+                    conductance[i - lo] = g
+            into = by_mechanism[col, lo:hi]
+            sums = conductance_sum[lo:hi]
+            for t in range(hi - lo):
+                into[t] += heat[t]
+                sums[t] += conductance[t]
 
 
 @parallel_kernel(error_model="numpy")

@@ -39,6 +39,7 @@ from numba import njit, prange
 from pydantic import Field
 
 from thermodem.config.base import StrictModel
+from thermodem.kernels.fastmath_exp import fast_power
 from thermodem.kernels.fields import (
     F_FLUID_CONDUCTIVITY,
     F_FLUID_DENSITY,
@@ -202,8 +203,11 @@ def nusselt_whitaker(re, pr, viscosity_ratio):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def nusselt_gunn(re, pr_cbrt, eps):
-    """Gunn (1978): (7 - 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 - 2.4ε + 1.2ε²) Re^0.7 Pr^⅓."""
-    re02 = power(re, 0.2)
+    """Gunn (1978): (7 - 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 - 2.4ε + 1.2ε²) Re^0.7 Pr^⅓.
+    Re^0.2 from the compiled exp and log (``kernels/fastmath_exp.py``: branch-free, so the
+    particle pass's loop over a chunk of particles vectorises; the same bits whether called
+    here or there)."""
+    re02 = fast_power(re, 0.2)
     re07 = re02 * math.sqrt(re)  # Re^0.7 = Re^0.2 Re^0.5
     a = 7.0 - 10.0 * eps + 5.0 * eps * eps
     b = 1.33 - 2.4 * eps + 1.2 * eps * eps
@@ -259,6 +263,31 @@ def _newton(nu, t_i, r_i, fields, i):
     """(Q, G) = (h A (T_f - T), h A), h A = 2π R k_f Nu."""
     ha = 2.0 * math.pi * r_i * fields[F_FLUID_CONDUCTIVITY, i] * nu
     return ha * (fields[F_FLUID_TEMPERATURE, i] - t_i), ha
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def gunn_chunk(table, type_id, radius, temperature, fields, lo, hi, heat, conductance):
+    """Gunn's (Q, G) of particles lo .. hi - 1 into ``heat[i - lo]``, ``conductance[i - lo]``
+    (the particle pass's scratch rows): the operations of :func:`gunn_convection`, particle by
+    particle the same bits, in four loops over the chunk: Re (the particle's row), Nu in place,
+    G = 2π R k_f Nu, Q = G (T_f - T). The last three read contiguous rows and call no library
+    function, so LLVM vectorises them (the power is :func:`fast_power`); as one scalar loop
+    with the C library's exp and log the term took ~1.2 ms of a step on the 50k bed."""
+    m = hi - lo
+    for i in range(lo, hi):
+        heat[i - lo] = reynolds(table[type_id[i]], radius[i], fields, i)
+    eps = fields[F_POROSITY, lo:hi]
+    pr_cbrt = fields[F_PRANDTL_CBRT, lo:hi]
+    for t in range(m):
+        heat[t] = nusselt_gunn(heat[t], pr_cbrt[t], eps[t])
+    r = radius[lo:hi]
+    k_f = fields[F_FLUID_CONDUCTIVITY, lo:hi]
+    for t in range(m):
+        conductance[t] = 2.0 * math.pi * r[t] * k_f[t] * heat[t]  # as _newton
+    t_f = fields[F_FLUID_TEMPERATURE, lo:hi]
+    t_p = temperature[lo:hi]
+    for t in range(m):
+        heat[t] = conductance[t] * (t_f[t] - t_p[t])
 
 
 @njit(cache=True, error_model="numpy")
