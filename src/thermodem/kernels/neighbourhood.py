@@ -175,9 +175,16 @@ def neighbourhood_emission(area, temperature, emission):
     bits as it gives: the area holds while the listing does, only T changes)."""
     n = area.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            t = temperature[i]
-            emission[i] = area[i] * (t * t) * (t * t)
+        lo = c * CHUNK
+        hi = min(n, lo + CHUNK)
+        # over slices indexed from 0 (no negative-index wrap-around on the index): LLVM
+        # vectorises this loop (the kernel alone ~0.07 -> ~0.015 ms on the 50k bed)
+        a = area[lo:hi]
+        t_p = temperature[lo:hi]
+        out = emission[lo:hi]
+        for k in range(hi - lo):
+            t = t_p[k]
+            out[k] = a[k] * (t * t) * (t * t)
 
 
 @parallel_kernel(error_model="numpy")
