@@ -17,8 +17,13 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
+from thermodem.kernels.fastmath_log import bits_float, float_bits
 from thermodem.models.mechanics.dispatch import (
     normal_dispatch,
     rolling_dispatch,
@@ -253,23 +258,74 @@ def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, led
 
 
 # ------------------------------------------------------------------- heat generation deposits
+#: Columns of a particle's row of heat generation accumulators (``Particles.generation_energy``,
+#: one per mechanism of state/heat.GENERATION). The particle pair pass indexes the accumulators
+#: as one flat row, ``energy.reshape(energy.size)``, particle i's first column at ``i * NG``:
+#: with the row width a compile-time constant each deposit is an add at a constant offset from
+#: one address (the 2-D index multiplies by the run-time row width for every column).
+NG = len(GENERATION)
+
+
+@intrinsic
+def _prefetch(typingctx, array, index):  # noqa: ANN001, ANN201, ARG001
+    """Ask the processor to bring ``array[index]`` (1-D) into the cache for a write: LLVM's
+    ``llvm.prefetch`` (a hint; no effect on any value, and no fault on any address)."""
+    if not (isinstance(array, types.Array) and array.ndim == 1):
+        return None
+
+    def codegen(context, builder, sig, args):  # noqa: ANN001, ANN202, ARG001
+        arr = context.make_array(sig.args[0])(context, builder, args[0])
+        offset = context.cast(builder, args[1], sig.args[1], types.intp)
+        address = builder.bitcast(builder.gep(arr.data, [offset]), ir.IntType(8).as_pointer())
+        i32 = ir.IntType(32)
+        hint = ir.FunctionType(ir.VoidType(), [address.type, i32, i32, i32])
+        fn = cgutils.get_or_insert_function(builder.module, hint, "llvm.prefetch.p0")
+        builder.call(fn, [address, i32(1), i32(3), i32(1)])  # write, keep in all levels, data
+        return context.get_dummy_value()
+
+    return types.none(array, index), codegen
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def prefetch_row(energy, i):
+    """Prefetch particle i's first NG - 2 accumulators (the columns the force laws deposit
+    into; two cache lines at most) from the flat accumulators ``energy`` (:data:`NG`)."""
+    _prefetch(energy, i * NG)
+    _prefetch(energy, i * NG + NG - 3)
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def deposits(select, generation, rolls, plastic):
-    """Which deposits a pass makes, read once per pass: (sliding friction, rolling friction,
-    normal damping, tangential damping, plastic deformation), each selected (``select[g]``
-    != 0) and, for the rolling and plastic ones, possible with the pass's mechanics
-    (``rolls``: a rolling law; ``plastic``: the elasto-plastic normal law); none without
-    ``generation``. The passes give the last three as compile-time constants, so the
-    deposits of what is always zero (adding 0 changes no sum) are not compiled; and the
-    selection is read once, not at every deposit (the compiler cannot keep it in a register
-    across the stores into the accumulators, which might alias it)."""
-    return (
-        generation and select[G_SLIDING_FRICTION] != 0.0,
-        generation and rolls and select[G_ROLLING_FRICTION] != 0.0,
-        generation and select[G_NORMAL_DAMPING] != 0.0,
-        generation and select[G_TANGENTIAL_DAMPING] != 0.0,
-        generation and plastic and select[G_PLASTIC_DEFORMATION] != 0.0,
-    )
+    """Which deposits a pass makes, read once per pass: for sliding friction, rolling friction,
+    normal damping, tangential damping and plastic deformation a bit mask (int64), all ones
+    when the mechanism is selected (``select[g]`` != 0) and, for the rolling and plastic ones,
+    possible with the pass's mechanics (``rolls``: a rolling law; ``plastic``: the
+    elasto-plastic normal law), else 0; then whether rolling and plastic deposits are made at
+    all and whether any of the five is (none without ``generation``). The passes give the
+    last three arguments as compile-time constants, so the deposits of what is always zero are
+    not compiled; and the selection is read once, not at every deposit (the compiler cannot
+    keep it in a register across the stores into the accumulators, which might alias it).
+    The particle pair pass adds ``kept(e, mask)`` (e, or +0.0 unselected: a bitwise and, no
+    branch) for the other three; the wall pass tests the masks."""
+    m_slip = _mask(generation and select[G_SLIDING_FRICTION] != 0.0)
+    m_roll = _mask(generation and rolls and select[G_ROLLING_FRICTION] != 0.0)
+    m_ndamp = _mask(generation and select[G_NORMAL_DAMPING] != 0.0)
+    m_tdamp = _mask(generation and select[G_TANGENTIAL_DAMPING] != 0.0)
+    m_plastic = _mask(generation and plastic and select[G_PLASTIC_DEFORMATION] != 0.0)
+    any_force = (m_slip | m_roll | m_ndamp | m_tdamp | m_plastic) != 0
+    return (m_slip, m_roll, m_ndamp, m_tdamp, m_plastic, generation and rolls,
+            generation and plastic, any_force)  # fmt: skip
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _mask(flag):
+    return np.int64(-1) if flag else np.int64(0)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def kept(e, mask):
+    """``e`` where ``mask`` is all ones, +0.0 where it is 0 (the bits of e and the mask)."""
+    return bits_float(float_bits(e) & mask)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -277,34 +333,35 @@ def deposit_pair(
     energy, i, j, use, psi_friction, psi_other, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic
 ):
     """Add a particle pair's dissipated energies of one step [J] to the two particles'
-    accumulators of the mechanisms ``use`` (:func:`deposits`): ψ e to i, the rest to j
-    (``psi_*``: i's share of the friction heat and of the other heat, the heat generation
-    row's partition; models/thermal/heat_generation.py)."""
+    accumulators (flat, :data:`NG`) of the mechanisms ``use`` (:func:`deposits`): ψ e to i,
+    the rest to j (``psi_*``: i's share of the friction heat and of the other heat, the heat
+    generation row's partition; models/thermal/heat_generation.py)."""
     s_ndamp = psi_other * e_ndamp
     s_tdamp = psi_other * e_tdamp
     s_slip = psi_friction * e_slip
     s_roll = psi_friction * e_roll
     s_plastic = psi_other * e_plastic
-    deposit_particle(energy, i, use, s_ndamp, s_tdamp, s_slip, s_roll, s_plastic)
-    deposit_particle(energy, j, use, e_ndamp - s_ndamp, e_tdamp - s_tdamp, e_slip - s_slip,
-                     e_roll - s_roll, e_plastic - s_plastic)  # fmt: skip
+    deposit_particle(energy, i * NG, use, s_ndamp, s_tdamp, s_slip, s_roll, s_plastic)
+    deposit_particle(energy, j * NG, use, e_ndamp - s_ndamp, e_tdamp - s_tdamp,
+                     e_slip - s_slip, e_roll - s_roll, e_plastic - s_plastic)  # fmt: skip
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def deposit_particle(energy, i, use, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
+def deposit_particle(energy, base, use, e_ndamp, e_tdamp, e_slip, e_roll, e_plastic):
     """Add one particle's shares of dissipated energy [J] to its accumulators of the
-    mechanisms ``use`` (:func:`deposits`; the particle pair pass: j's share of each pair at
-    once, i's shares summed over its run of pairs in the list and added when i changes)."""
-    if use[0]:
-        energy[i, G_SLIDING_FRICTION] += e_slip
-    if use[1]:
-        energy[i, G_ROLLING_FRICTION] += e_roll
-    if use[2]:
-        energy[i, G_NORMAL_DAMPING] += e_ndamp
-    if use[3]:
-        energy[i, G_TANGENTIAL_DAMPING] += e_tdamp
-    if use[4]:
-        energy[i, G_PLASTIC_DEFORMATION] += e_plastic
+    mechanisms ``use`` (:func:`deposits`): ``energy`` flat, the particle's first column at
+    ``base`` (= i :data:`NG`). A mechanism not selected gets +0.0 (it stays 0; adding is
+    cheaper than a branch per mechanism); rolling and plastic only when the mechanics has
+    them. The particle pair pass: j's share of each pair at once, i's shares summed over its
+    run of pairs in the list and added when i changes."""
+    if use[7]:
+        energy[base + G_SLIDING_FRICTION] += kept(e_slip, use[0])
+        if use[5]:
+            energy[base + G_ROLLING_FRICTION] += kept(e_roll, use[1])
+        energy[base + G_NORMAL_DAMPING] += kept(e_ndamp, use[2])
+        energy[base + G_TANGENTIAL_DAMPING] += kept(e_tdamp, use[3])
+        if use[6]:
+            energy[base + G_PLASTIC_DEFORMATION] += kept(e_plastic, use[4])
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -321,15 +378,15 @@ def deposit_wall(
 ):  # fmt: skip
     """The same for a particle-wall pair: the particle's share into its accumulators, the
     wall's share into the ledger row (``psi_*`` = 1 for an adiabatic wall)."""
-    if use[0]:
+    if use[0] != 0:
         _deposit_wall(energy, i, G_SLIDING_FRICTION, e_slip, psi_friction, ledger_row)
-    if use[1]:
+    if use[1] != 0:
         _deposit_wall(energy, i, G_ROLLING_FRICTION, e_roll, psi_friction, ledger_row)
-    if use[2]:
+    if use[2] != 0:
         _deposit_wall(energy, i, G_NORMAL_DAMPING, e_ndamp, psi_other, ledger_row)
-    if use[3]:
+    if use[3] != 0:
         _deposit_wall(energy, i, G_TANGENTIAL_DAMPING, e_tdamp, psi_other, ledger_row)
-    if use[4]:
+    if use[4] != 0:
         _deposit_wall(energy, i, G_PLASTIC_DEFORMATION, e_plastic, psi_other, ledger_row)
 
 

@@ -35,6 +35,7 @@ from thermodem.kernels.contact import (
     L_MAX_OVERLAP_RATIO,
     L_WALL_GENERATION,
     L_WALL_WORK,
+    NG,
     STATE_FAR,
     STATE_NEAR,
     STATE_TOUCHING,
@@ -46,6 +47,7 @@ from thermodem.kernels.contact import (
     deposit_wall,
     deposits,
     kinetic_energy,
+    prefetch_row,
 )
 from thermodem.kernels.contact_conduction import _pp_conductance, reusable
 from thermodem.kernels.neighbors import pair_separation, wall_distance
@@ -54,6 +56,7 @@ from thermodem.state import history as HL
 from thermodem.state.heat import G_COLLISION, M_DIRECT
 
 WALL_CHUNK = 4096  # particles per chunk of the wall pass (one ledger row per chunk)
+WALL_AHEAD = 16  # wall pairs ahead whose particle's generation accumulators are prefetched
 
 
 _PASSES: dict[tuple, tuple] = {}
@@ -203,6 +206,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         length = upper - lower
         ngroups = group_start.shape[0] - 1
         use = deposits(gen_select, GENERATION, ROLLS, PLASTIC)  # (see contact.deposits)
+        energy = gen_energy.reshape(gen_energy.size)  # (flat: see contact.NG)
         for parity in range(2):
             for half in prange((ngroups + 1 - parity) // 2):
                 g = 2 * half + parity
@@ -219,7 +223,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                     j = pair_j[k]
                     if GENERATION and i != owner:
                         if owner >= 0:
-                            deposit_particle(gen_energy, owner, use, a_ndamp, a_tdamp, a_slip,
+                            deposit_particle(energy, owner * NG, use, a_ndamp, a_tdamp, a_slip,
                                              a_roll, a_plastic)  # fmt: skip
                         owner = i
                         a_ndamp = a_tdamp = a_slip = a_roll = a_plastic = 0.0
@@ -248,7 +252,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             ti = type_id[i]
                             tj = type_id[j]
                             deposit_pair(
-                                gen_energy, i, j, use, gen_partition[ti, tj, 0],
+                                energy, i, j, use, gen_partition[ti, tj, 0],
                                 gen_partition[ti, tj, 1], 0.0, 0.0, e_spring, e_rspring, 0.0,
                             )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
@@ -340,7 +344,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             a_roll += s_roll
                             a_plastic += s_plastic
                             deposit_particle(
-                                gen_energy, j, use, e_ndamp - s_ndamp, e_tdamp - s_tdamp,
+                                energy, j * NG, use, e_ndamp - s_ndamp, e_tdamp - s_tdamp,
                                 e_slip - s_slip, e_roll - s_roll, e_plastic - s_plastic,
                             )  # fmt: skip
                         # force on i: -F_n n + F_t; torque R n x F_t on both, rolling torque ±
@@ -381,7 +385,7 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                         conductance_sum[i] += h
                         conductance_sum[j] += h
                 if GENERATION and owner >= 0:
-                    deposit_particle(gen_energy, owner, use, a_ndamp, a_tdamp, a_slip,
+                    deposit_particle(energy, owner * NG, use, a_ndamp, a_tdamp, a_slip,
                                      a_roll, a_plastic)  # fmt: skip
 
     return particle_pair_pass
@@ -468,13 +472,20 @@ def _compile_wall_pass(GENERATION: bool, LAYOUT: tuple[int, ...], MECHANICS: tup
         n = radius.shape[0]
         nchunks = (n + WALL_CHUNK - 1) // WALL_CHUNK
         use = deposits(gen_select, GENERATION, ROLLS, PLASTIC)  # (see contact.deposits)
+        energy = gen_energy.reshape(gen_energy.size)  # (flat: see contact.NG)
         for c in prange(nchunks):
             row = chunk_ledger[c]
             for q in range(row.shape[0]):
                 row[q] = 0.0
             first = wall_row_start[c * WALL_CHUNK]
-            for k in range(first, wall_row_start[min(n, (c + 1) * WALL_CHUNK)]):
+            last = wall_row_start[min(n, (c + 1) * WALL_CHUNK)]
+            for k in range(first, last):
                 i = wall_pair_i[k]
+                if GENERATION and use[7]:
+                    # the accumulators of the particle WALL_AHEAD pairs on: the particles
+                    # touching walls are scattered through the arrays, each row a cache miss
+                    # (measured: 0.11 -> 0.05 ms of deposits per step for 3,500 wall pairs)
+                    prefetch_row(energy, wall_pair_i[min(k + WALL_AHEAD, last - 1)])
                 w = wall_pair_w[k]
                 wrow = wall_rows[w]
                 d, wnx, wny, wnz, qx, qy, qz = wall_distance(wall_kind[w], wrow, position[i])
