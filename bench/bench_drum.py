@@ -21,6 +21,16 @@ part of the drum and flow for ``--settle`` seconds while the drum turns; that st
 Prints particle-steps per second (wall clock, and per CPU second of the process, which is less
 sensitive to other processes on a shared machine) and the peak memory above the interpreter's
 baseline per particle, with the load average.
+
+``--paired`` (issue 12's measure): mechanics and ``generation`` built in one process from the
+same bed, warmed up, then timed in alternating blocks of ``--block`` steps (mechanics,
+generation, generation, mechanics, ...; both advance in step, so they see the same flow;
+short blocks pair the two cases more closely on a machine whose speed wanders), each block timed
+by the process's CPU time (and wall clock); prints the overhead of generation over mechanics
+(the ratio of the summed CPU times - 1; the wall-clock one too) and the median and quartiles
+of the per-pair block ratios, with the load average, for each thread count of ``--threads``:
+
+    python bench/bench_drum.py --paired --threads 1 2 [--blocks 100] [--block 10] [--warmup 100]
 """
 
 from __future__ import annotations
@@ -187,6 +197,40 @@ def timed(n: int, steps: int, threads: int, case: str, substeps: int, bed: Path)
     }
 
 
+def paired(n: int, bed: Path, threads: int, substeps: int, blocks: int, block: int,
+           warmup: int) -> None:  # fmt: skip
+    """Mechanics and generation in one process, timed in alternating blocks (``--paired``)."""
+    from thermodem.config.load import case_from_dict
+    from thermodem.engine.simulation import Simulation
+
+    sims = {
+        case: Simulation(case_from_dict(case_dict(n, str(bed), case, substeps)), threads=threads)
+        for case in ("mechanics", "generation")
+    }
+    for sim in sims.values():
+        sim.run(steps=warmup)
+    load = os.getloadavg()[0]
+    cpu: dict[str, list[float]] = {case: [] for case in sims}
+    wall: dict[str, list[float]] = {case: [] for case in sims}
+    for b in range(blocks):
+        order = list(sims.items()) if b % 2 == 0 else list(sims.items())[::-1]  # (ABBA...)
+        for case, sim in order:
+            c0, t0 = time.process_time(), time.perf_counter()
+            sim.run(steps=block)
+            cpu[case].append(time.process_time() - c0)
+            wall[case].append(time.perf_counter() - t0)
+    mech, gen = np.array(cpu["mechanics"]), np.array(cpu["generation"])
+    q1, med, q3 = np.percentile(gen / mech - 1.0, [25, 50, 75])
+    wall_over = sum(wall["generation"]) / sum(wall["mechanics"]) - 1.0
+    steps = blocks * block
+    print(f"threads {threads}, {n} particles, {blocks} blocks of {block} steps, load "
+          f"{load:.2f} -> {os.getloadavg()[0]:.2f}: mechanics {1e3 * mech.sum() / steps:.3f} "
+          f"ms/step, generation {1e3 * gen.sum() / steps:.3f} ms/step (CPU); generation "
+          f"overhead {gen.sum() / mech.sum() - 1.0:+.1%} per CPU s (block ratios: median "
+          f"{med:+.1%}, quartiles {q1:+.1%} .. {q3:+.1%}), {wall_over:+.1%} wall clock",
+          flush=True)  # fmt: skip
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=BASE)
@@ -202,9 +246,17 @@ def main() -> None:
         help="rounds of every case in turn; medians and per-round overheads",
     )
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--paired", action="store_true", help="mechanics vs generation, one process")
+    ap.add_argument("--blocks", type=int, default=100, help="--paired: timed blocks of each case")
+    ap.add_argument("--block", type=int, default=10, help="--paired: steps per block")
+    ap.add_argument("--warmup", type=int, default=100, help="--paired: steps before timing")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     bed = settle(args.n, args.settle)
+    if args.paired:
+        for th in args.threads:
+            paired(args.n, bed, th, args.substeps, args.blocks, args.block, args.warmup)
+        return
     if args.child:
         res = timed(args.n, args.steps, args.threads[0], args.cases[0], args.substeps, bed)
         print(json.dumps(res))
