@@ -20,7 +20,7 @@ def test_voronoi_example_runs(tmp_path: Path) -> None:
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-2000:]
     log = (out / "run.log").read_text(encoding="utf-8")
-    assert "tessellation 2 (plain)" in log and "mirror particles" in log
+    assert "tessellation 2 (plain)" in log and "compiled clipped cells" in log
     rows = list(csv.DictReader((out / "timeseries.csv").open(encoding="utf-8")))
     last = rows[-1]
     gas = float(last["heat_in_wall_indirect_conduction"])

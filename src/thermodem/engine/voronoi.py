@@ -6,8 +6,8 @@ the face's area A_n as input; its wall pairs are the cells' faces on flat walls.
 :class:`VoronoiProvider` fills it on its update policy (``thermal.tessellation``), and the
 ``voronoi`` porosity provider reads its cell volumes (ε_i = 1 - V_particle / V_cell).
 
-The tessellation itself (freud or pyvoro2, the clipping planes and mirror particles, the
-checks, the walls a face lies on) is ``engine/tessellation.py``.
+The tessellation itself (compiled clipped cells, or freud / pyvoro2 with mirror particles,
+the clipping planes, the checks, the walls a face lies on) is ``engine/tessellation.py``.
 
 Checkpoints: the pairs and inputs are the external set's; the provider saves its counters and
 the reference positions of its last tessellation, so a restart continues bit-identically.
@@ -191,12 +191,16 @@ class VoronoiProvider:
         self.seconds += self.last_seconds
         if self.count <= 3 or self.count % 10 == 0:
             pairs = faces.pair_i.size
+            how = (
+                "compiled clipped cells"
+                if faces.attempts == 0
+                else f"library cells with {faces.mirrors} mirror particles ({faces.attempts} "
+                f"attempt{'s' if faces.attempts > 1 else ''})"
+            )
             warnings.warn(
                 f"tessellation {self.count} ({self.settings.method}) at step {sim.step_count}: "
                 f"{p.count} cells, {pairs} faces between particles, {faces.wall_area.size} on "
-                "clipping planes, "
-                f"{faces.mirrors} mirror particles ({faces.attempts} attempt"
-                f"{'s' if faces.attempts > 1 else ''}), {self.last_seconds:.3g} s; "
+                f"clipping planes, {how}, {self.last_seconds:.3g} s; "
                 f"{self.seconds:.3g} s in {self.count} tessellations so far",
                 RunNotice,
                 stacklevel=2,
