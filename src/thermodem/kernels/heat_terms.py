@@ -408,12 +408,14 @@ def particle_pass(
             if ev == EVAL_CONVECTION and mid == GUNN:
                 gunn_chunk(rows, type_id, radius, temperature, fields, lo, hi, heat, conductance)
             else:
-                # one call site of the (inlined) dispatchers: two would double the compile time
-                for i in range(lo, hi):
-                    q, g = particle_term(ev, mid, rows[type_id[i]], temperature[i], radius[i],
-                                         fields, i)  # fmt: skip
-                    heat[i - lo] = q
-                    conductance[i - lo] = g
+                # one call site of the (inlined) dispatchers: two would double the compile
+                # time; an unsigned index (no negative-index wrap-around on its loads)
+                for t in range(hi - lo):
+                    i = np.uint64(lo + t)
+                    q, g = particle_term(ev, mid, rows[np.uint32(type_id[i])], temperature[i],
+                                         radius[i], fields, i)  # fmt: skip
+                    heat[t] = q
+                    conductance[t] = g
             into = by_mechanism[col, lo:hi]
             sums = conductance_sum[lo:hi]
             for t in range(hi - lo):

@@ -274,8 +274,9 @@ def gunn_chunk(table, type_id, radius, temperature, fields, lo, hi, heat, conduc
     function, so LLVM vectorises them (the power is :func:`fast_power`); as one scalar loop
     with the C library's exp and log the term took ~1.2 ms of a step on the 50k bed."""
     m = hi - lo
-    for i in range(lo, hi):
-        heat[i - lo] = reynolds(table[type_id[i]], radius[i], fields, i)
+    for t in range(m):
+        i = np.uint64(lo + t)  # (unsigned: no negative-index wrap-around on the loads)
+        heat[t] = reynolds(table[np.uint32(type_id[i])], radius[i], fields, i)
     eps = fields[F_POROSITY, lo:hi]
     pr_cbrt = fields[F_PRANDTL_CBRT, lo:hi]
     for t in range(m):
