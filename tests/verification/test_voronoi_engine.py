@@ -64,11 +64,18 @@ def lattice_case(tmp_path: Path, model: str, cells: int, gap: float, **thermal) 
     }
 
 
-@pytest.mark.parametrize("model", ["voronoi_a", "voronoi_b"])
-def test_simple_cubic_lattice_heat_is_the_models_on_cubes(tmp_path: Path, model: str) -> None:
+@pytest.mark.parametrize(("model", "backend"), [("voronoi_a", "compiled"),
+                                               ("voronoi_b", "compiled"),
+                                               ("voronoi_a", "library")])  # fmt: skip
+def test_simple_cubic_lattice_heat_is_the_models_on_cubes(tmp_path: Path, model: str,
+                                                          backend: str) -> None:  # fmt: skip
     gap = 0.05 * R
-    sim = Simulation(case_from_dict(lattice_case(tmp_path, model, 4, gap)))
-    sim.run(steps=2)
+    case = lattice_case(tmp_path, model, 4, gap)
+    case["thermal"]["tessellation"] = {"backend": backend}
+    with pytest.warns(RuntimeWarning, match="compiled clipped cells" if backend == "compiled"
+                      else "library cells with"):  # fmt: skip
+        sim = Simulation(case_from_dict(case))
+        sim.run(steps=2)
     sim.thermal.compute_rates(sim.time)  # the rates of the current temperatures
     p = sim.particles
     k_f = GasProperties().thermal_conductivity
@@ -99,9 +106,10 @@ def test_simple_cubic_lattice_heat_is_the_models_on_cubes(tmp_path: Path, model:
                 else:
                     wall_q[k] += h_wall * (350.0 - t[k])
     by = p.heat_rate_by_mechanism
-    # freud computes the faces in single precision: areas to ~1e-7
-    assert by[:, heat.M_INDIRECT] == pytest.approx(pair_q, rel=1e-7, abs=1e-9 * abs(pair_q).max())
-    assert by[:, heat.M_WALL_INDIRECT] == pytest.approx(wall_q, rel=1e-7)
+    # freud computes the faces in single precision: areas to ~1e-7; the compiled cells in double
+    rel, small = (1e-7, 1e-9) if backend == "library" else (1e-12, 1e-12)
+    assert by[:, heat.M_INDIRECT] == pytest.approx(pair_q, rel=rel, abs=small * abs(pair_q).max())
+    assert by[:, heat.M_WALL_INDIRECT] == pytest.approx(wall_q, rel=rel)
     assert sim.thermal.voronoi.count == 1  # frozen: one tessellation
     assert sim.thermal.external.count == 3 * 4 * 4 * 3
 

@@ -200,13 +200,19 @@ class TessellationSettings(StrictModel):
     mechanical steps have passed since the last one, or when a particle has moved more than
     ``displacement_ratio`` × R_min since the last one (like a neighbour skin); with neither
     (or frozen mechanics) it is made once. Non-periodic domain faces and plane walls clip the
-    cells (mirror particles); the cell faces on walls are the particle-wall faces.
+    cells; the cell faces on walls are the particle-wall faces.
     """
 
     method: Literal["plain", "radical"] = Field(
         default="plain",
-        description="plain: Voronoi (freud); radical: the radical (Laguerre, power) "
-        "tessellation of the spheres (pyvoro2), for polydisperse beds",
+        description="plain: Voronoi; radical: the radical (Laguerre, power) tessellation of "
+        "the spheres, for polydisperse beds",
+    )
+    backend: Literal["compiled", "library"] = Field(
+        default="compiled",
+        description="compiled: thermodem's clipped cells in double precision (the library "
+        "when a check fails, said in run.log); library: freud (plain) or pyvoro2 (radical) "
+        "with mirror particles",
     )
     every_steps: int | None = Field(
         default=None, ge=1, description="re-tessellate every this many mechanical steps"

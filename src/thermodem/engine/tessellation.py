@@ -105,6 +105,8 @@ class Faces:
     volume: np.ndarray
     mirrors: int
     attempts: int
+    #: the compiled cells were tried and failed their checks (the library made these)
+    fallback: bool = False
 
 
 # ------------------------------------------------------------------------- geometry
@@ -312,8 +314,9 @@ def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, uppe
     """The clipped Voronoi (or radical) tessellation of the spheres (see the module
     docstring). Raises ValueError with the reason if it cannot be made, naming particles by
     ``global_id`` (as the case and the outputs do; without it by their index here).
-    ``backend``: "auto" (the compiled cells, the libraries if their check fails), "compiled"
-    (None of the fallback: a ValueError instead), "library" (freud or pyvoro2 with mirrors)."""
+    ``backend``: "auto" (the compiled cells, the libraries if their check fails; the result
+    says so in ``fallback``), "compiled" (no fallback: a ValueError instead), "library"
+    (freud or pyvoro2 with mirrors)."""
 
     def particle(k: int) -> str:
         if global_id is None:
@@ -351,6 +354,9 @@ def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, uppe
             return _collect(*cells, unit, particle, 0, 0)
         if backend == "compiled":
             raise ValueError("the compiled cells did not pass their checks")
+        fallback = True
+    else:
+        fallback = False
     spread = r_max**2 - (float(radius.min()) / unit) ** 2 if method == "radical" else 0.0
     reaching = _reaching(x, normals, points, spread, (FREE_SURFACE + 2.0) * r_max)
     depth: list[np.ndarray] = []
@@ -431,8 +437,10 @@ def tessellate(position: np.ndarray, radius: np.ndarray, lower: np.ndarray, uppe
         raise ValueError(f"the tessellation failed: {reason}")
     sel = real & big
     w = m & own & big
-    return _collect(cell[sel], nbr[sel], area[sel], cell[w], plane_of[nbr[w] - n], area[w],
-                    volume, unit, particle, int(origin.size), attempt)  # fmt: skip
+    faces = _collect(cell[sel], nbr[sel], area[sel], cell[w], plane_of[nbr[w] - n], area[w],
+                     volume, unit, particle, int(origin.size), attempt)  # fmt: skip
+    faces.fallback = fallback
+    return faces
 
 
 def _collect(a: np.ndarray, b: np.ndarray, face: np.ndarray, w_cell: np.ndarray,

@@ -161,8 +161,9 @@ class VoronoiProvider:
                 stacklevel=2,
             )
         try:
+            backend = "auto" if self.settings.backend == "compiled" else "library"
             faces = tessellate(p.position, p.radius, lower, upper, sim.periodic, planes,
-                               self.settings.method, p.global_id)  # fmt: skip
+                               self.settings.method, p.global_id, backend)  # fmt: skip
         except ValueError as exc:
             raise SimulationError(
                 f"thermal.tessellation ({self.settings.method}): {exc} (step {sim.step_count}, "
@@ -189,7 +190,7 @@ class VoronoiProvider:
         self.mirrors = faces.mirrors
         self.last_seconds = wallclock.perf_counter() - started
         self.seconds += self.last_seconds
-        if self.count <= 3 or self.count % 10 == 0:
+        if self.count <= 3 or self.count % 10 == 0 or faces.fallback:
             pairs = faces.pair_i.size
             how = (
                 "compiled clipped cells"
@@ -197,6 +198,8 @@ class VoronoiProvider:
                 else f"library cells with {faces.mirrors} mirror particles ({faces.attempts} "
                 f"attempt{'s' if faces.attempts > 1 else ''})"
             )
+            if faces.fallback:
+                how = f"the compiled cells failed their check: {how}"
             warnings.warn(
                 f"tessellation {self.count} ({self.settings.method}) at step {sim.step_count}: "
                 f"{p.count} cells, {pairs} faces between particles, {faces.wall_area.size} on "
