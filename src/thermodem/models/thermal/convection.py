@@ -202,16 +202,29 @@ def nusselt_whitaker(re, pr, viscosity_ratio):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def nusselt_gunn(re, pr_cbrt, eps):
-    """Gunn (1978): (7 - 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 - 2.4ε + 1.2ε²) Re^0.7 Pr^⅓.
-    Re^0.2 from the compiled exp and log (``kernels/fastmath_exp.py``: branch-free, so the
-    particle pass's loop over a chunk of particles vectorises; the same bits whether called
-    here or there)."""
-    re02 = fast_power(re, 0.2)
+def gunn_from_power(re02, re, pr_cbrt, eps):
+    """Gunn's Nu from Re^0.2 (``re02``) and Re (see :func:`nusselt_gunn`)."""
     re07 = re02 * math.sqrt(re)  # Re^0.7 = Re^0.2 Re^0.5
     a = 7.0 - 10.0 * eps + 5.0 * eps * eps
     b = 1.33 - 2.4 * eps + 1.2 * eps * eps
     return a * (1.0 + 0.7 * re02 * pr_cbrt) + b * re07 * pr_cbrt
+
+
+@njit(cache=True, error_model="numpy")
+def gunn_power(re):
+    """Re^0.2 by :func:`fast_power`, compiled once and called (not inlined) from the
+    particle-by-particle paths (the model's kernel, the dispatchers, the validity check):
+    :func:`gunn_chunk` inlines the same operations where they vectorise."""
+    return fast_power(re, 0.2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def nusselt_gunn(re, pr_cbrt, eps):
+    """Gunn (1978): (7 - 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^⅓) + (1.33 - 2.4ε + 1.2ε²) Re^0.7 Pr^⅓.
+    Re^0.2 from the compiled exp and log (``kernels/fastmath_exp.py``: branch-free, so the
+    particle pass's loop over a chunk of particles vectorises, :func:`gunn_chunk`; IEEE
+    operations only, so the same bits there and here)."""
+    return gunn_from_power(gunn_power(re), re, pr_cbrt, eps)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -265,7 +278,7 @@ def _newton(nu, t_i, r_i, fields, i):
     return ha * (fields[F_FLUID_TEMPERATURE, i] - t_i), ha
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def gunn_chunk(table, type_id, radius, temperature, fields, lo, hi, heat, conductance):
     """Gunn's (Q, G) of particles lo .. hi - 1 into ``heat[i - lo]``, ``conductance[i - lo]``
     (the particle pass's scratch rows): the operations of :func:`gunn_convection`, particle by
@@ -280,7 +293,8 @@ def gunn_chunk(table, type_id, radius, temperature, fields, lo, hi, heat, conduc
     eps = fields[F_POROSITY, lo:hi]
     pr_cbrt = fields[F_PRANDTL_CBRT, lo:hi]
     for t in range(m):
-        heat[t] = nusselt_gunn(heat[t], pr_cbrt[t], eps[t])
+        re = heat[t]
+        heat[t] = gunn_from_power(fast_power(re, 0.2), re, pr_cbrt[t], eps[t])
     r = radius[lo:hi]
     k_f = fields[F_FLUID_CONDUCTIVITY, lo:hi]
     for t in range(m):
