@@ -4,11 +4,11 @@ faces on walls. The geometry only: :class:`~thermodem.engine.voronoi.VoronoiProv
 
 **Compiled cells first.** Each particle's cell is clipped from a box by the clipping planes
 and by its neighbours' bisectors (``plain``) or power planes (``radical``) in double
-precision (``kernels/voronoi_cells.py``; no mirror particles, parallel over particles); the
+precision (``kernels/voronoi_cells.py``; no mirror particles, serial); the
 cells are used when every one fit its buffers, none reached its starting box and their
 volumes add up to the clipped domain's (to 1e-6; ~1e-15 measured). Otherwise the libraries
-below run, with their own checks (the 50k settled bed: 1.2 s on 1 thread, 0.9 s on 2, against
-2-3.6 s for freud with mirrors).
+below run, with their own checks (the 50k settled bed: 1.2 s against 2-3.6 s for freud with
+mirrors).
 
 **Libraries.** ``method: plain``: freud (``freud.locality.Voronoi``, voro++ inside, periodic
 boxes, face areas as neighbour-list weights). freud needs coordinates of order 1: in metres
