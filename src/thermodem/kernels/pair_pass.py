@@ -207,6 +207,10 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
         ngroups = group_start.shape[0] - 1
         use = deposits(gen_select, GENERATION, ROLLS, PLASTIC)  # (see contact.deposits)
         energy = gen_energy.reshape(gen_energy.size)  # (flat: see contact.NG)
+        # the partition table (types, types, 2) flat too, a row of type i's pairs 2 ntypes wide
+        # (measured: ~0.1-0.2 ms of the drum's 0.65 ms of deposits per step against the 3-D index)
+        shares = gen_partition.reshape(gen_partition.size)
+        shares_row = 2 * gen_partition.shape[1]
         for parity in range(2):
             for half in prange((ngroups + 1 - parity) // 2):
                 g = 2 * half + parity
@@ -249,11 +253,10 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             k, history, H_SPRING, H_ROLL, out_normal_force, out_state, row
                         )
                         if GENERATION and (e_spring != 0.0 or e_rspring != 0.0):
-                            ti = type_id[i]
-                            tj = type_id[j]
+                            at = type_id[i] * shares_row + 2 * type_id[j]
                             deposit_pair(
-                                energy, i, j, use, gen_partition[ti, tj, 0],
-                                gen_partition[ti, tj, 1], 0.0, 0.0, e_spring, e_rspring, 0.0,
+                                energy, i, j, use, shares[at], shares[at + 1], 0.0, 0.0,
+                                e_spring, e_rspring, 0.0,
                             )  # fmt: skip
                         out_state[k] = STATE_NEAR if -overlap < extra else STATE_FAR
                     else:
@@ -331,8 +334,9 @@ def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRI
                             row,
                         )
                         if GENERATION and dt > 0.0:  # (none at the t = 0 evaluation)
-                            psi_f = gen_partition[ti, tj, 0]
-                            psi_o = gen_partition[ti, tj, 1]
+                            at = ti * shares_row + 2 * tj  # (gen_partition[ti, tj])
+                            psi_f = shares[at]
+                            psi_o = shares[at + 1]
                             s_ndamp = psi_o * e_ndamp
                             s_tdamp = psi_o * e_tdamp
                             s_slip = psi_f * e_slip
