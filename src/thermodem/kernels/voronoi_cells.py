@@ -179,6 +179,27 @@ def _cut(nv, nf, verts, loops, face_len, face_label, normal, t, label, work):
 
 
 @njit(cache=True)
+def _sort_by_distance(cand, cand_j, nc):
+    """Shell sort of the first ``nc`` candidates by their squared distance (column 3)."""
+    gap = 1
+    while gap < nc // 3:
+        gap = 3 * gap + 1
+    while gap >= 1:
+        for k in range(gap, nc):
+            x0, x1, x2, x3 = cand[k, 0], cand[k, 1], cand[k, 2], cand[k, 3]
+            jk = cand_j[k]
+            q = k
+            while q >= gap and cand[q - gap, 3] > x3:
+                for c in range(4):
+                    cand[q, c] = cand[q - gap, c]
+                cand_j[q] = cand_j[q - gap]
+                q -= gap
+            cand[q, 0], cand[q, 1], cand[q, 2], cand[q, 3] = x0, x1, x2, x3
+            cand_j[q] = jk
+        gap //= 3
+
+
+@njit(cache=True)
 def _farthest(nv, verts):
     best = 0.0
     for v in range(nv):
@@ -314,10 +335,10 @@ def voronoi_cells(x, weight, spread, lo, hi, periodic, plane_normal, plane_point
                                     nc += 1
                 if status != OK:
                     break
-                order = np.argsort(cand[:nc, 3])
+                _sort_by_distance(cand, cand_j, nc)
                 vmax = _farthest(nv, verts)
                 for k in range(nc):
-                    c = order[k]
+                    c = k
                     d2 = cand[c, 3]
                     d = math.sqrt(d2)
                     if (d2 - spread) / (2.0 * d) >= vmax:
