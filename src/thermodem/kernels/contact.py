@@ -404,3 +404,12 @@ def collision_loss(history, k, h_collision, kinetic_now):
     """Kinetic energy the pair of row k lost since its collision started (the value kept at
     the first touching pass), clipped at 0 (Al-Arkawazi 2017, ΔU; documented)."""
     return max(history[k, h_collision] - kinetic_now, 0.0)
+
+
+def dissipates(mechanics: tuple[int, ...], layout: tuple[int, ...]) -> tuple[bool, bool]:
+    """(rolling friction, plastic deformation): whether the mechanics combination can
+    dissipate by them, a compile-time constant of the passes (:func:`thermodem.kernels.contact.
+    deposits`): a rolling law (id != 0; without one the rolling terms are zero) and the
+    elasto-plastic normal law, the one law that keeps a normal history column
+    (models/mechanics/normal.py: the elastic laws return a plastic energy of 0)."""
+    return int(mechanics[2]) != 0, int(layout[history_layout.NORMAL]) >= 0
