@@ -339,7 +339,6 @@ def pre_run_checks(sim: Simulation) -> list[str]:
     case = sim.case
     notes: list[str] = []
     try:
-        check_contact_law_agreement(case)
         check_step_count(sim)
         on_every_rank(sim, check_wall_overlaps)
         check_pour_walls(sim)
@@ -386,13 +385,15 @@ def built_simulation(
     case: Case, threads: int | None = None, build: Callable[[], Simulation] | None = None
 ) -> Simulation:
     """``Simulation(case)`` of a fresh run (``validate``, ``run``, ``etc``; ``build``: another
-    constructor, the MPI runner's): a SimulationError met while it is built, before step 0
-    (a periodic axis shorter than two neighbour cells of the inserted particles, a
-    tessellation the start positions cannot make), is an error of the input, not of a run: a
-    ConfigError with its message (exit code 2). Failures met while the run steps stay
-    SimulationErrors."""
+    constructor, the MPI runner's), after the checks that need the case alone and would
+    otherwise wait for the first kernels to compile. A SimulationError met while it is
+    built, before step 0 (a periodic axis shorter than two neighbour cells of the inserted
+    particles, a tessellation the start positions cannot make), is an error of the input,
+    not of a run: a ConfigError with its message (exit code 2). Failures met while the run
+    steps stay SimulationErrors."""
     from thermodem.engine.simulation import Simulation
 
+    check_contact_law_agreement(case)  # the case alone: before any kernel compiles
     try:
         return build() if build is not None else Simulation(case, threads=threads)
     except SimulationError as exc:
