@@ -218,20 +218,33 @@ def test_implicit_scheme_needs_frozen_mechanics(tmp_path: Path) -> None:
 
 
 def test_multigrid_and_jacobi_paths_match_direct_solve(tmp_path: Path) -> None:
-    thermal = {"time_step": 0.3, "scheme": "backward_euler"}
-    a = _sim(_column(tmp_path, 10), thermal, walls=HOT_FLOOR)
-    b = _sim(_column(tmp_path, 10), thermal, walls=HOT_FLOOR)
-    c = _sim(_column(tmp_path, 10), {**thermal, "implicit": {"preconditioner": "jacobi"}},
-             walls=HOT_FLOOR)  # fmt: skip
-    b.thermal.implicit.direct_below = 0  # CG + smoothed aggregation even for 10 unknowns
-    c.thermal.implicit.direct_below = 0
-    for sim in (a, b, c):
-        sim.run(steps=5)
-    np.testing.assert_allclose(_by_gid(b), _by_gid(a), rtol=1e-10)
-    np.testing.assert_allclose(_by_gid(c), _by_gid(a), rtol=1e-10)
-    assert c.thermal.implicit.timings.setups == 0 and c.thermal.implicit.timings.cg_iterations
-    assert b.thermal.implicit.timings.setups == 1  # one hierarchy for the constant matrix
-    assert isinstance(b.thermal.implicit, ImplicitSolver)
+    """CG with multigrid, with the diagonal and with ``auto`` (the default) equal the direct
+    solve; ``auto`` takes the diagonal where the capacity term bounds the condition number
+    (Δt = 0.3 s, κ ≤ 2 (1 + Δt ΣH/(m c)) ≈ 2) and multigrid where it does not (Δt = 1e5 s,
+    ~1e4 × m c/ΣH)."""
+    for dt, auto in ((0.3, 0), (1e5, 1)):
+        thermal = {"time_step": dt, "scheme": "backward_euler"}
+        sims = [
+            _sim(
+                _column(tmp_path, 10),
+                {**thermal, "implicit": {"preconditioner": choice}},
+                walls=HOT_FLOOR,
+            )
+            for choice in ("auto", "amg", "jacobi", "auto")
+        ]
+        for sim in sims[1:]:
+            sim.thermal.implicit.direct_below = 0  # CG even for 10 unknowns
+        for sim in sims:
+            sim.run(steps=5)
+        for sim in sims[1:]:
+            np.testing.assert_allclose(_by_gid(sim), _by_gid(sims[0]), rtol=1e-10)
+            assert sim.thermal.implicit.timings.cg_iterations
+        timings = [sim.thermal.implicit.timings for sim in sims]
+        assert timings[0].cg_iterations == 0  # (direct)
+        assert timings[1].setups == 1  # one hierarchy for the constant matrix
+        assert timings[2].setups == 0
+        assert timings[3].setups == auto
+        assert isinstance(sims[1].thermal.implicit, ImplicitSolver)
 
 
 def test_rannacher_start_keeps_second_order_and_damps_the_stiff_start(tmp_path: Path) -> None:
@@ -273,3 +286,107 @@ def test_a_failed_solve_names_the_step_being_computed(tmp_path: Path) -> None:
         sim.run(steps=5)
     assert "at step 1 (t = 0.3 s)" in str(failed.value), str(failed.value)
     assert failed.value.step == 1
+
+
+def test_a_linear_network_skips_the_passes_while_its_data_hold(tmp_path: Path) -> None:
+    """Backward Euler on a chain over a wall equals the recursion
+    (C/Δt + K) Tⁿ⁺¹ = C/Δt Tⁿ + b(tⁿ⁺¹) written here (K: the chain's bonds and the wall's
+    Batchelor & O'Brien conductance 4 k̄ R_c, k̄ = k/2, geometric R_c): with the wall at
+    400 K the data of b do not change and a step reuses K and b (one pass of the engine per
+    step, for the ledger); with the wall ramped, 400 + 0.05 t, b changes every step and the
+    network's pass runs again (two per step)."""
+    n, gap, dt, steps = 9, 1e-5, 50.0, 6
+    h_wall = 2.0 * K * math.sqrt(R**2 - (R - gap) ** 2)
+    k = np.diag(np.r_[H + h_wall, np.full(n - 2, 2.0 * H), H])
+    k -= H * (np.eye(n, k=1) + np.eye(n, k=-1))
+    cap = MASS * C / dt
+    path = _write(tmp_path / "chain.txt", [(i * D, 0.0, 0.0, R, 300.0) for i in range(n)])
+    for wall_t, per_step, first in (("400", 1, 1), ("400 + 0.05 * t", 2, 0)):
+        thermal_wall = {"kind": "fixed", "temperature": wall_t}
+        wall = [{"kind": "plane", "point": [-R + gap, 0, 0], "normal": [1, 0, 0],
+                 "material": "glass", "thermal": thermal_wall}]  # fmt: skip
+        sim = _sim(path, {"time_step": dt, "scheme": "backward_euler"}, walls=wall)
+        eng = sim.thermal
+        passes = [0]
+        evaluate = eng.compute_rates
+
+        def counted(time: float, evaluate=evaluate, passes=passes) -> np.ndarray:  # noqa: ANN001
+            passes[0] += 1
+            return evaluate(time)
+
+        eng.compute_rates = counted
+        t = np.full(n, 300.0)
+        for step in range(1, steps + 1):
+            sim.run(steps=1)
+            b = np.zeros(n)
+            b[0] = h_wall * (400.0 + (0.05 * step * dt if first == 0 else 0.0))
+            t = np.linalg.solve(cap * np.eye(n) + k, cap * t + b)
+            np.testing.assert_allclose(_by_gid(sim), t, rtol=1e-12)
+        assert passes[0] == per_step * steps + first
+
+
+def test_conjugate_gradients_error_bound_holds_against_the_direct_solve() -> None:
+    """a = C' + L (L the Laplacian of a random graph with random conductances and a few
+    links to fixed nodes, C' a random capacity term): stopped by Σ rᵢ²/C'ᵢ ≤ ε² ΣC', the
+    capacity-weighted RMS error against the direct solve is ≤ ε (the bound
+    eᵀC'e ≤ rᵀC'⁻¹r; a conservative one: measured 6e-5 to 0.04 ε), and the stop comes before
+    the relative residual 1e-10."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from thermodem.engine.implicit_solve import conjugate_gradients
+
+    rng = np.random.default_rng(7)
+    n, pairs = 2000, 8000
+    i, j = rng.integers(0, n, pairs), rng.integers(0, n, pairs)
+    keep = i != j
+    h = rng.uniform(0.1, 10.0, keep.sum())
+    lap = sp.coo_matrix((np.r_[-h, -h], (np.r_[i[keep], j[keep]], np.r_[j[keep], i[keep]])),
+                        shape=(n, n)).tocsr()  # fmt: skip
+    lap -= sp.diags(np.asarray(lap.sum(axis=1)).ravel())
+    to_fixed = np.where(rng.random(n) < 0.05, rng.uniform(0.1, 10.0, n), 0.0)
+    for scale in (1e-3, 1.0):  # stiff (capacity ≪ conductances) and mild
+        c = scale * rng.uniform(0.5, 2.0, n)
+        a = (lap + sp.diags(c + to_fixed)).tocsr()
+        r = rng.normal(size=n)
+        exact = spla.spsolve(a.tocsc(), r)
+        for eps in (1e-2, 1e-5):
+            stop = 1e-10 * np.linalg.norm(r)
+            x, count, ok = conjugate_gradients(a, r, 1.0 / a.diagonal(), stop, 5000, 1.0 / c,
+                                               eps**2 * c.sum())  # fmt: skip
+            assert ok
+            error = np.sqrt(np.sum(c * (x - exact) ** 2) / c.sum())
+            assert error <= eps
+            _, full, _ = conjugate_gradients(a, r, 1.0 / a.diagonal(), stop, 5000)
+            assert count < full
+
+
+@pytest.mark.parametrize("scheme", ["backward_euler", "crank_nicolson", "tr_bdf2"])
+def test_restart_over_a_hot_wall_is_bit_identical(tmp_path: Path, scheme: str) -> None:
+    """A chain over a wall at 400 K (b ≠ 0: the wall's conductance) with conjugate gradients:
+    the restarted run reuses b from its first pass, the uninterrupted one from its last
+    pass at the same state, so the two agree bit for bit."""
+    from thermodem.io.checkpoint import checkpoint_name, write_checkpoint
+
+    n, gap = 9, 1e-5
+    path = _write(tmp_path / "chain.txt", [(i * D, 0.0, 0.0, R, 300.0) for i in range(n)])
+    wall = [{"kind": "plane", "point": [-R + gap, 0, 0], "normal": [1, 0, 0],
+             "material": "glass", "thermal": {"kind": "fixed", "temperature": 400.0}}]  # fmt: skip
+    thermal = {"time_step": 20.0, "scheme": scheme, "implicit": {"preconditioner": "jacobi"}}
+
+    def sim() -> Simulation:
+        s = _sim(path, thermal, walls=wall)
+        s.thermal.implicit.direct_below = 0
+        return s
+
+    reference = sim()
+    reference.run(steps=6)
+    first = sim()
+    first.run(steps=3)
+    saved = write_checkpoint(first, tmp_path / checkpoint_name(first.step_count))
+    second = Simulation.from_checkpoint(saved)
+    second.thermal.implicit.direct_below = 0
+    second.run(steps=3)
+    assert np.array_equal(second.particles.temperature, reference.particles.temperature)
+    assert second.thermal.cumulative == reference.thermal.cumulative
+    assert reference.thermal.implicit.timings.cg_iterations > 0

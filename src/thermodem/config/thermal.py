@@ -241,10 +241,11 @@ class ImplicitSettings(StrictModel):
         default=1e-10, gt=0, lt=1, description="relative residual of the conjugate gradients"
     )
     max_iterations: int = Field(default=1000, ge=1, description="conjugate-gradient iterations")
-    preconditioner: Literal["amg", "jacobi"] = Field(
-        default="amg",
+    preconditioner: Literal["auto", "amg", "jacobi"] = Field(
+        default="auto",
         description="preconditioner of the conjugate gradients: smoothed-aggregation algebraic "
-        "multigrid (pyamg) or the diagonal (Jacobi)",
+        "multigrid (pyamg) or the diagonal (Jacobi); auto: the diagonal for a time step whose "
+        "capacity term bounds the condition number by 1000, else multigrid",
     )
     picard_tolerance: float = Field(
         default=1e-8,

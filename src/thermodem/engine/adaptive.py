@@ -53,6 +53,8 @@ A = 1.0 / (GAMMA * (2.0 - GAMMA))
 B = (1.0 - GAMMA) ** 2 / (GAMMA * (2.0 - GAMMA))
 W = A * D  # quadrature weight of the first two stages (√2/4); the third is D
 K3 = (-3.0 * GAMMA**2 + 4.0 * GAMMA - 2.0) / (12.0 * (2.0 - GAMMA))
+#: the linear solves of a stage stop when their error is bounded by this × error_tolerance
+SOLVE_FRACTION = 0.01
 
 
 class AdaptiveTRBDF2:
@@ -135,8 +137,9 @@ class AdaptiveTRBDF2:
         if self._previous is not None and self.predict:
             h_prev, slope = self._previous
             guess = t_n + (GAMMA * h / h_prev) * slope
+        accuracy = SOLVE_FRACTION * self.tolerance
         limit, where = solver.solve_stage(GAMMA * h, time + GAMMA * h, 0.5, t_n, h_n,
-                                          0.5 * start.heat_rate, guess)  # fmt: skip
+                                          0.5 * start.heat_rate, guess, accuracy)  # fmt: skip
         mid = solver._rates(time + GAMMA * h)
         t_g = p.temperature.copy()
         # stage 2: backward Euler over d h from the virtual state a T_γ - b T_n
@@ -147,7 +150,7 @@ class AdaptiveTRBDF2:
             h_virtual = None
             t_virtual = A * t_g - B * t_n
         guess = t_n + (t_g - t_n) / GAMMA if self.predict else None
-        solver.solve_stage(D * h, time + h, 1.0, t_virtual, h_virtual, None, guess)
+        solver.solve_stage(D * h, time + h, 1.0, t_virtual, h_virtual, None, guess, accuracy)
         end = solver._rates(time + h)
         err = self._error(h, start, mid, end)
         if err > self.tolerance:

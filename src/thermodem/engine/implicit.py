@@ -34,6 +34,7 @@ matrix does not change (constant properties: one setup per run). The solves are
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time as _time
 from dataclasses import dataclass, field
@@ -44,6 +45,7 @@ import scipy.sparse as sp
 
 from thermodem.engine.implicit_solve import SparseSolve
 from thermodem.errors import ConfigError, SimulationError
+from thermodem.geometry import wall_layout as wall_cols
 from thermodem.kernels import thermal as kernels
 from thermodem.state import heat
 
@@ -85,6 +87,13 @@ class Timings:
     cg_iterations: int = 0
     picard_iterations: int = 0
     extra: dict = field(default_factory=dict)
+
+
+def serial_blas() -> contextlib.AbstractContextManager:
+    """BLAS on one thread for the solves (``implicit_solve.SparseSolve._solve`` says why)."""
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1, user_api="blas")
 
 
 def pair_lists(engine: ThermalEngine) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -147,8 +156,10 @@ class ImplicitSolver(SparseSolve):
         self._hierarchy_key: tuple = ()
         self._end: Rates | None = None
         self._network_cache: tuple | None = None
+        self._rhs_cache: tuple | None = None  # (data key, b) of a linear network
         self._system: tuple | None = None  # (matrix, fixed, free block)
-        self._capacity_matrix: tuple | None = None  # (K, C/Δt, θ K + diag(C/Δt))
+        self._step_system: tuple | None = None  # (K_ff, its diagonal, ..., K_ff + C')
+        self._kept_capacities: tuple | None = None
         self.interval: tuple[float, float] | None = None  # (Δt, t) of the step being computed
         self.direct_below = 200
         self.linear = engine.override == 0 and not any(
@@ -181,17 +192,75 @@ class ImplicitSolver(SparseSolve):
         by_mech = p.heat_rate_by_mechanism
         empty = np.zeros(0)
         rates = Rates(
-            boundary=by_mech[:, eng.boundary_columns].sum(axis=0),
+            boundary=by_mech.T[eng.boundary_columns].sum(axis=1),  # (by_mech: Fortran order)
             absorbed=float(p.heat_rate[fixed].sum()) if fixed.shape[0] else 0.0,
             heat_rate=p.heat_rate.copy() if copies else empty,
             temperature=p.temperature.copy() if copies else empty,
             time=time,
         )
+        cached = self._network_cache
+        if self.linear and cached is not None and cached[3].shape[0] == p.count:
+            # b of the linear network from the latest pass (a restarted run's first pass is
+            # at the state of the uninterrupted run's last one: the same b, bit for bit)
+            self._rhs_cache = (self._data_key(), self._boundary_rhs(cached[3]))
         self.timings.evaluation += _time.perf_counter() - t0
         return rates
 
+    def _boundary_rhs(self, diag: np.ndarray) -> np.ndarray:
+        """b = Q_boundary + D T of the engine's last pass (per particle)."""
+        eng = self.engine
+        p = eng.sim.particles
+        boundary = p.heat_rate_by_mechanism.T[eng.boundary_columns].sum(axis=0)
+        return boundary + diag * p.temperature
+
+    def _data_key(self) -> tuple:
+        """What b of a linear network depends on besides the (constant) conductances: the
+        fixed set and temperatures, the sources and the wall temperatures, as the engine's
+        conditions set them (``ThermalEngine.prepare``)."""
+        eng = self.engine
+        sim = eng.sim
+        p = sim.particles
+        fixed = eng.fixed if eng.fixed.shape[0] == p.count else np.zeros(p.count, np.bool_)
+        walls = sim.wall_rows
+        source = eng.source if eng.source is not None and eng.source.shape[0] else None
+        return (
+            fixed.copy(),
+            p.temperature[fixed].copy(),
+            None if source is None else np.array(source, copy=True),
+            walls[:, wall_cols.COL_TEMPERATURE].copy() if walls.shape[0] else None,
+        )
+
+    def _known_rhs(self, time: float, extra_fixed: np.ndarray | None) -> Network | None:
+        """The network of a linear system whose data at ``time`` are those of the last
+        evaluation, without the engine's passes: K is constant and b = Q + K T does not
+        depend on T (the engine's own conditions still set the fixed particles, walls and
+        sources at ``time``). None when the data changed or the network is not linear."""
+        eng = self.engine
+        p = eng.sim.particles
+        cached, known = self._network_cache, self._rhs_cache
+        if not self.linear or cached is None or known is None or cached[3].shape[0] != p.count:
+            return None
+        t0 = _time.perf_counter()
+        eng.prepare(time)
+        key = self._data_key()
+        same = all(
+            (x is None and y is None) or (x is not None and y is not None and np.array_equal(x, y))
+            for x, y in zip(key, known[0], strict=True)
+        )
+        if not same:
+            return None
+        fixed = key[0].copy()
+        if extra_fixed is not None:
+            fixed |= extra_fixed
+        net = Network(cached[4], known[1].copy(), fixed, p.temperature.copy())
+        self.timings.assembly += _time.perf_counter() - t0
+        return net
+
     def network(self, time: float, extra_fixed: np.ndarray | None = None) -> Network:
         """The conductance network at the current temperatures and ``time``."""
+        known = self._known_rhs(time, extra_fixed)
+        if known is not None:
+            return known
         eng = self.engine
         p = eng.sim.particles
         self._rates(time)
@@ -208,8 +277,7 @@ class ImplicitSolver(SparseSolve):
             # what the pairs left is the boundary conductance; round-off of the difference
             # is not a conductance
             diag[np.abs(diag) <= 1e-12 * np.abs(eng.conductance_sum[:n])] = 0.0
-        boundary = p.heat_rate_by_mechanism[:, eng.boundary_columns].sum(axis=1)
-        rhs = boundary + diag * p.temperature
+        rhs = self._boundary_rhs(diag)
         fixed = eng.fixed.copy() if eng.fixed.shape[0] == n else np.zeros(n, np.bool_)
         if extra_fixed is not None:
             fixed |= extra_fixed
@@ -227,6 +295,8 @@ class ImplicitSolver(SparseSolve):
         else:
             conductance = laplacian(n, i, j, h, diag)
             self._network_cache = (i.copy(), j.copy(), h.copy(), diag.copy(), conductance)
+        if self.linear:
+            self._rhs_cache = (self._data_key(), rhs.copy())  # (the first assembly)
         net = Network(conductance, rhs, fixed, p.temperature.copy())
         self.timings.assembly += _time.perf_counter() - t0
         return net
@@ -265,6 +335,10 @@ class ImplicitSolver(SparseSolve):
         if self.exponential is not None:
             self.exponential.step(dt, time)
             return
+        with serial_blas():
+            self._advance(dt, time)
+
+    def _advance(self, dt: float, time: float) -> None:
         if self.adaptive is not None:
             self.adaptive.step(dt, time)
             return
@@ -337,38 +411,45 @@ class ImplicitSolver(SparseSolve):
         h_old: np.ndarray | None,
         explicit: np.ndarray | None,
         guess: np.ndarray | None = None,
+        accuracy: float | None = None,
     ) -> tuple[float, int]:
         """Solve  C (T - T_old)/dt = θ Q(T) + explicit  for the temperatures at ``time``
         (with c(T): m (h(T) - h_old)/dt on the left), Picard on the temperature-dependent
         terms; the solution is left in the particles. ``guess``: the first iterate of the free
         particles (default: their current temperatures); the conjugate-gradient tolerance
-        stays relative to the residual at the current temperatures. Returns the explicit
-        limit and its particle at the first iterate."""
+        stays relative to the residual at the current temperatures. ``accuracy`` [K]: the
+        conjugate gradients also stop when the capacity-weighted RMS of their error is
+        bounded by it (``implicit_solve.conjugate_gradients``); the relative tolerance then
+        refers to the residual at the guess (stricter; the bound stops them first). Returns
+        the explicit limit and its particle at the first iterate."""
         eng = self.engine
         p = eng.sim.particles
         limit, where = math.inf, -1
         start = None
         if guess is not None:
-            start = p.temperature.copy()
-            free = ~eng.fixed if eng.fixed.shape[0] == p.count else slice(None)
-            p.temperature[free] = guess[free]
+            if accuracy is None:
+                start = p.temperature.copy()
+            if eng.fixed.shape[0] == p.count:
+                np.copyto(p.temperature, guess, where=~eng.fixed)
+            else:
+                p.temperature[:] = guess
         change = math.inf
         for iteration in range(1, self.options.picard_iterations + 1):
             net = self.network(time)
             t_k = net.temperature
             if iteration == 1:
                 limit, where = kernels.stability_limit(
-                    p.mass, eng.specific_heat(), eng.conductance_sum, net.fixed
+                    p.mass, self._capacities()[1], eng.conductance_sum, net.fixed
                 )
-            matrix, residual = self._system_of(net, dt, theta, t_old, h_old, explicit, t_k)
+            matrix, residual, cap = self._system_of(net, dt, theta, t_old, h_old, explicit, t_k)
             reference = None
             if start is not None and iteration == 1:
                 # the tolerance's scale: the residual of the unpredicted start (the same
                 # network; fixed particles at their new temperature)
                 start[net.fixed] = t_k[net.fixed]
-                _, r0 = self._system_of(net, dt, theta, t_old, h_old, explicit, start)
+                _, r0, _ = self._system_of(net, dt, theta, t_old, h_old, explicit, start)
                 reference = float(np.linalg.norm(r0[~net.fixed]))
-            delta = self._solve(matrix, residual, net.fixed, reference)
+            delta = self._solve(matrix, residual, net.fixed, reference, cap, accuracy)
             p.temperature[:] = t_k + delta
             self.timings.picard_iterations += 1
             change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
@@ -376,8 +457,8 @@ class ImplicitSolver(SparseSolve):
                 break
         else:
             self._not_converged(change, time - dt)
-        bad = np.nonzero(~(p.temperature > 0.0) | ~np.isfinite(p.temperature))[0]
-        if bad.shape[0]:
+        if not (p.temperature.min() > 0.0 and math.isfinite(p.temperature.max())):
+            bad = np.nonzero(~(p.temperature > 0.0) | ~np.isfinite(p.temperature))[0]
             gid = int(p.global_id[bad[0]])
             raise SimulationError(
                 f"implicit heat step: temperature of particle {gid} became "
@@ -390,12 +471,13 @@ class ImplicitSolver(SparseSolve):
 
     def _system_of(self, net: Network, dt: float, theta: float, t_old: np.ndarray,
                    h_old: np.ndarray | None, explicit: np.ndarray | None, t_k: np.ndarray
-                   ) -> tuple[sp.csr_matrix, np.ndarray]:  # fmt: skip
-        """(K + C/(θΔt), residual/θ at the temperatures t_k) of the stage: the system scaled
-        by 1/θ, so that the stages of one step size share one matrix."""
+                   ) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray]:  # fmt: skip
+        """(K, residual/θ at the temperatures t_k, C' = C/(θΔt)) of the stage: the system
+        K + diag(C') scaled by 1/θ, so that the stages of one step size share one matrix."""
         eng = self.engine
         p = eng.sim.particles
-        cap = p.mass * eng.specific_heat() / dt
+        t0 = _time.perf_counter()
+        cap = self._capacities()[0] / dt
         if h_old is not None:
             inertia = cap * t_k - p.mass * (self._enthalpy(t_k) - h_old) / dt
         else:
@@ -403,11 +485,25 @@ class ImplicitSolver(SparseSolve):
         rhs = inertia + theta * net.rhs
         if explicit is not None:
             rhs += explicit
-        t0 = _time.perf_counter()
-        matrix = self._matrix(net.conductance, cap / theta)
-        residual = rhs / theta - matrix @ t_k
+        capacity = cap / theta
+        residual = rhs / theta - net.conductance @ t_k - capacity * t_k
         self.timings.assembly += _time.perf_counter() - t0
-        return matrix, residual
+        return net.conductance, residual, capacity
+
+    def _capacities(self) -> tuple[np.ndarray, np.ndarray]:
+        """(m c(T) [J/K], c(T) [J/(kg K)]) of every particle (kept with constant properties
+        while the network is)."""
+        eng = self.engine
+        p = eng.sim.particles
+        if eng.has_c_table:
+            c = eng.specific_heat()
+            return p.mass * c, c
+        kept = self._kept_capacities
+        if kept is not None and kept[0] is self._network_cache and kept[1].shape[0] == p.count:
+            return kept[1:]
+        c = eng.specific_heat()
+        self._kept_capacities = (self._network_cache, p.mass * c, c)
+        return self._kept_capacities[1:]
 
     def _not_converged(self, change: float, time: float) -> None:
         sim = self.engine.sim
@@ -439,7 +535,8 @@ class ImplicitSolver(SparseSolve):
             net = self.network(time, extra_fixed)
             self._check_anchored(net)
             residual = net.rhs - net.conductance @ net.temperature
-            delta = self._solve(net.conductance, residual, net.fixed)
+            with serial_blas():
+                delta = self._solve(net.conductance, residual, net.fixed)
             p.temperature[:] = net.temperature + delta
             self.timings.picard_iterations += 1
             change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
