@@ -176,7 +176,7 @@ class AdaptiveTRBDF2:
         free = ~fixed
         if not free.any():
             return 0.0
-        cap = p.mass * eng.specific_heat()
+        cap = self.solver._capacities()[0]  # m c(T)
         slopes = (start.heat_rate / GAMMA - mid.heat_rate / (GAMMA * (1.0 - GAMMA))
                   + end.heat_rate / (1.0 - GAMMA))  # fmt: skip
         estimate = 2.0 * K3 * h * slopes[free] / cap[free]

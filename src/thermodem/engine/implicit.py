@@ -89,11 +89,16 @@ class Timings:
     extra: dict = field(default_factory=dict)
 
 
+_BLAS: list = []  # the threadpoolctl controller (its library scan costs ~2 ms a call)
+
+
 def serial_blas() -> contextlib.AbstractContextManager:
     """BLAS on one thread for the solves (``implicit_solve.SparseSolve._solve`` says why)."""
-    from threadpoolctl import threadpool_limits
+    if not _BLAS:
+        from threadpoolctl import ThreadpoolController
 
-    return threadpool_limits(limits=1, user_api="blas")
+        _BLAS.append(ThreadpoolController())  # (numpy's and scipy's BLAS are loaded by now)
+    return _BLAS[0].limit(limits=1, user_api="blas")
 
 
 def pair_lists(engine: ThermalEngine) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -160,6 +165,7 @@ class ImplicitSolver(SparseSolve):
         self._system: tuple | None = None  # (matrix, fixed, free block)
         self._step_system: tuple | None = None  # (K_ff, its diagonal, ..., K_ff + C')
         self._kept_capacities: tuple | None = None
+        self._kept_term: tuple | None = None
         self.interval: tuple[float, float] | None = None  # (Δt, t) of the step being computed
         self.direct_below = 200
         self.linear = engine.override == 0 and not any(
@@ -192,7 +198,7 @@ class ImplicitSolver(SparseSolve):
         by_mech = p.heat_rate_by_mechanism
         empty = np.zeros(0)
         rates = Rates(
-            boundary=by_mech.T[eng.boundary_columns].sum(axis=1),  # (by_mech: Fortran order)
+            boundary=by_mech.sum(axis=0)[eng.boundary_columns],  # (Fortran order: columns)
             absorbed=float(p.heat_rate[fixed].sum()) if fixed.shape[0] else 0.0,
             heat_rate=p.heat_rate.copy() if copies else empty,
             temperature=p.temperature.copy() if copies else empty,
@@ -202,7 +208,9 @@ class ImplicitSolver(SparseSolve):
         if self.linear and cached is not None and cached[3].shape[0] == p.count:
             # b of the linear network from the latest pass (a restarted run's first pass is
             # at the state of the uninterrupted run's last one: the same b, bit for bit)
-            self._rhs_cache = (self._data_key(), self._boundary_rhs(cached[3]))
+            known = self._rhs_cache
+            key = known[0] if known is not None and self._data_holds(known[0]) else None
+            self._rhs_cache = (key or self._data_key(), self._boundary_rhs(cached[3]))
         self.timings.evaluation += _time.perf_counter() - t0
         return rates
 
@@ -210,13 +218,16 @@ class ImplicitSolver(SparseSolve):
         """b = Q_boundary + D T of the engine's last pass (per particle)."""
         eng = self.engine
         p = eng.sim.particles
-        boundary = p.heat_rate_by_mechanism.T[eng.boundary_columns].sum(axis=0)
-        return boundary + diag * p.temperature
+        by_mech = p.heat_rate_by_mechanism
+        rhs = diag * p.temperature
+        for m in eng.boundary_columns:  # (Fortran order: a column is contiguous)
+            rhs += by_mech[:, m]
+        return rhs
 
-    def _data_key(self) -> tuple:
+    def _data(self) -> tuple:
         """What b of a linear network depends on besides the (constant) conductances: the
         fixed set and temperatures, the sources and the wall temperatures, as the engine's
-        conditions set them (``ThermalEngine.prepare``)."""
+        conditions set them (``ThermalEngine.prepare``); views, see :meth:`_data_key`."""
         eng = self.engine
         sim = eng.sim
         p = sim.particles
@@ -224,10 +235,21 @@ class ImplicitSolver(SparseSolve):
         walls = sim.wall_rows
         source = eng.source if eng.source is not None and eng.source.shape[0] else None
         return (
-            fixed.copy(),
-            p.temperature[fixed].copy(),
-            None if source is None else np.array(source, copy=True),
-            walls[:, wall_cols.COL_TEMPERATURE].copy() if walls.shape[0] else None,
+            fixed,
+            p.temperature[fixed],
+            None if source is None else np.asarray(source),
+            walls[:, wall_cols.COL_TEMPERATURE] if walls.shape[0] else None,
+        )
+
+    def _data_key(self) -> tuple:
+        """A copy of :meth:`_data`, kept with the b it belongs to."""
+        return tuple(None if x is None else np.array(x, copy=True) for x in self._data())
+
+    def _data_holds(self, key: tuple) -> bool:
+        """The engine's current data equal ``key``."""
+        return all(
+            (x is None and y is None) or (x is not None and y is not None and np.array_equal(x, y))
+            for x, y in zip(self._data(), key, strict=True)
         )
 
     def _known_rhs(self, time: float, extra_fixed: np.ndarray | None) -> Network | None:
@@ -242,14 +264,9 @@ class ImplicitSolver(SparseSolve):
             return None
         t0 = _time.perf_counter()
         eng.prepare(time)
-        key = self._data_key()
-        same = all(
-            (x is None and y is None) or (x is not None and y is not None and np.array_equal(x, y))
-            for x, y in zip(key, known[0], strict=True)
-        )
-        if not same:
+        if not self._data_holds(known[0]):
             return None
-        fixed = key[0].copy()
+        fixed = known[0][0].copy()
         if extra_fixed is not None:
             fixed |= extra_fixed
         net = Network(cached[4], known[1].copy(), fixed, p.temperature.copy())
@@ -472,23 +489,39 @@ class ImplicitSolver(SparseSolve):
     def _system_of(self, net: Network, dt: float, theta: float, t_old: np.ndarray,
                    h_old: np.ndarray | None, explicit: np.ndarray | None, t_k: np.ndarray
                    ) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray]:  # fmt: skip
-        """(K, residual/θ at the temperatures t_k, C' = C/(θΔt)) of the stage: the system
-        K + diag(C') scaled by 1/θ, so that the stages of one step size share one matrix."""
+        """(K, residual at the temperatures t_k, C' = C/(θΔt)) of the stage's system
+        (K + diag(C')) δ = residual, the stage divided by θ so that the stages of one step
+        size share one matrix: residual = C'(T_old - t_k) + b + explicit/θ - K t_k, with c(T)
+        the capacity term on the enthalpy, -m (h(t_k) - h_old)/(θΔt)."""
         eng = self.engine
         p = eng.sim.particles
         t0 = _time.perf_counter()
-        cap = self._capacities()[0] / dt
+        capacity = self._capacity_term(theta * dt)
         if h_old is not None:
-            inertia = cap * t_k - p.mass * (self._enthalpy(t_k) - h_old) / dt
+            residual = self._enthalpy(t_k) - h_old
+            residual *= p.mass / (-theta * dt)
         else:
-            inertia = cap * t_old
-        rhs = inertia + theta * net.rhs
+            residual = t_old - t_k
+            residual *= capacity
+        residual += net.rhs
         if explicit is not None:
-            rhs += explicit
-        capacity = cap / theta
-        residual = rhs / theta - net.conductance @ t_k - capacity * t_k
+            residual += explicit / theta
+        residual -= net.conductance @ t_k
         self.timings.assembly += _time.perf_counter() - t0
         return net.conductance, residual, capacity
+
+    def _capacity_term(self, scale: float) -> np.ndarray:
+        """C' = m c/(θΔt) for ``scale`` = θΔt; with constant capacities the same array for
+        the same θΔt (the solves key their matrix on it)."""
+        mc = self._capacities()[0]
+        if self.engine.has_c_table:
+            return mc / scale
+        kept = self._kept_term
+        if kept is not None and kept[0] is mc and kept[1] == scale:
+            return kept[2]
+        term = mc / scale
+        self._kept_term = (mc, scale, term)
+        return term
 
     def _capacities(self) -> tuple[np.ndarray, np.ndarray]:
         """(m c(T) [J/K], c(T) [J/(kg K)]) of every particle (kept with constant properties

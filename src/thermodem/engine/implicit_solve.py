@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -98,6 +99,35 @@ def conjugate_gradients(
     return x, max_iterations, False
 
 
+@dataclass
+class StepBlock:
+    """The free block of a time step's matrix and what its solves need of it."""
+
+    matrix: sp.csr_matrix  # a = K_ff + diag(C')
+    capacity: np.ndarray  # C' of the free particles
+    source: np.ndarray  # the capacity array (all particles) it was made from
+    inverse: np.ndarray  # 1/aᵢᵢ (Jacobi)
+    weight: np.ndarray  # 1/C'ᵢ (the error bound)
+    capacity_sum: float  # ΣC'
+    row_sum: float  # Σ (a 1)ᵢ (the conservative correction)
+    condition: float  # the bound 2 max aᵢᵢ/C'ᵢ on κ(D⁻¹a)
+
+    @classmethod
+    def of(cls, k_ff: sp.csr_matrix, on_diagonal: np.ndarray | None, k_diagonal: np.ndarray,
+           k_rows: np.ndarray, c: np.ndarray, source: np.ndarray) -> StepBlock:  # fmt: skip
+        diagonal = k_diagonal + c
+        if on_diagonal is not None:  # (K_ff's index arrays shared)
+            data = k_ff.data.copy()
+            data[on_diagonal] = diagonal
+            a = sp.csr_matrix((data, k_ff.indices, k_ff.indptr), shape=k_ff.shape, copy=False)
+        else:
+            a = (k_ff + sp.diags(c)).tocsr()
+        # κ(D⁻¹a) ≤ 2 max aᵢᵢ/C'ᵢ: Gershgorin bounds D⁻¹a's spectrum by 2 above (a
+        # diagonally dominant M-matrix) and a ≥ C' by min C'ᵢ/aᵢᵢ below
+        return cls(a, c, source, 1.0 / diagonal, 1.0 / c, float(c.sum()),
+                   float(k_rows.sum() + c.sum()), 2.0 * float(np.max(diagonal / c)))  # fmt: skip
+
+
 class SparseSolve:
     """The linear solves of the implicit solver (see the module docstring)."""
 
@@ -132,11 +162,12 @@ class SparseSolve:
         if not free.any():
             return delta
         t0 = _time.perf_counter()
+        block = None
         if capacity is None:
             a = self._free_block(matrix, fixed)
-            c = diagonal = row_sum = None
         else:
-            a, c, diagonal, row_sum = self._step_block(matrix, fixed, capacity)
+            block = self._step_block(matrix, fixed, capacity)
+            a = block.matrix
         r = residual[free]
         norm = float(np.sqrt(r @ r))
         if norm == 0.0:
@@ -146,16 +177,11 @@ class SparseSolve:
             self.timings.solve += _time.perf_counter() - t0
             self.timings.solves += 1
             return delta
-        if diagonal is None:
-            diagonal = a.diagonal()
         choice = self.options.preconditioner
         if choice == "auto":
-            # κ(D⁻¹a) ≤ 2 max aᵢᵢ/C'ᵢ: Gershgorin bounds D⁻¹a's spectrum by 2 above (a
-            # diagonally dominant M-matrix) and a ≥ C' by min C'ᵢ/aᵢᵢ below
-            condition = 2.0 * float(np.max(diagonal / c)) if c is not None else np.inf
-            choice = "jacobi" if condition <= AUTO_CONDITION else "amg"
+            choice = "jacobi" if block is not None and block.condition <= AUTO_CONDITION else "amg"
         if choice == "jacobi":
-            preconditioner = 1.0 / diagonal
+            preconditioner = block.inverse if block is not None else 1.0 / a.diagonal()
         else:
             preconditioner = self._preconditioner(a).matvec
         t1 = _time.perf_counter()
@@ -163,15 +189,15 @@ class SparseSolve:
         # relative to the residual of the stage's start (a warm start keeps that scale)
         stop = self.options.tolerance * (norm if reference is None else reference)
         weight, bound = None, 0.0
-        if c is not None and accuracy is not None:
-            weight, bound = 1.0 / c, accuracy * accuracy * float(c.sum())
+        if block is not None and accuracy is not None:
+            weight, bound = block.weight, accuracy * accuracy * block.capacity_sum
         x, count, converged = conjugate_gradients(
             a, r, preconditioner, stop, self.options.max_iterations, weight, bound
         )
-        if row_sum is not None:
+        if block is not None:
             # the conservative correction: the residual summed over the free particles is
             # the energy that the step's ledger would miss; a uniform shift removes it
-            x += float((r - a @ x).sum()) / float(row_sum.sum())
+            x += float((r - a @ x).sum()) / block.row_sum
         self.timings.solve += _time.perf_counter() - t1
         self.timings.solves += 1
         self.timings.cg_iterations += count
@@ -204,33 +230,29 @@ class SparseSolve:
 
     def _step_block(
         self, conductance: sp.csr_matrix, fixed: np.ndarray, capacity: np.ndarray
-    ) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray, np.ndarray]:
-        """(a, C', diagonal, row sums) of a time step's free block a = K_ff + diag(C'), C' the
-        free particles' ``capacity``: K_ff is kept (:meth:`_free_block`), a is a copy of it
-        whose diagonal entries are updated in place (kept while C' is the same)."""
+    ) -> StepBlock:
+        """The free block a = K_ff + diag(C') of a time step, C' the free particles'
+        ``capacity``: K_ff is kept (:meth:`_free_block`), a is a copy of it whose diagonal
+        entries are overwritten; kept while ``capacity`` is the same array object or equal."""
         k_ff = self._free_block(conductance, fixed)
-        c = capacity[~fixed]
         base = self._step_system
         if base is None or base[0] is not k_ff:
             coo = k_ff.tocoo()
             on_diagonal = np.flatnonzero(coo.row == coo.col)
             if on_diagonal.shape[0] != k_ff.shape[0]:  # a row without a stored diagonal
                 on_diagonal = None
-            k_diagonal = k_ff.diagonal()
             rows = np.asarray(k_ff.sum(axis=1)).ravel()
-            base = (k_ff, on_diagonal, k_diagonal, rows, None)
+            base = (k_ff, on_diagonal, k_ff.diagonal(), rows, None)
         k_ff, on_diagonal, k_diagonal, k_rows, kept = base
-        if kept is not None and np.array_equal(kept[0], c):
-            return kept[1:]
-        diagonal = k_diagonal + c
-        if on_diagonal is not None:
-            a = k_ff.copy()
-            a.data[on_diagonal] = diagonal
-        else:
-            a = (k_ff + sp.diags(c)).tocsr()
-        kept = (c, a, c, diagonal, k_rows + c)
+        if kept is not None and kept.source is capacity:
+            return kept
+        c = capacity[~fixed]
+        if kept is not None and np.array_equal(kept.capacity, c):
+            kept.source = capacity
+            return kept
+        kept = StepBlock.of(k_ff, on_diagonal, k_diagonal, k_rows, c, capacity)
         self._step_system = (*base[:4], kept)
-        return kept[1:]
+        return kept
 
     def _preconditioner(self, a: sp.csr_matrix) -> spla.LinearOperator:
         """Smoothed-aggregation AMG, kept while the matrix is the same (within 10 % per
