@@ -177,14 +177,20 @@ def test_ledger_closes_with_a_wall_a_source_and_a_fixed_particle(
     assert abs(th.balance_error()) < 1e-11 * u0
 
 
-def test_temperature_dependent_properties_conserve_enthalpy(tmp_path: Path) -> None:
-    """k(T) and c(T) tables: Picard in each stage; the pair exchange conserves Σ m h(T)."""
+@pytest.mark.parametrize("direct_below", [200, 0])
+def test_temperature_dependent_properties_conserve_enthalpy(
+    tmp_path: Path, direct_below: int
+) -> None:
+    """k(T) and c(T) tables: Picard in each stage; the pair exchange conserves Σ m h(T), with
+    the direct solve and with conjugate gradients stopped at their error bound."""
     constants = ("thermal_conductivity", "specific_heat")  # (a table replaces its constant)
     glass = {k: v for k, v in MATERIAL.items() if k not in constants}
     mats = {"glass": dict(glass, thermal_conductivity_table=[[300.0, 1.0], [400.0, 3.0]],
                           specific_heat_table=[[300.0, 700.0], [400.0, 1100.0]])}  # fmt: skip
     thermal = {"time_step": 2.0, "implicit": {"error_tolerance": 1e-3}}
-    sim = _sim(_write(tmp_path / "two.txt", [300.0, 400.0]), thermal, materials=mats)
+    chain = [300.0, 400.0] * 6  # (12 unknowns: the CG takes several iterations)
+    sim = _sim(_write(tmp_path / "chain.txt", chain), thermal, materials=mats)
+    sim.thermal.implicit.direct_below = direct_below
     u0 = sim.thermal.thermal_energy()
     sim.run(steps=5)
     t = _by_gid(sim)

@@ -436,9 +436,10 @@ class ImplicitSolver(SparseSolve):
         particles (default: their current temperatures); the conjugate-gradient tolerance
         stays relative to the residual at the current temperatures. ``accuracy`` [K]: the
         conjugate gradients also stop when the capacity-weighted RMS of their error is
-        bounded by it (``implicit_solve.conjugate_gradients``); the relative tolerance then
-        refers to the residual at the guess (stricter; the bound stops them first). Returns
-        the explicit limit and its particle at the first iterate."""
+        bounded by it (``implicit_solve.conjugate_gradients``; the first Picard iterate only);
+        the relative tolerance then refers to the residual at the guess (stricter; the bound
+        stops them first). Returns the explicit limit and its particle at the first
+        iterate."""
         eng = self.engine
         p = eng.sim.particles
         limit, where = math.inf, -1
@@ -466,7 +467,10 @@ class ImplicitSolver(SparseSolve):
                 start[net.fixed] = t_k[net.fixed]
                 _, r0, _ = self._system_of(net, dt, theta, t_old, h_old, explicit, start)
                 reference = float(np.linalg.norm(r0[~net.fixed]))
-            delta = self._solve(matrix, residual, net.fixed, reference, cap, accuracy)
+            # (the bound for the first solve only: a Picard iteration then converges to
+            # picard_tolerance, which a solve stopped at the bound would end early)
+            bound = accuracy if iteration == 1 else None
+            delta = self._solve(matrix, residual, net.fixed, reference, cap, bound)
             p.temperature[:] = t_k + delta
             self.timings.picard_iterations += 1
             change = float(np.max(np.abs(delta))) if delta.shape[0] else 0.0
