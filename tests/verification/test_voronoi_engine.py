@@ -375,7 +375,7 @@ def test_conductance_reuse_stays_within_its_bound(tmp_path: Path, model: str) ->
         used = th.term_conductance[index][: ext.count].copy()
         exact = np.zeros(ext.count)
         p = sim.particles
-        passes.external_pair_pass(
+        passes.EXTERNAL_PAIR_PASSES[True](
             p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
             sim.periodic, term.evaluator, term.model_id, term.table, -1, -1, th.k_p,
             np.zeros((ext.count // passes.PARTICLE_CHUNK + 1, 16)), exact, 0.0,

@@ -194,7 +194,8 @@ class TermEvaluation:
                                     or self.external_reuse.shape[0] != ext.count):  # fmt: skip
                 self.external_reuse = np.full((ext.count, passes.REUSE_WIDTH), np.nan)
                 self.external_reuse_stamp = ext.updates
-            self.external_evaluations += passes.external_pair_pass(
+            voronoi = term.evaluator == passes.EVAL_VORONOI
+            self.external_evaluations += passes.EXTERNAL_PAIR_PASSES[voronoi](
                 p.position, p.radius, p.type_id, ext.i, ext.j, ext.inputs, sim.lower, sim.upper,
                 sim.periodic, term.evaluator, term.model_id, term.table, k_i, k_j, self.k_p,
                 scratch, h, tolerance, self.external_reuse,

@@ -13,9 +13,10 @@ selected, not with their combinations.
   model: :mod:`thermodem.kernels.range_pass`;
 - :func:`contact_term_pair_pass`, :func:`contact_term_wall_pass`: touching pairs of the
   contact lists (terms that need the contact radius model and the normal force);
-- :func:`external_pair_pass` and :func:`csr_heat`: pairs of an external pair set (not
-  bounded by a cell edge): a conductance per pair, then every particle sums its pairs
-  through a CSR index (``engine/external_set.py``);
+- ``EXTERNAL_PAIR_PASSES`` (an external pair pass for the Voronoi models, one for the
+  other terms) and :func:`csr_heat`: pairs of an external pair set (not bounded by a cell
+  edge): a conductance per pair, then every particle sums its pairs through a CSR index
+  (``engine/external_set.py``);
 - :func:`particle_pass`: per-particle terms (radiation, convection), each returning a heat
   rate and a linearised conductance G = -dQ/dT_i that the stability limit adds to
   ``conductance_sum``;
@@ -204,7 +205,7 @@ def pair_csr(pair_i, pair_j, n, offsets, entries):
         fill[pair_j[k]] += 1
 
 
-#: Columns of the per-pair state of the Voronoi conductance reuse (``external_pair_pass``):
+#: Columns of the per-pair state of the Voronoi conductance reuse (the external pair pass):
 #: the interval of centre distances where the last evaluation is reused, the distance,
 #: conductance and face area of that evaluation, and the slope dH/dd applied (the secant
 #: through the last two evaluations, or 0).
@@ -216,7 +217,7 @@ CUTOFF_GUARD = 1e-12
 
 @njit(cache=True, error_model="numpy")
 def _reuse_row(model_id, p, ri, rj, dist, h, area, tolerance, row):
-    """Store an evaluation H(dist) in the pair's reuse row (see ``external_pair_pass``)."""
+    """Store an evaluation H(dist) in the pair's reuse row (see ``_compile_external_pair_pass``)."""
     touch = ri + rj
     side = voronoi_side(model_id, p, ri, rj, dist)
     d_b = row[REUSE_DISTANCE]
@@ -253,59 +254,76 @@ def _reuse_row(model_id, p, ri, rj, dist, h, area, tolerance, row):
     row[REUSE_AREA] = area
 
 
-@parallel_kernel(error_model="numpy")
-def external_pair_pass(
-    position, radius, type_id, pair_i, pair_j, inputs, lower, upper, periodic, evaluator,
-    model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance, tolerance, reuse,
-):  # fmt: skip
-    """Conductance of every pair of an external pair set (``inputs``: a row per pair, read
-    by the models made for such sets; the gap-conduction models ignore it). Returns the
-    number of pairs whose model was evaluated.
+def _compile_external_pair_pass(VORONOI: bool):  # noqa: ANN202, N803
+    """The external pair pass for the Voronoi models (``VORONOI``: they read the pair's input
+    row) or for the other pair terms (the gap-conduction models): one model family per
+    compiled kernel, so a Voronoi case does not compile every gap model too (serial twin
+    6.9 → 3.2 s of compile)."""
 
-    With ``tolerance`` > 0 (Voronoi models only; ``reuse``: a row per pair, NaN rows: no
-    evaluation yet) a pair keeps its last evaluation H_b at distance d_b while its face area
-    is unchanged and its distance d is within the row's interval: d_b ± tolerance × w,
-    w = |d_b - R_i - R_j| its surface gap (or overlap) then, clipped to d_b's side of touching
-    and of the cut-off; H = H_b + S (d - d_b) with S the secant slope through its last two
-    evaluations (when they were at most 2 tolerance w apart; without one S = 0 and the
-    interval is d_b ± tolerance² w). Otherwise the model is evaluated and the row updated.
-    docs/models/indirect_conduction-voronoi_a.md, "Conductance reuse"."""
-    length = upper - lower
-    npairs = pair_i.shape[0]
-    nchunks = (npairs + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
-    evaluated = 0
-    for c in prange(nchunks):
-        srow = scratch[c]
-        count = 0
-        for k in range(c * PARTICLE_CHUNK, min(npairs, (c + 1) * PARTICLE_CHUNK)):
-            i = pair_i[k]
-            j = pair_j[k]
-            dist = pair_separation(position, i, j, length, periodic)[3]
-            if tolerance > 0.0:
-                row = reuse[k]
-                if row[REUSE_AREA] == inputs[k, 0] and row[REUSE_LOW] <= dist <= row[REUSE_HIGH]:
-                    out_conductance[k] = row[REUSE_CONDUCTANCE] + row[REUSE_SLOPE] * (
-                        dist - row[REUSE_DISTANCE]
-                    )
-                    continue
-            ri = radius[i]
-            rj = radius[j]
-            ki = kj = 0.0
-            if k_col_i >= 0:
-                ki = k_particle[i]
-                kj = k_particle[j]
-            p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
-            r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
-            count += 1
-            if evaluator == EVAL_VORONOI:
-                h = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
-            else:
-                h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
-            out_conductance[k] = h
-            if tolerance > 0.0:
-                _reuse_row(model_id, p, ri, rj, dist, h, inputs[k, 0], tolerance, reuse[k])
-        evaluated += count
-    return evaluated
+    @parallel_kernel(error_model="numpy")
+    def external_pair_pass(
+        position, radius, type_id, pair_i, pair_j, inputs, lower, upper, periodic, evaluator,
+        model_id, table, k_col_i, k_col_j, k_particle, scratch, out_conductance, tolerance,
+        reuse,
+    ):  # fmt: skip
+        """Conductance     of every pair of an external pair set (``inputs``: a row per pair, read
+        by the models made for such sets; the gap-conduction models ignore it). Returns the
+        number of pairs whose model was evaluated.
+
+        With ``tolerance`` > 0 (Voronoi models only; ``reuse``: a row per pair, NaN rows: no
+        evaluation yet) a pair keeps its last evaluation H_b at distance d_b while its face area
+        is unchanged and its distance d is within the row's interval: d_b ± tolerance × w,
+        w = |d_b - R_i - R_j| its surface gap (or overlap) then, clipped to d_b's side of touching
+        and of the cut-off; H = H_b + S (d - d_b) with S the secant slope through its last two
+        evaluations (when they were at most 2 tolerance w apart; without one S = 0 and the
+        interval is d_b ± tolerance² w). Otherwise the model is evaluated and the row updated.
+        docs/models/indirect_conduction-voronoi_a.md, "Conductance reuse"."""
+        length = upper - lower
+        npairs = pair_i.shape[0]
+        nchunks = (npairs + PARTICLE_CHUNK - 1) // PARTICLE_CHUNK
+        evaluated = 0
+        for c in prange(nchunks):
+            srow = scratch[c]
+            count = 0
+            for k in range(c * PARTICLE_CHUNK, min(npairs, (c + 1) * PARTICLE_CHUNK)):
+                i = pair_i[k]
+                j = pair_j[k]
+                dist = pair_separation(position, i, j, length, periodic)[3]
+                if tolerance > 0.0:
+                    row = reuse[k]
+                    if (
+                        row[REUSE_AREA] == inputs[k, 0]
+                        and row[REUSE_LOW] <= dist <= row[REUSE_HIGH]
+                    ):
+                        out_conductance[k] = row[REUSE_CONDUCTANCE] + row[REUSE_SLOPE] * (
+                            dist - row[REUSE_DISTANCE]
+                        )
+                        continue
+                ri = radius[i]
+                rj = radius[j]
+                ki = kj = 0.0
+                if k_col_i >= 0:
+                    ki = k_particle[i]
+                    kj = k_particle[j]
+                p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
+                r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
+                count += 1
+                if VORONOI:
+                    h = voronoi_dispatch(model_id, p, ri, rj, dist, r_c, inputs[k])
+                else:
+                    h = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+                out_conductance[k] = h
+                if tolerance > 0.0:
+                    _reuse_row(model_id, p, ri, rj, dist, h, inputs[k, 0], tolerance, reuse[k])
+            evaluated += count
+        return evaluated
+
+    return external_pair_pass
+
+
+#: The external pair passes: ``EXTERNAL_PAIR_PASSES[evaluator == EVAL_VORONOI]``.
+EXTERNAL_PAIR_PASSES = {True: _compile_external_pair_pass(True),
+                        False: _compile_external_pair_pass(False)}  # fmt: skip
 
 
 @parallel_kernel(error_model="numpy")

@@ -361,7 +361,7 @@ def voronoi_side(model_id, p, r_i, r_j, dist):
     not smooth: 0 overlapping (d < R_i + R_j: a contact radius R_c > 0), 1 separated within
     the cut-off, 2 at or beyond the cut-off (H = 0; the same test as the kernels). The
     conductance reuse of ``thermal.tessellation.conductance_gap_tolerance`` never carries a
-    conductance across them (``kernels/heat_terms.py:external_pair_pass``)."""
+    conductance across them (``kernels/heat_terms.py``: the external pair pass)."""
     if dist < r_i + r_j:
         return 0
     ratio = p[A_CUTOFF] if model_id == VORONOI_A else p[B_CUTOFF]
