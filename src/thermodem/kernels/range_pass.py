@@ -36,9 +36,11 @@ keeps IEEE semantics (no fast-math), so H is the model's value whatever LLVM vec
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, types
+from numba.extending import overload
 
 from thermodem.geometry.wall_layout import COL_TEMPERATURE, COL_THERMAL_KIND
 from thermodem.kernels.heat_terms import (
@@ -51,12 +53,14 @@ from thermodem.kernels.heat_terms import (
 )
 from thermodem.kernels.neighbors import minimum_image, pair_separation, wall_distance
 from thermodem.kernels.variants import parallel_kernel
+from thermodem.models import registry
 from thermodem.models.thermal.contact_radius import geometric_contact_radius
-from thermodem.models.thermal.direct_conduction import separated_conductance
+from thermodem.models.thermal.direct_conduction import SEPARATED_FORMS, separated_conductance
 from thermodem.models.thermal.indirect_conduction import (
     VECTORISED_SPHERE_FORMS,
     indirect_sphere_dispatch,
 )
+from thermodem.models.thermal.surrounding_layer import rong_horio1999_spheres
 
 #: Pairs per chunk of the range pair pass (buffers of (width + 4) × CHUNK doubles per group:
 #: 8 kB for Rong & Horio's 4 columns, in L1). 128 and 256 measured alike, 64 slower.
@@ -69,6 +73,86 @@ def term_sphere_conductance(evaluator, model_id, p, r_i, r_j, dist, r_c, f_n):
     if evaluator == EVAL_SEPARATED:
         return separated_conductance(model_id, p, r_i, r_j, dist)
     return indirect_sphere_dispatch(model_id, p, r_i, r_j, dist, r_c, f_n)
+
+
+def _selected_form(evaluator: int, model_id: int, spheres: bool) -> Any:
+    """The one model kernel H(p, r_i, r_j, dist, r_c) of (evaluator, model id), inlined into
+    its caller, or None (an id without a registered kernel: the switch)."""
+    if evaluator == EVAL_SEPARATED:
+        form = SEPARATED_FORMS.get(model_id)
+        if form is None:
+            return _nothing
+
+        @njit(inline="always", error_model="numpy")
+        def separated(p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+            return form(p, r_i, r_j, dist)
+
+        return separated
+    if evaluator != EVAL_INDIRECT:
+        return None
+    if spheres and model_id in VECTORISED_SPHERE_FORMS:
+        kernel = rong_horio1999_spheres  # (the one model with a branch-free sphere form)
+    else:
+        specs = [m for m in registry.all_models() if m.family == "indirect_conduction"]
+        found = [m for m in specs if m.model_id == model_id]
+        if not found:
+            return None
+        kernel = njit(inline="always", error_model="numpy")(found[0].kernel.py_func)
+
+    @njit(inline="always", error_model="numpy")
+    def indirect(p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+        return kernel(p, r_i, r_j, dist, r_c, 0.0)
+
+    return indirect
+
+
+@njit(inline="always", error_model="numpy")
+def _nothing(p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+    return 0.0
+
+
+def range_term(evaluator, model_id, p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN201
+    """Conductance H [W/K] of the range term (evaluator, model id) for a pair (or a wall:
+    ``r_j`` = inf): compiled code only. With both ids compile-time literals (the passes
+    compiled per model, :func:`range_passes_for`) it is an inlined copy of that one model's
+    kernel: the integer switches of :func:`~thermodem.kernels.heat_terms.term_conductance`
+    would compile every gap model into every variant (~4 s of a variant's ~7 s). Else the
+    switch."""
+
+
+def range_sphere_term(evaluator, model_id, p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN201
+    """:func:`range_term` of two spheres (the sphere form of a model that has one)."""
+
+
+def _overload_term(spheres: bool) -> Any:
+    def typer(evaluator, model_id, p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+        if isinstance(evaluator, types.IntegerLiteral) and isinstance(
+            model_id, types.IntegerLiteral
+        ):
+            form = _selected_form(evaluator.literal_value, model_id.literal_value, spheres)
+            if form is not None:
+
+                def selected(evaluator, model_id, p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+                    return form(p, r_i, r_j, dist, r_c)
+
+                return selected
+        if spheres:
+
+            def sphere_switch(evaluator, model_id, p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+                return term_sphere_conductance(evaluator, model_id, p, r_i, r_j, dist, r_c, 0.0)
+
+            return sphere_switch
+
+        def switch(evaluator, model_id, p, r_i, r_j, dist, r_c):  # noqa: ANN001, ANN202
+            return term_conductance(evaluator, model_id, p, r_i, r_j, dist, r_c, 0.0)
+
+        return switch
+
+    return typer
+
+
+overload(range_term, inline="always", prefer_literal=True)(_overload_term(False))
+overload(range_sphere_term, inline="always", prefer_literal=True)(_overload_term(True))
 
 
 @njit(cache=True, error_model="numpy")
@@ -169,7 +253,7 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                             ki = k_particle[i]
                             kj = k_particle[j]
                         p = _row(table[type_id[i], type_id[j]], k_col_i, k_col_j, ki, kj, srow)
-                        hk = term_conductance(evaluator, model_id, p, ri, rj, dist, r_c, 0.0)
+                        hk = range_term(evaluator, model_id, p, ri, rj, dist, r_c)
                         if store:
                             out_conductance[k] = hk
                         add_pair_heat(by_mechanism, column, conductance_sum, temperature, i, j, hk)
@@ -208,8 +292,8 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                             r_c = 0.0
                             if NEED_RC:
                                 r_c = geometric_contact_radius(ri, rj, ri + rj - dist)
-                            h[t] = term_sphere_conductance(
-                                evaluator, model_id, cols[:, t], ri, rj, dist, r_c, 0.0
+                            h[t] = range_sphere_term(
+                                evaluator, model_id, cols[:, t], ri, rj, dist, r_c
                             )
                         for t in range(n):  # 3. scatter, in pair order
                             k = start + t
@@ -250,7 +334,7 @@ def _compile_range_passes(EVALUATOR: int, MODEL_ID: int, NEED_RC: bool, OVERRIDE
                         p = _row(
                             table[type_id[i], wall_material[w]], k_col_i, k_col_j, ki, kw, srow
                         )
-                        h = term_conductance(evaluator, model_id, p, ri, math.inf, d, r_c, 0.0)
+                        h = range_term(evaluator, model_id, p, ri, math.inf, d, r_c)
                     if store:
                         out_conductance[k] = h
                     if h != 0.0:

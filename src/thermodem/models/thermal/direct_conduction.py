@@ -350,6 +350,34 @@ def zhou2008_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_i
 
 # ----------------------------------------------------------- separated pairs (range set)
 @njit(cache=True, inline="always", error_model="numpy")
+def bob_complete_separated(p, r_i, r_j, dist):
+    """Batchelor & O'Brien complete across a gap: 0 when the pair touches (see
+    :func:`separated_conductance`)."""
+    overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
+    if overlap >= 0.0:
+        return 0.0
+    return bob_complete_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def bob_modified_separated(p, r_i, r_j, dist):
+    """Batchelor & O'Brien modified across a gap: 0 when the pair touches (see
+    :func:`separated_conductance`)."""
+    overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
+    if overlap >= 0.0:
+        return 0.0
+    return bob_modified_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+#: The separated-pair form H(p, r_i, r_j, dist) of each model that has one (a pass compiled
+#: for one model calls its form alone: kernels/range_pass.py).
+SEPARATED_FORMS = {
+    BATCHELOR_OBRIEN_COMPLETE: bob_complete_separated,
+    BATCHELOR_OBRIEN_MODIFIED: bob_modified_separated,
+}
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def separated_conductance(model_id, p, r_i, r_j, dist):
     """Conductance H [W/K] of the *separated-pair* part of a direct model that conducts across
     a gap (those registered with an ``interaction_range``: Batchelor & O'Brien complete and
@@ -359,13 +387,10 @@ def separated_conductance(model_id, p, r_i, r_j, dist):
     the contact pass evaluates the same kernels on touching pairs only, so no pair is counted
     twice. A wall is ``r_j = inf`` with ``dist`` the centre-to-wall distance.
     """
-    overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
-    if overlap >= 0.0:
-        return 0.0
     if model_id == BATCHELOR_OBRIEN_COMPLETE:
-        return bob_complete_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+        return bob_complete_separated(p, r_i, r_j, dist)
     elif model_id == BATCHELOR_OBRIEN_MODIFIED:
-        return bob_modified_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+        return bob_modified_separated(p, r_i, r_j, dist)
     return 0.0
 
 
