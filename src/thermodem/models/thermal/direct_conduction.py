@@ -349,25 +349,22 @@ def zhou2008_rate(p, t_i, t_j, r_i, r_j, dist, overlap, r_c, f_n, t_contact, v_i
 
 
 # ----------------------------------------------------------- separated pairs (range set)
-@njit(cache=True, inline="always", error_model="numpy")
-def bob_complete_separated(p, r_i, r_j, dist):
-    """Batchelor & O'Brien complete across a gap: 0 when the pair touches (see
-    :func:`separated_conductance`)."""
-    overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
-    if overlap >= 0.0:
-        return 0.0
-    return bob_complete_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+def _separated_form(rate):  # noqa: ANN001, ANN202
+    """The separated-pair form H(p, r_i, r_j, dist) of a model's heat-rate kernel ``rate``
+    (ΔT = 1 K): 0 when the pair touches (see :func:`separated_conductance`)."""
+
+    @njit(inline="always", error_model="numpy")
+    def form(p, r_i, r_j, dist):  # noqa: ANN001, ANN202
+        overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
+        if overlap >= 0.0:
+            return 0.0
+        return rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+    return form
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def bob_modified_separated(p, r_i, r_j, dist):
-    """Batchelor & O'Brien modified across a gap: 0 when the pair touches (see
-    :func:`separated_conductance`)."""
-    overlap = (r_i - dist) if math.isinf(r_j) else (r_i + r_j) - dist
-    if overlap >= 0.0:
-        return 0.0
-    return bob_modified_rate(p, 0.0, 1.0, r_i, r_j, dist, overlap, 0.0, 0.0, 0.0, 0.0, 0.0)
-
+bob_complete_separated = _separated_form(bob_complete_rate)
+bob_modified_separated = _separated_form(bob_modified_rate)
 
 #: The separated-pair form H(p, r_i, r_j, dist) of each model that has one (a pass compiled
 #: for one model calls its form alone: kernels/range_pass.py).
