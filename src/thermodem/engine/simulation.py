@@ -390,7 +390,8 @@ class Simulation(ParticleInsertion, SimulationLedger):
     def _contact_passes(self, conducts: bool) -> tuple:
         """(particle pair pass, wall pair pass) of this case: compiled with the contact
         conduction when the case has a contact conduction model (that pass serves the steps
-        without heat too: one compiled variant, kernels/pair_pass.py), else mechanics only."""
+        without heat too: one compiled variant, kernels/pair_pass.py), else mechanics only;
+        in 2D the planar pass where it covers the case (kernels/planar_pass.py)."""
         passes = self._passes.get(conducts)
         if passes is None:
             layout = self.history_layout.offsets
@@ -399,7 +400,9 @@ class Simulation(ParticleInsertion, SimulationLedger):
                 ids = (th.radius_id, th.conduction_id, th.override)
             else:
                 ids = (0, 0, 0)
-            passes = PP.passes_for(conducts, *ids, layout, self.generation, self.model_ids)
+            passes = PP.passes_for(
+                conducts, *ids, layout, self.generation, self.model_ids, self.planar
+            )
             self._passes[conducts] = passes
         return passes
 

@@ -7,9 +7,10 @@ and the same for ω with T / I. Contact forces at t+dt use x(t+dt) and the half-
 (the usual choice for velocity-dependent forces in DEM).
 
 ``planar`` (a 2D case): the particles move in the plane z = 0 and turn about z only, so each
-kick leaves v_z = 0 and ω_x = ω_y = 0 (and the drift keeps z). With in-plane loads these are
-already exactly zero (every normal, lever arm and velocity has z = 0); the constraint makes sure
-of it whatever the round-off.
+kick advances x, y and ω_z only and sets v_z = 0 and ω_x = ω_y = 0; the drift moves x and y
+(z stays 0). The out-of-plane force and torque components are not read: with in-plane loads
+they are exactly zero anyway (every normal, lever arm and velocity has z = 0; the planar pair
+pass does not write them), and the constraint makes sure of it whatever the round-off.
 """
 
 from __future__ import annotations
@@ -41,8 +42,8 @@ def kick_drift(
     chunk_check,
     planar,
 ):
-    """First half kick and drift; wraps positions on periodic axes (``planar``: out-of-plane
-    force and torque components dropped first, see the module docstring).
+    """First half kick and drift; wraps positions on periodic axes (``planar``: x, y and ω_z
+    only, see the module docstring).
 
     In the same pass, per chunk of CHECK_CHUNK particles, ``chunk_check`` receives the largest
     squared displacement since ``reference`` (minimum image), and the first particle with a
@@ -60,37 +61,56 @@ def kick_drift(
             inv_m = half / mass[i]
             inv_i = half / inertia[i]
             d2 = 0.0
-            if planar:  # (the force arrays are set again before the next use)
-                force[i, 2] = 0.0
-                torque[i, 0] = 0.0
-                torque[i, 1] = 0.0
+            if planar:  # x, y and ω_z move; z, v_z, ω_x, ω_y stay 0 (F_z, T_x, T_y not read)
                 velocity[i, 2] = 0.0
                 angular_velocity[i, 0] = 0.0
                 angular_velocity[i, 1] = 0.0
-            for a in range(3):
-                velocity[i, a] += force[i, a] * inv_m
-                angular_velocity[i, a] += torque[i, a] * inv_i
-                x = position[i, a] + velocity[i, a] * dt
-                length = upper[a] - lower[a]
-                if periodic[a]:
-                    x -= length * math.floor((x - lower[a]) / length)
-                position[i, a] = x
-                dx = x - reference[i, a]
-                if periodic[a]:
-                    dx -= length * math.floor(dx / length + 0.5)
-                d2 += dx * dx
-                if bad < 0:
-                    if not (math.isfinite(x) and math.isfinite(velocity[i, a])):
+                angular_velocity[i, 2] += torque[i, 2] * inv_i
+                for a in range(2):
+                    velocity[i, a] += force[i, a] * inv_m
+                    d, fault = _drift(position, velocity, i, a, dt, lower, upper, periodic,
+                                      reference, bad < 0)  # fmt: skip
+                    d2 += d
+                    if fault != 0:
                         bad = i
-                        code = 1
-                    elif not periodic[a] and (x < lower[a] or x > upper[a]):
+                        code = fault
+            else:
+                for a in range(3):
+                    velocity[i, a] += force[i, a] * inv_m
+                    angular_velocity[i, a] += torque[i, a] * inv_i
+                    d, fault = _drift(position, velocity, i, a, dt, lower, upper, periodic,
+                                      reference, bad < 0)  # fmt: skip
+                    d2 += d
+                    if fault != 0:
                         bad = i
-                        code = 2
+                        code = fault
             if d2 > best:
                 best = d2
         chunk_check[c, 0] = best
         chunk_check[c, 1] = bad
         chunk_check[c, 2] = code
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _drift(position, velocity, i, a, dt, lower, upper, periodic, reference, check):
+    """Drift particle i along axis a (wrapped on a periodic axis): (the squared displacement
+    along a since ``reference``, minimum image; with ``check``, 1 for a non-finite value, 2
+    for a position outside the domain on a non-periodic axis, else 0)."""
+    x = position[i, a] + velocity[i, a] * dt
+    length = upper[a] - lower[a]
+    if periodic[a]:
+        x -= length * math.floor((x - lower[a]) / length)
+    position[i, a] = x
+    dx = x - reference[i, a]
+    if periodic[a]:
+        dx -= length * math.floor(dx / length + 0.5)
+    fault = 0
+    if check:
+        if not (math.isfinite(x) and math.isfinite(velocity[i, a])):
+            fault = 1
+        elif not periodic[a] and (x < lower[a] or x > upper[a]):
+            fault = 2
+    return dx * dx, fault
 
 
 @njit(cache=True, error_model="numpy")
@@ -169,13 +189,17 @@ def final_kick(velocity, angular_velocity, force, torque, mass, inertia, dt, pla
     for i in prange(force.shape[0]):
         inv_m = half / mass[i]
         inv_i = half / inertia[i]
-        for a in range(3):
-            velocity[i, a] += force[i, a] * inv_m
-            angular_velocity[i, a] += torque[i, a] * inv_i
         if planar:
+            velocity[i, 0] += force[i, 0] * inv_m
+            velocity[i, 1] += force[i, 1] * inv_m
             velocity[i, 2] = 0.0
             angular_velocity[i, 0] = 0.0
             angular_velocity[i, 1] = 0.0
+            angular_velocity[i, 2] += torque[i, 2] * inv_i
+            continue
+        for a in range(3):
+            velocity[i, a] += force[i, a] * inv_m
+            angular_velocity[i, a] += torque[i, a] * inv_i
 
 
 @njit(cache=True, error_model="numpy")

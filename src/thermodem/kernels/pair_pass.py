@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from numba import prange
 
+from thermodem.kernels import planar_pass
 from thermodem.kernels.contact import (
     H_DURATION,
     L_COLLISION,
@@ -57,8 +58,14 @@ def passes_for(
     layout: tuple[int, ...],
     generation: bool,
     mechanics: tuple[int, int, int],
+    planar: bool = False,
 ) -> tuple:
     """(particle pair pass, wall pair pass) for one model combination and history layout.
+
+    ``planar`` (a 2D case): the particle pair pass is the planar pass
+    (:func:`thermodem.kernels.planar_pass.planar_pair_pass`, one kernel whose model choice is
+    run-time) where it covers the case (:func:`thermodem.kernels.planar_pass.covers`: the
+    disc laws, no contact conduction, no heat generation), else the 3D pass below.
 
     The heat switch, the contact radius and direct conduction model ids, the k(T)/ρc(T)
     override, the history offsets ``layout`` (``HistoryLayout.offsets``: normal, spring,
@@ -85,12 +92,13 @@ def passes_for(
     layout = tuple(int(c) for c in layout)
     mechanics = tuple(int(m) for m in mechanics)
     key = (*key, layout, bool(generation), mechanics)
-    if key not in _PASSES:
-        _PASSES[key] = (
-            _compile_pair_pass(*key),
+    flat = bool(planar) and planar_pass.covers(key[0], bool(generation), mechanics)
+    if (flat, key) not in _PASSES:
+        _PASSES[flat, key] = (
+            planar_pass.planar_pair_pass if flat else _compile_pair_pass(*key),
             wall_pass_for(bool(generation), layout, mechanics),
         )
-    return _PASSES[key]
+    return _PASSES[flat, key]
 
 
 def _compile_pair_pass(HEAT_ON: bool, RADIUS_ID: int, CONDUCTION_ID: int, OVERRIDE: int,  # noqa: N803
