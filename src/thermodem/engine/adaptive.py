@@ -47,7 +47,8 @@ from thermodem.errors import SimulationError
 from thermodem.state import heat
 
 if TYPE_CHECKING:
-    from thermodem.engine.implicit import ImplicitSolver, Rates
+    from thermodem.engine.implicit import ImplicitSolver
+    from thermodem.engine.implicit_network import Rates
 
 GAMMA = 2.0 - math.sqrt(2.0)
 D = GAMMA / 2.0

@@ -218,7 +218,7 @@ def periodic_gradient(
     import scipy.sparse.linalg as spla
     from scipy.sparse.csgraph import connected_components
 
-    from thermodem.engine.implicit import laplacian, pair_lists
+    from thermodem.engine.implicit_network import laplacian, pair_lists
 
     _check_case(sim)
     allowed = "xy" if getattr(sim, "planar", False) else "xyz"  # 2D: in the plane
