@@ -232,13 +232,13 @@ def contact_response(
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, ledger_row):
+def clear_opened(k, history, h_spring, h_roll, out_normal_force, out_state):
     """Outputs of a pair that does not touch; a contact that just opened is cleared.
 
     The energy left in its springs when a contact opens is counted as friction (documented);
-    returns it, (sliding, rolling) [J], for the heat generation. A pair that did not touch at
-    the previous pass already has zero outputs and history: no writes (a rebuild marks every
-    pair STATE_UNSET, so the outputs of a new list are written).
+    returns it, (sliding, rolling) [J], for the ledger and the heat generation. A pair that
+    did not touch at the previous pass already has zero outputs and history: no writes (a
+    rebuild marks every pair STATE_UNSET, so the outputs of a new list are written).
     """
     if out_state[k] == STATE_NEAR or out_state[k] == STATE_FAR:
         return 0.0, 0.0
@@ -247,13 +247,23 @@ def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, led
     if history[k, H_DURATION] != 0.0:
         if h_spring >= 0:
             e_spring = history[k, h_spring + 3]
-            ledger_row[L_SLIDING_FRICTION] += e_spring
         if h_roll >= 0:
             e_roll = history[k, h_roll + 3]
-            ledger_row[L_ROLLING_FRICTION] += e_roll
         for c in range(history.shape[1]):
             history[k, c] = 0.0
     out_normal_force[k] = 0.0
+    return e_spring, e_roll
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _open_contact(k, history, h_spring, h_roll, out_normal_force, out_state, ledger_row):
+    """:func:`clear_opened`, the springs' energies added to the ledger row (the planar pass
+    keeps its ledger sums in registers and calls :func:`clear_opened` itself)."""
+    e_spring, e_roll = clear_opened(k, history, h_spring, h_roll, out_normal_force, out_state)
+    if e_spring != 0.0:
+        ledger_row[L_SLIDING_FRICTION] += e_spring
+    if e_roll != 0.0:
+        ledger_row[L_ROLLING_FRICTION] += e_roll
     return e_spring, e_roll
 
 

@@ -45,6 +45,7 @@ from thermodem.kernels.contact import (
     STATE_FAR,
     STATE_NEAR,
     STATE_TOUCHING,
+    clear_opened,
 )
 from thermodem.kernels.neighbors import minimum_image
 from thermodem.kernels.variants import parallel_kernel
@@ -146,25 +147,6 @@ def _normal_law(normal_id, table, ti, tj, eff_mass):
         k = table[ti, tj, NL.LINEAR_STIFFNESS]
         zeta = table[ti, tj, NL.LINEAR_DAMPING_RATIO]
     return k, 2.0 * zeta * math.sqrt(eff_mass * k)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _open_pair(k, history, h_spring, h_roll, out_normal_force, out_state):
-    """:func:`thermodem.kernels.contact._open_contact` whose energies (sliding, rolling;
-    0 unless a contact opens) the pass adds to its ledger sums."""
-    if out_state[k] == STATE_NEAR or out_state[k] == STATE_FAR:
-        return 0.0, 0.0
-    e_spring = 0.0
-    e_roll = 0.0
-    if history[k, H_DURATION] != 0.0:
-        if h_spring >= 0:
-            e_spring = history[k, h_spring + 3]
-        if h_roll >= 0:
-            e_roll = history[k, h_roll + 3]
-        for c in range(history.shape[1]):
-            history[k, c] = 0.0
-    out_normal_force[k] = 0.0
-    return e_spring, e_roll
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -271,7 +253,7 @@ def planar_pair_pass(
                 rj = radius[j]
                 overlap = ri + rj - dist
                 if overlap <= 0.0 or dist == 0.0:
-                    e_spring, e_rspring = _open_pair(
+                    e_spring, e_rspring = clear_opened(
                         k, history, h_spring, h_roll, out_normal_force, out_state
                     )
                     l_slip += e_spring
